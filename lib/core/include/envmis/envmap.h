@@ -1,0 +1,142 @@
+// An importance-sampled equirectangular environment map: the radiance image, its
+// sampling density (luminance, optionally MIS-compensated, times sin theta) and the
+// distribution that samples it.
+//
+// Measure: `sample` and `pdf` speak solid angle (per steradian) over directions in the
+// world frame given by EnvMapOptions::axes (mapping.h). The density of texel (x, y) in
+// image space is proportional to q(x, y) sin(theta_y) (row centre), with
+// q = L (uncompensated) or max(L - alpha Lbar, 0) (compensated); the solid-angle pdf is
+// that image density / (2 pi^2 sin theta). Radiance is the texel's value (nearest), so
+// it is constant exactly where the density is.
+//
+// Cost: build O(w h), parallel over rows (see `envmis bench` for figures); sample, pdf
+// and eval O(1), noexcept and allocation-free. Memory: 16 bytes per texel for the
+// distribution plus 12 for the RGB radiance.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "envmis/compensation.h"
+#include "envmis/distribution.h"
+#include "envmis/image.h"
+#include "envmis/mapping.h"
+#include "envmis/math.h"
+
+namespace envmis {
+
+inline constexpr float kTwoPiSquared = static_cast<float>(2 * kPi * kPi);
+
+// How the density was chosen when the requested one was unusable.
+enum class DensityFallback : uint32_t {
+    none = 0,
+    uncompensated = 1,  // compensation zeroed every texel (a constant map): plain luminance used
+    uniform = 2,        // the map is black: uniform over the sphere
+};
+std::string_view to_string(DensityFallback f) noexcept;
+
+struct EnvMapOptions {
+    CompensationOptions compensation;  // enabled by default, alpha = 1
+    LumaCoefficients luma;             // of the radiance's colour space (Rec.709 by default)
+    Axes axes;                         // world frame of directions (z up by default)
+};
+
+// What the build measured and did; recorded in table files.
+struct EnvMapStats {
+    BadPixels bad_pixels;            // channel values replaced by 0
+    double mean_luminance = 0;       // Lbar, solid-angle weighted
+    float threshold = 0;             // alpha Lbar if compensation was applied, else 0
+    float max_luminance = 0;
+    float min_positive_luminance = 0;  // 0 if the map is black
+    uint64_t zeroed_texels = 0;        // texels with L > 0 whose density compensation set to 0
+    DensityFallback fallback = DensityFallback::none;
+};
+
+// One sample: a world direction, its solid-angle pdf, the radiance arriving from it and
+// its image point.
+struct EnvSample {
+    Vec3 direction;
+    float pdf = 0;
+    Rgb radiance;
+    Vec2 uv;
+};
+
+// Non-owning, device-friendly view of an EnvMap (flat arrays; see distribution.h).
+struct EnvMapView {
+    Distribution2DView distribution;
+    const Rgb* radiance = nullptr;
+    Axes axes;
+
+    ENVMIS_HD EnvSample sample(Vec2 u) const noexcept {
+        const auto s = distribution.sample(u);
+        float sin_theta = 0;
+        const Vec3 canonical = equirect_direction(s.p, &sin_theta);
+        return {to_world(axes, canonical), solid_angle_pdf(s.pdf, sin_theta),
+                radiance[static_cast<size_t>(s.y) * distribution.w + s.x], s.p};
+    }
+    // Solid-angle pdf of sampling `direction` (a unit vector in the world frame).
+    ENVMIS_HD float pdf(Vec3 direction) const noexcept { return pdf_uv(equirect_uv(to_canonical(axes, direction))); }
+    // Solid-angle pdf at image point uv; bit-identical to sample(u).pdf when uv = sample(u).uv.
+    ENVMIS_HD float pdf_uv(Vec2 uv) const noexcept {
+        return solid_angle_pdf(distribution.pdf(uv), std::sin(kPiF * uv.y));
+    }
+    // Radiance arriving from `direction` (nearest texel).
+    ENVMIS_HD Rgb eval(Vec3 direction) const noexcept {
+        const Vec2 uv = equirect_uv(to_canonical(axes, direction));
+        const uint32_t x = detail::cell_of(uv.x, distribution.w), y = detail::cell_of(uv.y, distribution.h);
+        return radiance[static_cast<size_t>(y) * distribution.w + x];
+    }
+    // Image density to solid angle; 0 at the poles, where the mapping degenerates.
+    ENVMIS_HD static float solid_angle_pdf(float image_pdf, float sin_theta) noexcept {
+        return sin_theta > 0 ? image_pdf / (kTwoPiSquared * sin_theta) : 0.0f;
+    }
+};
+
+class EnvMap {
+public:
+    EnvMap() = default;
+    // Builds the sampler from a radiance image, repairing bad pixels (counted in
+    // stats().bad_pixels). Throws std::invalid_argument for an empty image, a pixel count
+    // that does not match the size, more than 2^31 texels, or invalid options.
+    explicit EnvMap(RgbImage image, const EnvMapOptions& options = {});
+
+    // Rebuilds a saved sampler from its parts (the table reader's path): the image
+    // density q(x, y) sin(theta_y) exactly as density() returned it. Gives bit-identical
+    // samples to the map that was saved. Throws std::invalid_argument on inconsistent parts.
+    EnvMap(RgbImage radiance, std::span<const float> density, const EnvMapOptions& options,
+           const EnvMapStats& stats);
+
+    EnvMapView view() const noexcept { return {distribution_.view(), radiance_.pixels.data(), options_.axes}; }
+    EnvSample sample(Vec2 u) const noexcept { return view().sample(u); }
+    float pdf(Vec3 direction) const noexcept { return view().pdf(direction); }
+    float pdf_uv(Vec2 uv) const noexcept { return view().pdf_uv(uv); }
+    Rgb eval(Vec3 direction) const noexcept { return view().eval(direction); }
+
+    uint32_t width() const noexcept { return radiance_.width; }
+    uint32_t height() const noexcept { return radiance_.height; }
+    const EnvMapOptions& options() const noexcept { return options_; }
+    const EnvMapStats& stats() const noexcept { return stats_; }
+    const RgbImage& radiance() const noexcept { return radiance_; }
+    const Distribution2D& distribution() const noexcept { return distribution_; }
+    // The image-space density function, q(x, y) sin(theta_y), row-major.
+    std::vector<float> density() const;
+
+    // True if the density was compensated (and no fallback replaced it).
+    bool compensated() const noexcept {
+        return options_.compensation.enabled && stats_.fallback == DensityFallback::none;
+    }
+    // True if pdf > 0 wherever the radiance is non-zero, so that the map can be sampled
+    // alone without bias. A compensated density is usually incomplete: combine it with a
+    // technique that covers the whole sphere (BSDF sampling) through MIS.
+    bool complete() const noexcept { return stats_.zeroed_texels == 0; }
+
+private:
+    RgbImage radiance_;
+    Distribution2D distribution_;
+    EnvMapOptions options_;
+    EnvMapStats stats_;
+};
+
+}  // namespace envmis

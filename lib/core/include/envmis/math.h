@@ -1,0 +1,63 @@
+// Small value types and constants shared by every envmis module.
+//
+// Everything here is header-only, allocation-free and usable from device code:
+// ENVMIS_HD expands to `__host__ __device__` under a CUDA compiler and to nothing
+// in plain C++, so the same sampling code runs in renderers on either side.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#if defined(__CUDACC__)
+#define ENVMIS_HD __host__ __device__
+#else
+#define ENVMIS_HD
+#endif
+
+namespace envmis {
+
+inline constexpr double kPi = 3.14159265358979323846;
+inline constexpr float kPiF = 3.14159265358979323846f;
+// Largest float below 1: samplers clamp to it so that points stay in [0,1).
+inline constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
+
+struct Vec2 {
+    float x = 0, y = 0;
+};
+
+struct Vec3 {
+    float x = 0, y = 0, z = 0;
+
+    ENVMIS_HD float operator[](int i) const noexcept { return i == 0 ? x : (i == 1 ? y : z); }
+    ENVMIS_HD friend Vec3 operator+(Vec3 a, Vec3 b) noexcept { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+    ENVMIS_HD friend Vec3 operator-(Vec3 a, Vec3 b) noexcept { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+    ENVMIS_HD friend Vec3 operator*(Vec3 a, float s) noexcept { return {a.x * s, a.y * s, a.z * s}; }
+    ENVMIS_HD friend Vec3 operator*(float s, Vec3 a) noexcept { return a * s; }
+};
+
+ENVMIS_HD inline float dot(Vec3 a, Vec3 b) noexcept { return a.x * b.x + a.y * b.y + a.z * b.z; }
+ENVMIS_HD inline float length(Vec3 a) noexcept { return std::sqrt(dot(a, a)); }
+ENVMIS_HD inline Vec3 normalize(Vec3 a) noexcept { return a * (1.0f / length(a)); }
+ENVMIS_HD inline Vec3 cross(Vec3 a, Vec3 b) noexcept {
+    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+
+// Linear RGB radiance in the table's working colour space (units of the source image).
+struct Rgb {
+    float r = 0, g = 0, b = 0;
+};
+
+// Luminance as a weighted sum of linear RGB; the weights are the Y row of the
+// working space's RGB->XYZ matrix (Rec.709 by default).
+struct LumaCoefficients {
+    float r = 0.2126f, g = 0.7152f, b = 0.0722f;
+};
+
+ENVMIS_HD inline float luminance(Rgb c, LumaCoefficients k) noexcept { return k.r * c.r + k.g * c.g + k.b * c.b; }
+
+template <class T>
+ENVMIS_HD constexpr T clamp(T v, T lo, T hi) noexcept {
+    return v < lo ? lo : (hi < v ? hi : v);
+}
+
+}  // namespace envmis

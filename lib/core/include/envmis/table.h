@@ -1,0 +1,61 @@
+// Table files: a built EnvMap saved to disk, readable with envmis::core alone.
+//
+// The format (version 1) is specified in docs/table-format.md: a fixed preamble (magic,
+// version, byte order, total size), a metadata block with the build options and the
+// source's name and content hash, a header checksum, then the payload (the image
+// density q sin(theta) and the RGB radiance, both float32) and a payload checksum.
+// The sampling structures are derived data and are rebuilt on load by the same code
+// that built them, so a loaded table samples bit-identically to the saved one, and no
+// index read from a file can ever address memory.
+//
+// Writing goes to a temporary file in the destination's folder, renamed over the
+// destination only when complete: an interrupted run never leaves a partial table.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "envmis/envmap.h"
+
+namespace envmis {
+
+inline constexpr uint32_t kTableVersion = 1;
+
+// Where a table's map came from.
+struct TableSource {
+    std::string name;                 // file name of the source image (no folders)
+    uint64_t content_hash = 0;        // hash64 of the source file's bytes
+    std::string input_colorspace;     // colour space the pixels were read in
+    std::string working_colorspace;   // colour space of the stored radiance
+};
+
+struct Table {
+    EnvMap map;
+    TableSource source;
+};
+
+// A table file that cannot be read; what() names the file and the problem.
+class TableError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// Writes atomically (temporary file, then rename). Throws TableError on I/O failure.
+void write_table(const std::filesystem::path& path, const EnvMap& map, const TableSource& source);
+
+// Reads and verifies a table. Throws TableError if the file is missing, truncated,
+// corrupted (checksums), of another format, or of an unsupported version.
+Table read_table(const std::filesystem::path& path);
+
+// The same checks on bytes already in memory; `name` appears in error messages.
+Table parse_table(std::span<const std::byte> bytes, std::string_view name);
+
+// True if the file starts with the table magic (cheap; does not validate the rest).
+bool looks_like_table(const std::filesystem::path& path) noexcept;
+
+}  // namespace envmis

@@ -1,0 +1,60 @@
+// Reading HDR images into linear RGB, and writing EXR and PNG files.
+//
+// Reading: anything OpenImageIO reads (OpenEXR scanline, tiled or multi-part (the first
+// part), Radiance .hdr, .pfm, float TIFF, ...), with 1 (grey), 2 (grey + alpha), 3 (RGB)
+// or 4+ (RGBA...: alpha and extra channels ignored) channels. Pixels are converted with
+// OpenColorIO from the input colour space (the file's metadata, or the caller's choice)
+// to a linear working space (colour.h). Values are returned as read: NaN, Inf and
+// negative values are left for EnvMap to repair and count.
+//
+// Writing: to a temporary file in the destination folder, renamed when complete.
+//
+// Errors: ImageError, whose message names the file and the problem (missing, not an
+// image, truncated, unsupported, unknown colour space...).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "envmis/image.h"
+#include "envmis/math.h"
+
+namespace envmis::io {
+
+class ImageError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+struct LoadOptions {
+    std::string colorspace;                 // input colour space; empty: from the file's metadata
+    std::string working_space = "lin_rec709";  // a colour space of the OCIO config (colour.h)
+};
+
+struct LoadedImage {
+    RgbImage image;                  // linear RGB in the working space, raw values
+    std::string input_colorspace;    // the colour space the pixels were converted from
+    std::string working_colorspace;  // the colour space of `image`
+    LumaCoefficients luma;           // luminance weights of the working space
+    uint64_t content_hash = 0;       // envmis::hash64 of the file's bytes
+    std::string format;              // OpenImageIO's format name, e.g. "openexr", "hdr"
+    uint32_t channels = 0;           // channels in the file
+};
+
+LoadedImage load_image(const std::filesystem::path& path, const LoadOptions& options = {});
+
+// 8-bit sRGB-encoded RGB pixels, row-major, row 0 at the top (pictures for people).
+struct Image8 {
+    uint32_t width = 0, height = 0;
+    std::vector<uint8_t> rgb;  // width * height * 3
+};
+
+// Writes linear float RGB as a 32-bit float OpenEXR file.
+void write_exr(const std::filesystem::path& path, const RgbImage& image);
+// Writes a PNG file.
+void write_png(const std::filesystem::path& path, const Image8& image);
+
+}  // namespace envmis::io
