@@ -1,0 +1,267 @@
+// Specification of the environment-map sampler (envmap.h), checked against
+// computations written independently here from the documented conventions.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+
+#include "envmis/envmap.h"
+#include "maps.h"
+#include "stats.h"
+
+namespace envmis {
+namespace {
+
+using test::Rng;
+
+const double kLevel = test::sidak_level(0.01, 20);
+
+// The documented density, computed from scratch: q(x, y) sin(theta_y), q = L or max(L - alpha Lbar, 0).
+std::vector<double> reference_mass(const RgbImage& m, bool compensate, double alpha) {
+    const uint32_t w = m.width, h = m.height;
+    std::vector<double> lum(size_t{w} * h), mass(lum.size());
+    double weighted = 0, weights = 0;
+    for (uint32_t y = 0; y < h; ++y) {
+        const double s = std::sin(kPi * (y + 0.5) / h);
+        for (uint32_t x = 0; x < w; ++x) {
+            const Rgb p = m.at(x, y);
+            const double l = 0.2126 * std::max(p.r, 0.0f) + 0.7152 * std::max(p.g, 0.0f) + 0.0722 * std::max(p.b, 0.0f);
+            lum[size_t{y} * w + x] = l;
+            weighted += s * l, weights += s;
+        }
+    }
+    const double threshold = compensate ? alpha * weighted / weights : 0.0;
+    for (uint32_t y = 0; y < h; ++y)
+        for (uint32_t x = 0; x < w; ++x) {
+            const double l = lum[size_t{y} * w + x];
+            mass[size_t{y} * w + x] = std::max(l - threshold, 0.0) * std::sin(kPi * (y + 0.5) / h);
+        }
+    return mass;
+}
+
+// Texel a world direction falls in, for the default z-up axes.
+size_t texel_of(Vec3 d, uint32_t w, uint32_t h) {
+    const double theta = std::acos(std::clamp<double>(d.z, -1, 1));
+    double phi = std::atan2(double{d.y}, double{d.x});
+    if (phi < 0) phi += 2 * kPi;
+    const auto x = std::min<uint32_t>(w - 1, static_cast<uint32_t>(phi / (2 * kPi) * w));
+    const auto y = std::min<uint32_t>(h - 1, static_cast<uint32_t>(theta / kPi * h));
+    return size_t{y} * w + x;
+}
+
+void expect_directions_follow(const EnvMap& map, const std::vector<double>& mass, uint64_t seed) {
+    const size_t n = std::max<size_t>(100000, 30 * mass.size());
+    const double total = std::accumulate(mass.begin(), mass.end(), 0.0);
+    std::vector<double> observed(mass.size()), expected(mass.size());
+    for (size_t i = 0; i < mass.size(); ++i) expected[i] = n * mass[i] / total;
+    Rng rng(seed);
+    for (size_t i = 0; i < n; ++i) observed[texel_of(map.sample(rng.uniform2()).direction, map.width(), map.height())] += 1;
+    const auto chi = test::chi_square(expected, observed);
+    EXPECT_GT(chi.p_value, kLevel) << map.width() << "x" << map.height() << ": " << chi.describe();
+}
+
+// For a density proportional to sin(theta) of the row centre (constant and black maps):
+// the exact solid-angle pdf at a sample, close to 1 / (4 pi) away from the poles.
+void expect_sine_density(const EnvMap& map, uint64_t seed) {
+    const uint32_t h = map.height();
+    double mean_sin = 0;
+    for (uint32_t y = 0; y < h; ++y) mean_sin += std::sin(kPi * (y + 0.5) / h) / h;
+    Rng rng(seed);
+    for (int i = 0; i < 1000; ++i) {
+        const EnvSample s = map.sample(rng.uniform2());
+        const double row_sin = std::sin(kPi * (std::floor(s.uv.y * h) + 0.5) / h);
+        const double expected = row_sin / mean_sin / (2 * kPi * kPi * std::sin(kPi * s.uv.y));
+        EXPECT_NEAR(s.pdf, expected, 1e-4 * expected);
+    }
+}
+
+EnvMapOptions options(bool compensate, float alpha = 1.0f) {
+    EnvMapOptions o;
+    o.compensation = {compensate, alpha};
+    return o;
+}
+
+TEST(EnvMap, DirectionsFollowTheDocumentedDensity) {
+    uint64_t seed = 100;
+    for (const RgbImage& image : {test::sun_sky_map(64, 32), test::random_map(40, 20, 1), test::random_map(7, 5, 2)})
+        for (bool compensate : {false, true}) {
+            const EnvMap map(image, options(compensate));
+            expect_directions_follow(map, reference_mass(image, compensate, 1.0), seed++);
+        }
+}
+
+TEST(EnvMap, CompensationStrengthAlphaIsHonoured) {
+    const RgbImage image = test::random_map(32, 16, 3);
+    for (float alpha : {0.0f, 0.5f, 2.0f}) {
+        const EnvMap map(image, options(true, alpha));
+        expect_directions_follow(map, reference_mass(image, true, alpha), 200 + static_cast<uint64_t>(alpha * 10));
+    }
+}
+
+TEST(EnvMap, SolidAnglePdfIntegratesToOne) {
+    for (const RgbImage& image : {test::sun_sky_map(64, 32), test::random_map(9, 5, 4), test::constant_map(1, 1, {1, 1, 1})})
+        for (bool compensate : {false, true}) {
+            const EnvMap map(image, options(compensate));
+            // Midpoint rule in (theta, phi) on a grid aligned with, and 4x finer than, the texels.
+            const uint32_t nt = 4 * map.height(), np = 4 * map.width();
+            double integral = 0;
+            for (uint32_t i = 0; i < nt; ++i) {
+                const double theta = kPi * (i + 0.5) / nt;
+                for (uint32_t j = 0; j < np; ++j) {
+                    const double phi = 2 * kPi * (j + 0.5) / np;
+                    const Vec3 d{static_cast<float>(std::sin(theta) * std::cos(phi)),
+                                 static_cast<float>(std::sin(theta) * std::sin(phi)), static_cast<float>(std::cos(theta))};
+                    integral += map.pdf(d) * std::sin(theta);
+                }
+            }
+            integral *= (kPi / nt) * (2 * kPi / np);
+            EXPECT_NEAR(integral, 1.0, 1e-3) << image.width << "x" << image.height << " compensate=" << compensate;
+        }
+}
+
+TEST(EnvMap, SampleAgreesWithPdfAndEval) {
+    const RgbImage image = test::sun_sky_map(128, 64);
+    const EnvMap map(image, options(true));
+    Rng rng(5);
+    int edge_cases = 0;
+    const int n = 50000;
+    for (int i = 0; i < n; ++i) {
+        const EnvSample s = map.sample(rng.uniform2());
+        ASSERT_EQ(s.pdf, map.pdf_uv(s.uv));
+        ASSERT_NEAR(length(s.direction), 1.0f, 1e-5f);
+        // From the direction alone, float round trips may land in the neighbouring texel.
+        const float p = map.pdf(s.direction);
+        if (std::abs(p - s.pdf) > 1e-3f * s.pdf) ++edge_cases;
+        const Rgb e = map.eval(s.direction);
+        if (e.r != s.radiance.r || e.g != s.radiance.g || e.b != s.radiance.b) ++edge_cases;
+    }
+    EXPECT_LT(edge_cases, n / 500);
+}
+
+TEST(EnvMap, PdfIsZeroExactlyWhereTheDensityIs) {
+    const RgbImage image = test::random_map(24, 12, 6);
+    const EnvMap map(image, options(true));
+    const auto mass = reference_mass(image, true, 1.0);
+    for (uint32_t y = 0; y < 12; ++y)
+        for (uint32_t x = 0; x < 24; ++x) {
+            const float p = map.pdf_uv({(x + 0.5f) / 24, (y + 0.5f) / 12});
+            EXPECT_EQ(p > 0, mass[size_t{y} * 24 + x] > 0) << x << "," << y;
+        }
+}
+
+TEST(EnvMap, CompensationZeroesExactlyTheTexelsAtOrBelowAlphaLbar) {
+    const RgbImage image = test::random_map(50, 25, 7);
+    for (float alpha : {0.5f, 1.0f, 3.0f}) {
+        const EnvMap map(image, options(true, alpha));
+        const auto density = map.density();
+        uint64_t zeroed = 0;
+        for (size_t i = 0; i < density.size(); ++i) {
+            const float l = luminance(image.pixels[i], {});
+            EXPECT_EQ(density[i] == 0, l <= map.stats().threshold) << i;
+            zeroed += l > 0 && l <= map.stats().threshold;
+        }
+        EXPECT_EQ(map.stats().zeroed_texels, zeroed);
+        EXPECT_NEAR(map.stats().threshold, alpha * map.stats().mean_luminance, 1e-6 * map.stats().threshold);
+        EXPECT_TRUE(map.compensated());
+        EXPECT_FALSE(map.complete());
+    }
+}
+
+TEST(EnvMap, MeanLuminanceIsSolidAngleWeighted) {
+    // Bright poles, dark equator: a per-texel mean would be far higher.
+    RgbImage image = test::constant_map(16, 64, {0, 0, 0});
+    for (uint32_t x = 0; x < 16; ++x) image.pixels[x] = image.pixels[63 * 16 + x] = {1, 1, 1};
+    const EnvMap map(image, options(true));
+    const double s0 = std::sin(kPi * 0.5 / 64);
+    double weights = 0;
+    for (int y = 0; y < 64; ++y) weights += std::sin(kPi * (y + 0.5) / 64);
+    EXPECT_NEAR(map.stats().mean_luminance, 2 * s0 / weights, 1e-7);
+}
+
+TEST(EnvMap, UncompensatedMapIsComplete) {
+    const EnvMap map(test::random_map(20, 10, 8), options(false));
+    EXPECT_FALSE(map.compensated());
+    EXPECT_TRUE(map.complete());
+    EXPECT_EQ(map.stats().threshold, 0.0f);
+}
+
+TEST(EnvMap, ConstantMapFallsBackToUncompensated) {
+    const EnvMap map(test::constant_map(32, 16, {0.5f, 0.5f, 0.5f}), options(true));
+    EXPECT_EQ(map.stats().fallback, DensityFallback::uncompensated);
+    EXPECT_FALSE(map.compensated());
+    EXPECT_TRUE(map.complete());
+    expect_sine_density(map, 9);
+}
+
+TEST(EnvMap, BlackMapSamplesTheSphereUniformly) {
+    const EnvMap map(test::constant_map(32, 16, {0, 0, 0}), options(true));
+    EXPECT_EQ(map.stats().fallback, DensityFallback::uniform);
+    EXPECT_TRUE(map.complete());
+    expect_sine_density(map, 10);
+}
+
+TEST(EnvMap, SingleTexelMapWorks) {
+    const EnvMap map(test::constant_map(1, 1, {2, 2, 2}), options(true));
+    Rng rng(11);
+    for (int i = 0; i < 1000; ++i) {
+        const EnvSample s = map.sample(rng.uniform2());
+        EXPECT_FLOAT_EQ(s.radiance.r, 2.0f);
+        if (s.pdf > 0) {
+            EXPECT_NEAR(s.pdf * kTwoPiSquared * std::sin(kPiF * s.uv.y), 1.0f, 1e-5f);
+        }
+    }
+}
+
+TEST(EnvMap, BadPixelsAreRepairedAndCounted) {
+    RgbImage image = test::constant_map(4, 3, {1, 1, 1});
+    image.pixels[0] = {NAN, 1, 1};
+    image.pixels[1] = {INFINITY, -INFINITY, 1};
+    image.pixels[2] = {-0.004f, 1, -2};
+    const EnvMap map(image, options(false));
+    EXPECT_EQ(map.stats().bad_pixels.nan, 1u);
+    EXPECT_EQ(map.stats().bad_pixels.infinite, 2u);
+    EXPECT_EQ(map.stats().bad_pixels.negative, 2u);
+    for (const Rgb& p : map.radiance().pixels) EXPECT_TRUE(p.r >= 0 && p.g >= 0 && p.b >= 0 && std::isfinite(p.r + p.g + p.b));
+}
+
+TEST(EnvMap, AbsurdDynamicRangeStillSamplesCorrectly) {
+    RgbImage image = test::constant_map(32, 16, {});
+    Rng rng(12);
+    for (Rgb& p : image.pixels) {
+        const float l = std::pow(10.0f, 16 * rng.uniform() - 8);  // 1e-8 .. 1e8
+        p = {l, l, l};
+    }
+    const EnvMap map(image, options(false));
+    EXPECT_TRUE(map.complete());
+    EXPECT_GT(map.stats().max_luminance / map.stats().min_positive_luminance, 1e14f);
+    for (uint32_t y = 0; y < 16; ++y)
+        for (uint32_t x = 0; x < 32; ++x) EXPECT_GT(map.pdf_uv({(x + 0.5f) / 32, (y + 0.5f) / 16}), 0.0f);
+    expect_directions_follow(map, reference_mass(image, false, 1.0), 13);
+}
+
+TEST(EnvMap, AxesRotateDirectionsWithoutChangingPdfs) {
+    const RgbImage image = test::sun_sky_map(64, 32);
+    EnvMapOptions y_up = options(true);
+    y_up.axes = Axes::parse("y-up");
+    const EnvMap z_map(image, options(true)), y_map(image, y_up);
+    Rng rng(14);
+    for (int i = 0; i < 1000; ++i) {
+        const Vec2 u = rng.uniform2();
+        const EnvSample a = z_map.sample(u), b = y_map.sample(u);
+        EXPECT_EQ(a.pdf, b.pdf);
+        EXPECT_FLOAT_EQ(b.direction.y, a.direction.z);  // canonical up is world +y
+        EXPECT_FLOAT_EQ(b.direction.x, a.direction.x);
+        EXPECT_FLOAT_EQ(b.direction.z, -a.direction.y);
+        EXPECT_NEAR(y_map.pdf(b.direction), b.pdf, 1e-3f * b.pdf + 1e-6f);
+    }
+}
+
+TEST(EnvMap, RejectsInvalidConstruction) {
+    EXPECT_THROW(EnvMap(RgbImage{}), std::invalid_argument);
+    EXPECT_THROW(EnvMap(RgbImage{4, 4, std::vector<Rgb>(15)}), std::invalid_argument);
+    EXPECT_THROW(EnvMap(test::constant_map(4, 2, {1, 1, 1}), options(true, -1.0f)), std::invalid_argument);
+    EXPECT_THROW(EnvMap(test::constant_map(4, 2, {1, 1, 1}), options(true, NAN)), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace envmis
