@@ -125,7 +125,8 @@ TYPED_TEST(Distribution2DTest, AllZeroFunctionGivesUniformWithFlag) {
 TYPED_TEST(Distribution2DTest, RejectsInvalidInput) {
     const std::vector<float> four(4, 1.0f);
     EXPECT_THROW(TypeParam(four, 3, 2), std::invalid_argument);
-    EXPECT_THROW(TypeParam({}, 0, 0), std::invalid_argument);
+    EXPECT_THROW(TypeParam(std::vector<float>{}, 0, 0), std::invalid_argument);
+    EXPECT_THROW(TypeParam(std::vector<float>(65537, 1.0f), 65537, 1), std::invalid_argument);
     for (float bad : {-1.0f, NAN, INFINITY}) {
         std::vector<float> f = four;
         f[2] = bad;
@@ -147,19 +148,46 @@ TEST(Distribution2D, ExtremeAspectRatiosWork) {
     }
 }
 
-TEST(Distribution2D, KeepsCellsBelowFloatResolution) {
-    // A cell 1e-9 of its row's mass: a float CDF loses it, the double CDF keeps it.
+TEST(Distribution2D, KeepsCellsFarBelowFloatResolution) {
+    // Cells 1e-12 of their row's mass, after a large one: a float CDF loses them; here
+    // they keep a positive pdf (their one unit of 2^-31 is below the 2^-24 grid of a float
+    // u, so they are practically never sampled, as their mass says).
     std::vector<float> f(4, 0.0f);
-    f[0] = 1e9f, f[1] = 1.0f;
+    f[0] = 1e12f, f[1] = 1.0f, f[3] = 1.0f;
     const Distribution2D d(f, 4, 1);
-    EXPECT_GT(d.view().cells[1].cdf, d.view().cells[0].cdf);
+    EXPECT_GT(d.pdf({0.3f, 0.5f}), 0.0f);
+    EXPECT_GT(d.pdf({0.8f, 0.5f}), 0.0f);
+    EXPECT_EQ(d.pdf({0.6f, 0.5f}), 0.0f);
+}
+
+TEST(Distribution2D, ProbabilitiesMatchTheFunctionToFixedPointResolution) {
+    const auto f = test::random_function(300 * 200, 13, 6);
+    const Distribution2D d(f, 300, 200);
+    const double mean = std::accumulate(f.begin(), f.end(), 0.0) / f.size();
+    for (uint32_t y = 0; y < 200; ++y)
+        for (uint32_t x = 0; x < 300; ++x) {
+            const double expected = f[y * 300 + x] / mean;
+            // Two fixed-point widths, each within one unit (2^-31) of the ideal probability.
+            ASSERT_NEAR(d.pdf({(x + 0.5f) / 300, (y + 0.5f) / 200}), expected, 1e-6 * expected + 300.0 * 200 * 0x1p-30)
+                << x << "," << y;
+        }
 }
 
 TEST(Distribution2D, BuildDoesNotDependOnThreads) {
-    // Rows are built in parallel; a second build must give identical cells.
+    // Rows are built in parallel; a second build must give identical tables.
     const auto f = test::random_function(300 * 200, 13);
     const Distribution2D a(f, 300, 200), b(f, 300, 200);
-    for (size_t i = 0; i < f.size(); ++i) ASSERT_EQ(a.view().cells[i].cdf, b.view().cells[i].cdf);
+    for (size_t i = 0; i < f.size(); ++i) {
+        ASSERT_EQ(a.view().start[i], b.view().start[i]);
+        ASSERT_EQ(a.view().guide[i], b.view().guide[i]);
+    }
+}
+
+TEST(Distribution2D, RowFunctionExceptionsReachTheCaller) {
+    EXPECT_THROW(Distribution2D(8, 64, [](uint32_t y, std::span<float>) {
+                     if (y == 40) throw std::runtime_error("row 40");
+                 }),
+                 std::runtime_error);
 }
 
 TEST(Distribution1D, SamplesFollowTheFunction) {
@@ -205,6 +233,7 @@ TEST(Distribution1D, SingleCellAndAllZero) {
 
 TEST(Distribution1D, RejectsInvalidInput) {
     EXPECT_THROW(Distribution1D(std::vector<float>{}), std::invalid_argument);
+    EXPECT_THROW(Distribution1D(std::vector<float>(65537, 1.0f)), std::invalid_argument);
     EXPECT_THROW(Distribution1D(std::vector<float>{1.0f, -0.5f}), std::invalid_argument);
     EXPECT_THROW(Distribution1D(std::vector<float>{NAN}), std::invalid_argument);
 }

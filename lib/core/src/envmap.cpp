@@ -26,9 +26,9 @@ constexpr uint32_t kRowsPerThread = 8;
 
 void check_image(const RgbImage& image) {
     const size_t n = size_t{image.width} * image.height;
-    if (image.width == 0 || image.height == 0 || n > kMaxTexels)
+    if (image.width == 0 || image.height == 0 || image.width > kMaxCells1D || image.height > kMaxCells1D || n > kMaxTexels)
         throw std::invalid_argument("environment map size " + std::to_string(image.width) + "x" +
-                                    std::to_string(image.height) + " is empty or above 2^31 texels");
+                                    std::to_string(image.height) + " is empty, above 65536 on a side or above 2^31 texels");
     if (image.pixels.size() != n)
         throw std::invalid_argument("environment map: " + std::to_string(image.pixels.size()) +
                                     " pixels do not make a " + std::to_string(image.width) + "x" +
@@ -45,6 +45,11 @@ void check_options(const EnvMapOptions& o) {
         throw std::invalid_argument("luma coefficients must be finite, >= 0 and not all 0");
 }
 
+// Luminance of a repaired pixel, kept finite when the channels are near float's maximum.
+float texel_luminance(const Rgb& p, const LumaCoefficients& k) noexcept {
+    return std::min(luminance(p, k), std::numeric_limits<float>::max());
+}
+
 // Per-row results of the luminance pass, reduced in row order so that the result does
 // not depend on the number of threads.
 struct RowStats {
@@ -55,6 +60,25 @@ struct RowStats {
     uint64_t zeroed = 0;
 };
 
+// Repairs a row's pixels and gathers its luminance statistics. The common case, a row
+// without bad values, is checked first with a loop the compiler vectorises, and four
+// partial sums keep double adds from serialising.
+void scan_row(Rgb* pixels, uint32_t w, const LumaCoefficients& luma, RowStats& r) noexcept {
+    const float* channels = &pixels[0].r;
+    bool clean = true;
+    for (uint32_t i = 0; i < 3 * w; ++i) clean &= channels[i] >= 0 && channels[i] <= std::numeric_limits<float>::max();
+    if (!clean)
+        for (uint32_t x = 0; x < w; ++x) sanitize_pixel(pixels[x], r.bad);
+    double sums[4] = {0, 0, 0, 0};
+    for (uint32_t x = 0; x < w; ++x) {
+        const float l = texel_luminance(pixels[x], luma);
+        sums[x & 3] += l;
+        r.max = std::max(r.max, l);
+        if (l > 0) r.min_positive = std::min(r.min_positive, l);
+    }
+    r.sum = (sums[0] + sums[1]) + (sums[2] + sums[3]);
+}
+
 }  // namespace
 
 EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : radiance_(std::move(image)), options_(options) {
@@ -63,21 +87,12 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : radiance_(std::mo
     const uint32_t w = radiance_.width, h = radiance_.height;
     Rgb* pixels = radiance_.pixels.data();
 
-    // Pass 1: repair pixels, luminance, row sums. `func` holds L, then the density.
-    std::vector<float> func(size_t{w} * h);
+    // Pass 1: repair pixels, row sums of luminance. Pass 2 (the distribution's build)
+    // recomputes luminance rather than holding it: reading the pixels again is cheaper
+    // than writing and reading another w x h buffer.
     std::vector<RowStats> rows(h);
     detail::parallel_for(h, kRowsPerThread, [&](uint32_t lo, uint32_t hi) {
-        for (uint32_t y = lo; y < hi; ++y) {
-            RowStats& r = rows[y];
-            for (size_t i = size_t{y} * w, end = i + w; i < end; ++i) {
-                sanitize_pixel(pixels[i], r.bad);
-                const float l = std::min(luminance(pixels[i], options_.luma), std::numeric_limits<float>::max());
-                func[i] = l;
-                r.sum += l;
-                r.max = std::max(r.max, l);
-                if (l > 0) r.min_positive = std::min(r.min_positive, l);
-            }
-        }
+        for (uint32_t y = lo; y < hi; ++y) scan_row(pixels + size_t{y} * w, w, options_.luma, rows[y]);
     });
     std::vector<double> row_sums(h);
     float min_positive = std::numeric_limits<float>::infinity();
@@ -90,28 +105,31 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : radiance_(std::mo
     stats_.min_positive_luminance = std::isfinite(min_positive) ? min_positive : 0.0f;
     stats_.mean_luminance = solid_angle_mean_of_rows(row_sums, w);
 
-    // Pass 2: the density q sin(theta), with the fallbacks for black and constant maps.
-    const bool black = !(stats_.max_luminance > 0);
+    // Fallbacks: a black map is sampled uniformly, a map that compensation would zero
+    // whole (a constant one) without compensation.
     const float threshold =
         options_.compensation.enabled ? compensation_threshold(stats_.mean_luminance, options_.compensation.alpha) : 0.0f;
-    const bool all_zeroed = !black && !(stats_.max_luminance > threshold);
-    if (black) stats_.fallback = DensityFallback::uniform;
-    if (all_zeroed) stats_.fallback = DensityFallback::uncompensated;
+    if (!(stats_.max_luminance > 0)) stats_.fallback = DensityFallback::uniform;
+    else if (!(stats_.max_luminance > threshold)) stats_.fallback = DensityFallback::uncompensated;
     stats_.threshold = stats_.fallback == DensityFallback::none ? threshold : 0.0f;
-    detail::parallel_for(h, kRowsPerThread, [&](uint32_t lo, uint32_t hi) {
-        for (uint32_t y = lo; y < hi; ++y) {
-            const float s = row_sin_theta(y, h);
-            uint64_t zeroed = 0;
-            for (size_t i = size_t{y} * w, end = i + w; i < end; ++i) {
-                const float q = black ? 1.0f : compensate(func[i], stats_.threshold);
-                zeroed += q == 0 && func[i] > 0;
-                func[i] = q * s;
-            }
-            rows[y].zeroed = zeroed;
-        }
-    });
+
+    distribution_ = Distribution2D(w, h, [&](uint32_t y, std::span<float> row) { density_row(y, row, &rows[y].zeroed); });
     for (const RowStats& r : rows) stats_.zeroed_texels += r.zeroed;
-    distribution_ = Distribution2D(func, w, h);
+}
+
+void EnvMap::density_row(uint32_t y, std::span<float> row, uint64_t* zeroed) const noexcept {
+    const uint32_t w = width();
+    const float s = row_sin_theta(y, height());
+    const Rgb* pixels = radiance_.pixels.data() + size_t{y} * w;
+    const bool uniform = stats_.fallback == DensityFallback::uniform;
+    uint64_t count = 0;
+    for (uint32_t x = 0; x < w; ++x) {
+        const float l = texel_luminance(pixels[x], options_.luma);
+        const float q = uniform ? 1.0f : compensate(l, stats_.threshold);
+        count += q == 0 && l > 0;
+        row[x] = q * s;
+    }
+    if (zeroed) *zeroed = count;
 }
 
 EnvMap::EnvMap(RgbImage radiance, std::span<const float> density, const EnvMapOptions& options,
@@ -131,10 +149,9 @@ EnvMap::EnvMap(RgbImage radiance, std::span<const float> density, const EnvMapOp
 }
 
 std::vector<float> EnvMap::density() const {
-    const uint32_t w = width(), h = height();
-    std::vector<float> out(size_t{w} * h);
-    for (uint32_t y = 0; y < h; ++y)
-        for (uint32_t x = 0; x < w; ++x) out[size_t{y} * w + x] = distribution_.func(x, y);
+    const uint32_t w = width();
+    std::vector<float> out(size_t{w} * height());
+    for (uint32_t y = 0; y < height(); ++y) density_row(y, std::span(out).subspan(size_t{y} * w, w), nullptr);
     return out;
 }
 

@@ -4,9 +4,9 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
-#include <random>
 #include <vector>
 
+#include "envmis/atomic_file.h"
 #include "envmis/hash.h"
 
 namespace envmis {
@@ -20,7 +20,6 @@ constexpr uint32_t kByteOrderMark = 0x01020304;
 constexpr size_t kPreambleSize = 32;
 constexpr uint32_t kMaxMetadataSize = 64 * 1024;
 constexpr uint32_t kMaxStringSize = 4096;
-constexpr uint32_t kMaxSide = 1 << 16;
 constexpr uint64_t kMaxTexels = uint64_t{1} << 31;
 constexpr uint32_t kSamplerCdf = 1;
 constexpr uint32_t kFlagCompensation = 1;
@@ -147,29 +146,18 @@ void write_table(const std::filesystem::path& path, const EnvMap& map, const Tab
     payload_hash.update(as_bytes_of(radiance));
     const uint64_t payload_digest = payload_hash.digest();
 
-    const std::filesystem::path folder = path.has_parent_path() ? path.parent_path() : ".";
-    const std::filesystem::path temp =
-        folder / ("." + path.filename().string() + ".tmp" + std::to_string(std::random_device{}()));
     try {
-        std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-        if (!out) throw TableError(describe_errno(temp, "create"));
-        auto write = [&](std::span<const std::byte> bytes) {
-            out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-        };
-        write(head.bytes);
-        write(as_bytes_of(density));
-        write(as_bytes_of(radiance));
-        write(std::as_bytes(std::span(&payload_digest, 1)));
-        out.close();
-        if (!out) throw TableError(describe_errno(temp, "write"));
-        std::filesystem::rename(temp, path);
-    } catch (const std::filesystem::filesystem_error& e) {
-        std::filesystem::remove(temp);
-        throw TableError(path.string() + ": cannot write: " + e.code().message());
-    } catch (...) {
-        std::error_code ignored;
-        std::filesystem::remove(temp, ignored);
-        throw;
+        write_file_atomically(path, [&](std::ostream& out) {
+            auto write = [&](std::span<const std::byte> bytes) {
+                out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+            };
+            write(head.bytes);
+            write(as_bytes_of(density));
+            write(as_bytes_of(radiance));
+            write(std::as_bytes(std::span(&payload_digest, 1)));
+        });
+    } catch (const std::runtime_error& e) {
+        throw TableError(e.what());
     }
 }
 
@@ -228,7 +216,7 @@ Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
     in.take_bytes(metadata_size, "metadata");
     if (in.take<uint64_t>("header checksum") != header_digest) in.fail("corrupted header (checksum mismatch)");
     if (meta.position() != metadata_size) in.fail("metadata block has " + std::to_string(metadata_size - meta.position()) + " unexpected bytes");
-    if (w == 0 || h == 0 || w > kMaxSide || h > kMaxSide || uint64_t{w} * h > kMaxTexels)
+    if (w == 0 || h == 0 || w > kMaxCells1D || h > kMaxCells1D || uint64_t{w} * h > kMaxTexels)
         in.fail("invalid size " + std::to_string(w) + "x" + std::to_string(h));
     if (sampler != kSamplerCdf) in.fail("unknown sampler kind " + std::to_string(sampler));
     if (fallback > static_cast<uint32_t>(DensityFallback::uniform)) in.fail("unknown fallback " + std::to_string(fallback));

@@ -10,7 +10,7 @@
 // it is constant exactly where the density is.
 //
 // Cost: build O(w h), parallel over rows (see `envmis bench` for figures); sample, pdf
-// and eval O(1), noexcept and allocation-free. Memory: 16 bytes per texel for the
+// and eval O(1), noexcept and allocation-free. Memory: 6 bytes per texel for the
 // distribution plus 12 for the RGB radiance.
 #pragma once
 
@@ -120,7 +120,8 @@ public:
     const EnvMapStats& stats() const noexcept { return stats_; }
     const RgbImage& radiance() const noexcept { return radiance_; }
     const Distribution2D& distribution() const noexcept { return distribution_; }
-    // The image-space density function, q(x, y) sin(theta_y), row-major.
+    // The image-space density function, q(x, y) sin(theta_y), row-major, recomputed
+    // from the radiance exactly as the build computed it.
     std::vector<float> density() const;
 
     // True if the density was compensated (and no fallback replaced it).
@@ -133,6 +134,9 @@ public:
     bool complete() const noexcept { return stats_.zeroed_texels == 0; }
 
 private:
+    // Row y of density(); counts the texels compensation zeroed into *zeroed if given.
+    void density_row(uint32_t y, std::span<float> row, uint64_t* zeroed) const noexcept;
+
     RgbImage radiance_;
     Distribution2D distribution_;
     EnvMapOptions options_;
