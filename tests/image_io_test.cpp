@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -108,6 +109,12 @@ void expect_image_error(Action&& action, std::initializer_list<std::string> part
             EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "'" << part << "' not in: " << e.what();
     }
 }
+
+// These expectations are about the shipped OCIO config, whatever $OCIO the runner has.
+class ShippedColourConfig : public ::testing::Environment {
+    void SetUp() override { unsetenv("OCIO"); }
+};
+::testing::Environment* const kShippedColourConfig = ::testing::AddGlobalTestEnvironment(new ShippedColourConfig);
 
 class ImageIo : public ::testing::Test {
 protected:

@@ -1,0 +1,103 @@
+#include "cli.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+
+#include "envmis/io/image_io.h"
+
+namespace envmis::cli {
+
+void add_map_flags(CLI::App& app, MapFlags& flags) {
+    app.add_flag("--no-compensate", flags.no_compensate, "Sample proportionally to luminance (no MIS compensation)");
+    app.add_option("--alpha", flags.alpha, "Compensation strength: q = max(L - alpha * mean(L), 0)")
+        ->check(CLI::NonNegativeNumber);
+    app.add_option("--colorspace", flags.colorspace, "Input colour space (default: from the file's metadata)");
+    app.add_option("--working-space", flags.working_space, "Linear working colour space, e.g. lin_rec709 or ACEScg")
+        ->capture_default_str();
+    app.add_option("--axes", flags.axes, "World frame of directions: z-up, y-up or a signed permutation like x,z,-y")
+        ->capture_default_str();
+}
+
+double milliseconds_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+LoadedMap load_map(const std::string& path, const MapFlags& flags) {
+    const auto start = std::chrono::steady_clock::now();
+    if (looks_like_table(path)) {
+        Table table = read_table(path);
+        LoadedMap loaded{std::move(table.map), std::move(table.source), true, "envmis table"};
+        loaded.load_ms = milliseconds_since(start);
+        return loaded;
+    }
+    io::LoadedImage image = io::load_image(path, {flags.colorspace, flags.working_space});
+    LoadedMap loaded;
+    loaded.load_ms = milliseconds_since(start);
+    EnvMapOptions options;
+    options.compensation = {!flags.no_compensate, flags.alpha};
+    options.luma = image.luma;
+    options.axes = Axes::parse(flags.axes);
+    const auto build_start = std::chrono::steady_clock::now();
+    loaded.map = EnvMap(std::move(image.image), options);
+    loaded.build_ms = milliseconds_since(build_start);
+    loaded.source = {std::filesystem::path(path).filename().string(), image.content_hash, image.input_colorspace,
+                     image.working_colorspace};
+    loaded.format = image.format;
+    loaded.channels = image.channels;
+    return loaded;
+}
+
+void print_summary(std::ostream& out, const LoadedMap& loaded) {
+    const EnvMap& m = loaded.map;
+    const EnvMapStats& s = m.stats();
+    const EnvMapOptions& o = m.options();
+    const double texels = static_cast<double>(m.width()) * m.height();
+    const auto flags = out.flags();
+    out << std::setprecision(4);
+    out << "  source        " << loaded.source.name << " (" << loaded.format << ", hash " << std::hex
+        << std::setw(16) << std::setfill('0') << loaded.source.content_hash << std::dec << std::setfill(' ') << ")\n";
+    out << "  size          " << m.width() << " x " << m.height() << "\n";
+    out << "  colour        " << loaded.source.input_colorspace << " -> " << loaded.source.working_colorspace
+        << ", luma (" << o.luma.r << ", " << o.luma.g << ", " << o.luma.b << ")\n";
+    out << "  axes          " << o.axes.to_string() << "\n";
+    out << "  luminance     max " << s.max_luminance << ", min positive " << s.min_positive_luminance;
+    if (s.min_positive_luminance > 0)
+        out << ", dynamic range " << s.max_luminance / s.min_positive_luminance << " ("
+            << std::log10(s.max_luminance / s.min_positive_luminance) << " decades)";
+    out << "\n  mean (Lbar)   " << s.mean_luminance << " (solid-angle weighted)\n";
+    if (o.compensation.enabled)
+        out << "  compensation  alpha " << o.compensation.alpha << ", threshold " << s.threshold << ", zeroed "
+            << s.zeroed_texels << " texels with radiance (" << 100.0 * s.zeroed_texels / texels << "%)\n";
+    else
+        out << "  compensation  off\n";
+    out << "  bad pixels    " << s.bad_pixels.nan << " NaN, " << s.bad_pixels.infinite << " Inf, " << s.bad_pixels.negative
+        << " negative channel values (replaced by 0)\n";
+    out << "  fallback      " << to_string(s.fallback) << "\n";
+    out << "  complete pdf  " << (m.complete() ? "yes" : "no: combine with BSDF sampling through MIS") << "\n";
+    out << "  memory        " << std::setprecision(3) << m.distribution().bytes() / texels << " bytes/texel (distribution) + "
+        << sizeof(Rgb) << " (radiance)\n";
+    out.flags(flags);
+}
+
+Progress::Progress(std::string label, uint64_t total)
+    : label_(std::move(label)), total_(total), enabled_(total > 0 && ::isatty(STDERR_FILENO)) {}
+
+Progress::~Progress() {
+    if (enabled_ && shown_ >= 0) std::fprintf(stderr, "\r%*s\r", static_cast<int>(label_.size()) + 6, "");
+}
+
+void Progress::update(uint64_t done) {
+    if (!enabled_) return;
+    const int percent = static_cast<int>(100 * done / total_);
+    if (percent == shown_) return;
+    shown_ = percent;
+    std::fprintf(stderr, "\r%s %3d%%", label_.c_str(), percent);
+    std::fflush(stderr);
+}
+
+}  // namespace envmis::cli

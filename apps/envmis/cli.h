@@ -1,0 +1,71 @@
+// Shared pieces of the `envmis` subcommands: the flags that choose how a map is built,
+// loading a map from a table or an image, timing, progress and the summary printout.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <ostream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "envmis/envmap.h"
+#include "envmis/table.h"
+
+namespace envmis::cli {
+
+// How to build an EnvMap from an image (ignored for tables, which record their own).
+struct MapFlags {
+    bool no_compensate = false;
+    float alpha = 1.0f;
+    std::string colorspace;                 // input colour space; empty: from the file
+    std::string working_space = "lin_rec709";
+    std::string axes = "z-up";
+};
+void add_map_flags(CLI::App& app, MapFlags& flags);
+
+// A map ready to sample, and where it came from.
+struct LoadedMap {
+    EnvMap map;
+    TableSource source;
+    bool from_table = false;
+    std::string format;  // "envmis table", "openexr", "hdr", ...
+    uint32_t channels = 3;
+    double load_ms = 0, build_ms = 0;
+};
+
+// Reads a table (recognised by its magic) or loads an image and builds its map.
+LoadedMap load_map(const std::string& path, const MapFlags& flags);
+
+// The summary that precompute and info print.
+void print_summary(std::ostream& out, const LoadedMap& loaded);
+
+double milliseconds_since(std::chrono::steady_clock::time_point start);
+
+// Progress on stderr, only when stderr is a terminal: "label  42%".
+class Progress {
+public:
+    Progress(std::string label, uint64_t total);
+    ~Progress();
+    void update(uint64_t done);
+
+private:
+    std::string label_;
+    uint64_t total_;
+    int shown_ = -1;
+    bool enabled_;
+};
+
+// Each subcommand adds itself to the app, with the function that runs it once parsed.
+struct Subcommand {
+    CLI::App* app;
+    std::function<void()> run;
+};
+Subcommand add_precompute(CLI::App& app);
+Subcommand add_info(CLI::App& app);
+Subcommand add_sample(CLI::App& app);
+Subcommand add_visualize(CLI::App& app);
+Subcommand add_bench(CLI::App& app);
+
+}  // namespace envmis::cli

@@ -1,0 +1,157 @@
+// envmis bench [IN | --size WxH]: build and sampling speed of the guided-CDF sampler
+// against the textbook float-CDF sampler, measured in the same run on the same map.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "reference.h"
+
+namespace envmis::cli {
+namespace {
+
+struct Timing {
+    std::string sampler;
+    double build_ms = 0, ns_per_sample = 0, ns_per_pdf = 0, bytes_per_texel = 0;
+};
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+// Median over `repeats` runs of ns per call of `call` over all inputs; the results
+// are summed into a sink the optimiser cannot drop.
+template <class Input, class Call>
+double ns_per_call(const std::vector<Input>& inputs, int repeats, Call&& call) {
+    std::vector<double> runs;
+    volatile float sink = 0;
+    for (int r = 0; r < repeats; ++r) {
+        float sum = 0;
+        const auto start = std::chrono::steady_clock::now();
+        for (const Input& in : inputs) sum += call(in);
+        runs.push_back(milliseconds_since(start) * 1e6 / static_cast<double>(inputs.size()));
+        sink = sink + sum;
+    }
+    return median(runs);
+}
+
+template <class Sampler>
+Timing measure(const std::string& name, const RgbImage& image, int repeats, const std::vector<Vec2>& us,
+               const std::vector<Vec3>& directions, const std::function<Sampler(RgbImage&)>& build,
+               const std::function<size_t(const Sampler&)>& bytes, Progress& progress, int& step) {
+    std::vector<double> builds;
+    std::unique_ptr<Sampler> sampler;
+    for (int r = 0; r < repeats; ++r) {
+        RgbImage copy = image;
+        const auto start = std::chrono::steady_clock::now();
+        sampler = std::make_unique<Sampler>(build(copy));
+        builds.push_back(milliseconds_since(start));
+        progress.update(++step);
+    }
+    Timing t{name, median(builds)};
+    t.ns_per_sample = ns_per_call(us, repeats, [&](Vec2 u) {
+        const EnvSample s = sampler->sample(u);
+        return s.pdf + s.direction.x + s.radiance.r;
+    });
+    t.ns_per_pdf = ns_per_call(directions, repeats, [&](Vec3 d) { return sampler->pdf(d); });
+    t.bytes_per_texel = static_cast<double>(bytes(*sampler)) / (static_cast<double>(image.width) * image.height);
+    progress.update(++step);
+    return t;
+}
+
+}  // namespace
+
+Subcommand add_bench(CLI::App& app) {
+    struct Args {
+        std::string input, size = "8192x4096";
+        int repeats = 5;
+        uint32_t samples = 1u << 20;
+        bool json = false, no_compensate = false;
+    };
+    auto args = std::make_shared<Args>();
+    CLI::App* sub = app.add_subcommand(
+        "bench", "Time building and sampling, guided-CDF sampler versus the textbook sampler (medians of repeats)");
+    sub->add_option("input", args->input, "HDR image or table (default: a synthetic sky with a small sun)");
+    sub->add_option("--size", args->size, "Size of the synthetic sky, WxH")->capture_default_str();
+    sub->add_option("--repeats", args->repeats, "Repeats of each measurement")->capture_default_str()->check(CLI::PositiveNumber);
+    sub->add_option("--samples", args->samples, "Samples and pdf evaluations per repeat")->capture_default_str()->check(CLI::PositiveNumber);
+    sub->add_flag("--no-compensate", args->no_compensate, "Measure the uncompensated density");
+    sub->add_flag("--json", args->json, "Print one JSON object instead of text lines");
+    return {sub, [args] {
+                RgbImage image;
+                std::string map_name;
+                if (args->input.empty()) {
+                    unsigned w = 0, h = 0;
+                    char x = 0;
+                    if (std::sscanf(args->size.c_str(), "%u%c%u", &w, &x, &h) != 3 || x != 'x' || !w || !h ||
+                        w > kMaxCells1D || h > kMaxCells1D)
+                        throw std::runtime_error("--size '" + args->size + "': expected WxH, each 1 to 65536");
+                    image = reference::synthetic_sky(w, h);
+                    map_name = "synthetic-sky";
+                } else {
+                    MapFlags flags;
+                    flags.no_compensate = true;
+                    image = load_map(args->input, flags).map.radiance();
+                    map_name = args->input;
+                }
+                EnvMapOptions options;
+                options.compensation.enabled = !args->no_compensate;
+
+                std::mt19937_64 rng(7);
+                auto uniform = [&rng] { return static_cast<float>(rng() >> 40) * 0x1p-24f; };
+                std::vector<Vec2> us(args->samples);
+                for (Vec2& u : us) u = {uniform(), uniform()};
+                std::vector<Vec3> directions(args->samples);
+                for (Vec3& d : directions) {
+                    const float z = 1 - 2 * uniform(), phi = 2 * kPiF * uniform(), r = std::sqrt(std::max(0.0f, 1 - z * z));
+                    d = {r * std::cos(phi), r * std::sin(phi), z};
+                }
+
+                Progress progress("bench", 2 * (args->repeats + 1));
+                int step = 0;
+                const std::vector<Timing> timings = {
+                    measure<EnvMap>("guided", image, args->repeats, us, directions,
+                                    [&](RgbImage& copy) { return EnvMap(std::move(copy), options); },
+                                    [](const EnvMap& m) { return m.distribution().bytes(); }, progress, step),
+                    measure<reference::TextbookEnvMap>(
+                        "textbook", image, args->repeats, us, directions,
+                        [&](RgbImage&) { return reference::TextbookEnvMap(image, options); },
+                        [](const reference::TextbookEnvMap& m) { return m.distribution_bytes(); }, progress, step)};
+                const Timing &fast = timings[0], &plain = timings[1];
+                if (args->json) {
+                    nlohmann::json j = {{"map", map_name},
+                                        {"width", image.width},
+                                        {"height", image.height},
+                                        {"compensated", !args->no_compensate},
+                                        {"repeats", args->repeats},
+                                        {"samples", args->samples}};
+                    for (const Timing& t : timings)
+                        j["samplers"].push_back({{"sampler", t.sampler},
+                                                 {"build_ms", t.build_ms},
+                                                 {"ns_per_sample", t.ns_per_sample},
+                                                 {"ns_per_pdf", t.ns_per_pdf},
+                                                 {"bytes_per_texel", t.bytes_per_texel}});
+                    j["speedup_vs_textbook"] = {{"build", plain.build_ms / fast.build_ms},
+                                                {"sample", plain.ns_per_sample / fast.ns_per_sample},
+                                                {"pdf", plain.ns_per_pdf / fast.ns_per_pdf}};
+                    std::cout << j.dump(2) << "\n";
+                    return;
+                }
+                std::printf("map=%s size=%ux%u compensated=%d repeats=%d samples=%u (medians)\n", map_name.c_str(),
+                            image.width, image.height, !args->no_compensate, args->repeats, args->samples);
+                for (const Timing& t : timings)
+                    std::printf("sampler=%s build_ms=%.1f ns_per_sample=%.1f ns_per_pdf=%.1f bytes_per_texel=%.2f\n",
+                                t.sampler.c_str(), t.build_ms, t.ns_per_sample, t.ns_per_pdf, t.bytes_per_texel);
+                std::printf("speedup_vs_textbook build=%.2fx sample=%.2fx pdf=%.2fx\n", plain.build_ms / fast.build_ms,
+                            plain.ns_per_sample / fast.ns_per_sample, plain.ns_per_pdf / fast.ns_per_pdf);
+            }};
+}
+
+}  // namespace envmis::cli

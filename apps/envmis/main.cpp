@@ -1,0 +1,28 @@
+// envmis: precompute, inspect, sample, visualise and benchmark environment-map samplers.
+#include <exception>
+#include <iostream>
+#include <vector>
+
+#include "cli.h"
+
+int main(int argc, char** argv) {
+    using namespace envmis::cli;
+    CLI::App app{"envmis: importance sampling of HDR environment maps, with and without MIS compensation"};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "envmis 0.1.0");
+    const std::vector<Subcommand> subcommands = {add_precompute(app), add_info(app), add_sample(app),
+                                                 add_visualize(app), add_bench(app)};
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+    try {
+        for (const Subcommand& s : subcommands)
+            if (s.app->parsed()) s.run();
+    } catch (const std::exception& e) {
+        std::cerr << "envmis: " << e.what() << "\n";
+        return 1;
+    }
+    return 0;
+}
