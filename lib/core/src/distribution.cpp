@@ -14,63 +14,94 @@
 namespace envmis {
 namespace detail {
 
-// Sum with four accumulators: a single chain of dependent double adds would bound a
-// row's build by add latency rather than memory.
+// First guide bucket whose first unit, ceil(k 2^31 / n), is at or after unit t.
+inline int64_t first_bucket_at_or_after(int64_t t, uint32_t n) noexcept { return (((t - 1) * n) >> 31) + 1; }
+
+struct Census {
+    uint32_t nonzero = 0, invalid = 0;  // positive finite values; negative, NaN or infinite ones
+};
+
 template <class T>
-double sum_of(const T* v, uint32_t n) noexcept {
-    double s[4] = {0, 0, 0, 0};
-    uint32_t i = 0;
-    for (; i + 4 <= n; i += 4)
-        for (int j = 0; j < 4; ++j) s[j] += v[i + j];
-    for (; i < n; ++i) s[0] += v[i];
-    return (s[0] + s[1]) + (s[2] + s[3]);
+Census census(const T* func, uint32_t n) noexcept {
+    Census c;
+    for (uint32_t i = 0; i < n; ++i) {
+        c.invalid += (func[i] < 0) | !(func[i] <= std::numeric_limits<T>::max());
+        c.nonzero += func[i] > 0;
+    }
+    return c;
+}
+
+// The same on the bits of each float, in integer operations that vectorise: positive
+// finite floats are the integers in (0, +Inf's bits); -0 counts as a valid zero.
+template <>
+Census census(const float* func, uint32_t n) noexcept {
+    constexpr int32_t kInfBits = 0x7f800000;
+    const auto* bits = reinterpret_cast<const int32_t*>(func);
+    Census c;
+    for (uint32_t i = 0; i < n; ++i) {
+        const int32_t magnitude = bits[i] & 0x7fffffff;
+        c.invalid += (magnitude >= kInfBits) | ((bits[i] < 0) & (magnitude != 0));
+        c.nonzero += (bits[i] > 0) & (bits[i] < kInfBits);
+    }
+    return c;
 }
 
 template <class T>
-double build_cdf(const T* func, uint32_t n, uint32_t* start, uint16_t* guide, uint32_t& invalid) noexcept {
-    uint32_t nonzero = 0, bad = 0;
-    for (uint32_t i = 0; i < n; ++i) {
-        bad += !(func[i] >= 0 && func[i] <= std::numeric_limits<T>::max());
-        nonzero += func[i] > 0;
-    }
+double build_cdf(const T* func, uint32_t n, uint32_t* start, uint16_t* guide, uint32_t& invalid,
+                 double* scratch) noexcept {
+    const Census counts = census(func, n);
+    uint32_t nonzero = counts.nonzero;
+    const uint32_t bad = counts.invalid;
     invalid += bad;
-    const double sum = bad ? 0.0 : sum_of(func, n);
+
+    // Prefix sums in four independent chains (quarters of the row, the last one taking
+    // the remainder), so that the latency of dependent double adds does not bound the build.
+    constexpr uint32_t kChains = 4;
+    const uint32_t q = n / kChains;
+    double* prefix = scratch;
+    double chain[kChains] = {0, 0, 0, 0};
+    for (uint32_t i = 0; i < q; ++i)
+        for (uint32_t c = 0; c < kChains; ++c) prefix[c * q + i] = chain[c] += func[c * q + i];
+    for (uint32_t i = kChains * q; i < n; ++i) prefix[i] = chain[kChains - 1] += func[i];
+    const double sum = bad ? 0.0 : (chain[0] + chain[1]) + (chain[2] + chain[3]);
+
     if (sum > 0) {
-        // Each non-empty cell ends at its rounded prefix sum, but takes at least one unit
-        // and leaves at least one for every non-empty cell after it; this also keeps the
-        // CDF monotone whatever the rounding.
+        // A non-empty cell ends at its rounded prefix sum, but takes at least one unit and
+        // leaves one for every non-empty cell after it; this also keeps the CDF monotone
+        // whatever the rounding. Written without branches: zeros and non-zeros mix freely.
         const double scale = kCdfUnits / sum;
-        double prefix = 0;
         uint64_t s = 0;
-        for (uint32_t i = 0; i < n; ++i) {
-            start[i] = static_cast<uint32_t>(s);
-            if (func[i] > 0) {
-                prefix += func[i];
-                --nonzero;
-                const auto end = static_cast<uint64_t>(prefix * scale + 0.5);
-                s = std::clamp<uint64_t>(end, s + 1, kCdfUnits - nonzero);
+        double offset = 0;
+        for (uint32_t c = 0; c < kChains; ++c) {
+            const uint32_t end_index = c + 1 < kChains ? (c + 1) * q : n;
+            for (uint32_t i = c * q; i < end_index; ++i) {
+                start[i] = static_cast<uint32_t>(s);
+                const bool filled = func[i] > 0;
+                nonzero -= filled;
+                const auto end = static_cast<uint64_t>((offset + prefix[i]) * scale + 0.5);
+                const uint64_t clamped = std::clamp<uint64_t>(end, s + 1, kCdfUnits - nonzero);
+                s = filled ? clamped : s;
             }
+            offset += chain[c];
         }
     } else {
-        for (uint32_t i = 0; i < n; ++i) start[i] = static_cast<uint32_t>(uint64_t{i} * kCdfUnits / n);
+        // Uniform: equal cells, the last one taking the remainder.
+        const uint32_t step = kCdfUnits / n;
+        for (uint32_t i = 0; i < n; ++i) start[i] = i * step;
     }
-    // guide[k]: the cell of the first unit of bucket k, ceil(k 2^31 / n), stepped without
-    // a division per bucket.
-    const uint64_t step = kCdfUnits / n, step_remainder = kCdfUnits % n;
-    uint64_t first_floor = 0, remainder = 0;
-    uint32_t i = 0;
-    for (uint32_t k = 0; k < n; ++k) {
-        const uint64_t first = first_floor + (remainder > 0);
-        while (i + 1 < n && start[i + 1] <= first) ++i;
-        guide[k] = static_cast<uint16_t>(i);
-        first_floor += step, remainder += step_remainder;
-        if (remainder >= n) ++first_floor, remainder -= n;
-    }
+    // guide[k] is the last cell starting at or before bucket k's first unit: mark each
+    // bucket with the last cell whose start falls just before it, then carry the maximum
+    // forward. Cells past the last bucket mark the spare slot n.
+    auto* mark = reinterpret_cast<uint32_t*>(scratch);
+    std::fill(mark, mark + n + 1, 0u);
+    for (uint32_t i = 0; i < n; ++i) mark[first_bucket_at_or_after(start[i], n)] = i;
+    uint32_t last = 0;
+    for (uint32_t k = 0; k < n; ++k) guide[k] = static_cast<uint16_t>(last = std::max(last, mark[k]));
     return sum;
 }
 
-template double build_cdf<float>(const float*, uint32_t, uint32_t*, uint16_t*, uint32_t&) noexcept;
-template double build_cdf<double>(const double*, uint32_t, uint32_t*, uint16_t*, uint32_t&) noexcept;
+template double build_cdf<float>(const float*, uint32_t, uint32_t*, uint16_t*, uint32_t&, double*) noexcept;
+template double build_cdf<double>(const double*, uint32_t, uint32_t*, uint16_t*, uint32_t&, double*) noexcept;
 
 }  // namespace detail
 
@@ -103,7 +134,8 @@ Distribution1D::Distribution1D(std::span<const float> func) {
     start_.resize(n);
     guide_.resize(n);
     uint32_t invalid = 0;
-    const double sum = detail::build_cdf(func.data(), n, start_.data(), guide_.data(), invalid);
+    std::vector<double> prefix(n);
+    const double sum = detail::build_cdf(func.data(), n, start_.data(), guide_.data(), invalid, prefix.data());
     check_invalid(invalid, "Distribution1D");
     uniform_ = !(sum > 0);
     integral_ = sum / n;
@@ -128,10 +160,12 @@ Distribution2D::Distribution2D(uint32_t w, uint32_t h, const RowFunction& rows) 
     detail::parallel_for(h, 16, [&](uint32_t lo, uint32_t hi) {
         try {
             std::vector<float> row(w);
+            std::vector<double> prefix(w);
             for (uint32_t y = lo; y < hi; ++y) {
                 rows(y, row);
                 const size_t offset = size_t{y} * w;
-                row_sums[y] = detail::build_cdf(row.data(), w, start_.data() + offset, guide_.data() + offset, row_invalid[y]);
+                row_sums[y] = detail::build_cdf(row.data(), w, start_.data() + offset, guide_.data() + offset,
+                                                row_invalid[y], prefix.data());
             }
         } catch (...) {
             const std::lock_guard lock(error_mutex);
@@ -143,7 +177,9 @@ Distribution2D::Distribution2D(uint32_t w, uint32_t h, const RowFunction& rows) 
     for (uint32_t c : row_invalid) invalid += c;
     check_invalid(invalid, "Distribution2D");
     uint32_t unused = 0;
-    const double sum = detail::build_cdf(row_sums.data(), h, marginal_start_.data(), marginal_guide_.data(), unused);
+    std::vector<double> prefix(h);
+    const double sum =
+        detail::build_cdf(row_sums.data(), h, marginal_start_.data(), marginal_guide_.data(), unused, prefix.data());
     uniform_ = !(sum > 0);
     integral_ = sum / static_cast<double>(n);
 }

@@ -99,9 +99,10 @@ ENVMIS_HD inline float point_in_cell(uint32_t index, float offset, uint32_t n) n
 
 // Fills start and guide (n each) from func and returns the sum of func (double); adds
 // the number of negative, NaN or infinite values to `invalid` (the caller rejects them).
-// A zero function gets a uniform CDF.
+// A zero function gets a uniform CDF. `scratch` is space for n doubles.
 template <class T>
-double build_cdf(const T* func, uint32_t n, uint32_t* start, uint16_t* guide, uint32_t& invalid) noexcept;
+double build_cdf(const T* func, uint32_t n, uint32_t* start, uint16_t* guide, uint32_t& invalid,
+                 double* scratch) noexcept;
 
 }  // namespace detail
 

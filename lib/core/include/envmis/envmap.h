@@ -134,8 +134,6 @@ public:
     bool complete() const noexcept { return stats_.zeroed_texels == 0; }
 
 private:
-    // Row y of density(); counts the texels compensation zeroed into *zeroed if given.
-    void density_row(uint32_t y, std::span<float> row, uint64_t* zeroed) const noexcept;
 
     RgbImage radiance_;
     Distribution2D distribution_;
