@@ -67,5 +67,6 @@ Subcommand add_info(CLI::App& app);
 Subcommand add_sample(CLI::App& app);
 Subcommand add_visualize(CLI::App& app);
 Subcommand add_bench(CLI::App& app);
+Subcommand add_compare(CLI::App& app);
 
 }  // namespace envmis::cli

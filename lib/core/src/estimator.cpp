@@ -70,9 +70,9 @@ Rgb DirectLightingEstimator::estimate(const ShadingPoint& point, const Bsdf& bsd
     for (uint32_t j = 0; j < n_bsdf; ++j) {
         const BsdfSample b = bsdf.sample(wo, rng.uniform2());
         if (!(b.pdf > 0)) continue;
-        const Vec3 wi = frame.to_world(b.wi);
-        const float weight = s == Strategy::mis ? mis_weight(h, n_bsdf * b.pdf, n_env * env_.pdf(wi)) : 1.0f;
-        add(sum, env_.eval(wi) * b.value, weight / (n_bsdf * b.pdf));
+        const EnvMapView::Lookup e = env_.lookup(frame.to_world(b.wi));
+        const float weight = s == Strategy::mis ? mis_weight(h, n_bsdf * b.pdf, n_env * e.pdf) : 1.0f;
+        add(sum, e.radiance * b.value, weight / (n_bsdf * b.pdf));
     }
     return sum;
 }

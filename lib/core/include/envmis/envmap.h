@@ -83,10 +83,19 @@ struct EnvMapView {
         return solid_angle_pdf(distribution.pdf(uv), std::sin(kPiF * uv.y));
     }
     // Radiance arriving from `direction` (nearest texel).
-    ENVMIS_HD Rgb eval(Vec3 direction) const noexcept {
-        const Vec2 uv = equirect_uv(to_canonical(axes, direction));
+    ENVMIS_HD Rgb eval(Vec3 direction) const noexcept { return eval_uv(equirect_uv(to_canonical(axes, direction))); }
+    ENVMIS_HD Rgb eval_uv(Vec2 uv) const noexcept {
         const uint32_t x = detail::cell_of(uv.x, distribution.w), y = detail::cell_of(uv.y, distribution.h);
         return radiance[static_cast<size_t>(y) * distribution.w + x];
+    }
+    // Both at once, mapping the direction to the image once (MIS needs both).
+    struct Lookup {
+        Rgb radiance;
+        float pdf = 0;
+    };
+    ENVMIS_HD Lookup lookup(Vec3 direction) const noexcept {
+        const Vec2 uv = equirect_uv(to_canonical(axes, direction));
+        return {eval_uv(uv), pdf_uv(uv)};
     }
     // Image density to solid angle; 0 at the poles, where the mapping degenerates.
     ENVMIS_HD static float solid_angle_pdf(float image_pdf, float sin_theta) noexcept {

@@ -1,0 +1,139 @@
+#include "envmis/comparison.h"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <thread>
+
+#include "envmis/statistics.h"
+
+namespace envmis {
+namespace {
+
+// What one (point, BSDF, technique) cell of the study measured.
+struct Cell {
+    RunningStats estimates, squared_relative_error;
+    double seconds = 0;
+};
+
+}  // namespace
+
+std::vector<Technique> ComparisonOptions::default_techniques() {
+    std::vector<Technique> t;
+    for (const char* name : {"env", "bsdf", "mis-balance", "mis-power", "mis-balance-comp", "mis-power-comp"})
+        t.push_back(Technique::parse(name));
+    return t;
+}
+
+const TechniqueStats* BsdfComparison::find(std::string_view technique) const {
+    for (const TechniqueStats& t : techniques)
+        if (t.technique.name() == technique) return &t;
+    return nullptr;
+}
+
+std::vector<ShadingPoint> sphere_points(uint32_t k) {
+    constexpr double kGoldenAngle = 2.39996322972865332;
+    std::vector<ShadingPoint> points(k);
+    for (uint32_t i = 0; i < k; ++i) {
+        const double z = 1 - (2 * i + 1.0) / k, r = std::sqrt(1 - z * z), phi = kGoldenAngle * i;
+        const Vec3 n{static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z)};
+        points[i] = {n, n};
+    }
+    return points;
+}
+
+Rgb average_estimate(const DirectLightingEstimator& estimator, const ShadingPoint& point, const Bsdf& bsdf,
+                     uint32_t spp, uint64_t seed, uint64_t stream) {
+    Pcg32 rng(seed, stream);
+    double r = 0, g = 0, b = 0;
+    for (uint32_t i = 0; i < spp; ++i) {
+        const Rgb e = estimator.estimate(point, bsdf, rng);
+        r += e.r, g += e.g, b += e.b;
+    }
+    return {static_cast<float>(r / spp), static_cast<float>(g / spp), static_cast<float>(b / spp)};
+}
+
+Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<const ShadingPoint> points,
+                   const ComparisonOptions& options, const std::atomic<bool>* stop,
+                   const std::function<void(size_t, size_t)>& progress) {
+    if (options.bsdfs.empty() || options.techniques.empty() || options.spp == 0 || points.empty())
+        throw std::invalid_argument("compare: needs at least one BSDF, technique, shading point and sample");
+    std::vector<DirectLightingEstimator> estimators;
+    for (const Technique& t : options.techniques)
+        estimators.emplace_back(t.compensated ? compensated : plain, t, options.allocation);
+    const size_t nb = options.bsdfs.size(), nt = options.techniques.size();
+    const uint32_t threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+    const LumaCoefficients luma = plain.options().luma;
+
+    // cells[(p * nb + b) * nt + t]; references[p * nb + b].
+    std::vector<Cell> cells;
+    std::vector<double> references;
+    size_t done = 0;
+    for (; done < points.size() && !(stop && stop->load()); ++done) {
+        const ShadingPoint& point = points[done];
+        for (const Bsdf& bsdf : options.bsdfs)
+            references.push_back(reflected_radiance(plain, bsdf, point, options.quadrature).luminance);
+        const size_t first = cells.size();
+        cells.resize(first + nb * nt);
+        std::atomic<size_t> next{0};
+        auto work = [&] {
+            for (size_t job; (job = next.fetch_add(1)) < nb * nt;) {
+                const size_t b = job / nt, t = job % nt;
+                const double reference = references[done * nb + b];
+                Cell& cell = cells[first + job];
+                Pcg32 rng(options.seed, (done * nb + b) * nt + t);
+                const auto start = std::chrono::steady_clock::now();
+                for (uint32_t i = 0; i < options.spp; ++i) {
+                    const double x = luminance(estimators[t].estimate(point, options.bsdfs[b], rng), luma);
+                    cell.estimates.add(x);
+                    if (reference > 0) cell.squared_relative_error.add((x - reference) * (x - reference) / (reference * reference));
+                }
+                cell.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            }
+        };
+        std::vector<std::jthread> pool;
+        for (uint32_t i = 1; i < threads; ++i) pool.emplace_back(work);
+        work();
+        pool.clear();
+        if (progress) progress(done + 1, points.size());
+    }
+
+    Comparison result{{}, done, points.size()};
+    if (done == 0) return result;
+    size_t mis_index = nt;
+    for (size_t t = 0; t < nt; ++t)
+        if (options.techniques[t] == Technique::parse("mis-balance")) mis_index = t;
+    for (size_t b = 0; b < nb; ++b) {
+        BsdfComparison bc{options.bsdfs[b], {}};
+        for (size_t t = 0; t < nt; ++t) {
+            TechniqueStats s{options.techniques[t]};
+            RunningStats rel;
+            double seconds = 0, variance_sum = 0, log_ratio = 0;
+            size_t ratios = 0;
+            for (size_t p = 0; p < done; ++p) {
+                const Cell& c = cells[(p * nb + b) * nt + t];
+                s.mean += c.estimates.mean() / done;
+                s.reference += references[p * nb + b] / done;
+                s.variance += c.estimates.variance() / done;
+                variance_sum += c.estimates.variance() / c.estimates.count();
+                rel.merge(c.squared_relative_error);
+                seconds += c.seconds;
+                s.estimates += c.estimates.count();
+                if (mis_index < nt) {
+                    const double v = c.estimates.variance(), v_mis = cells[(p * nb + b) * nt + mis_index].estimates.variance();
+                    if (v > 0 && v_mis > 0) log_ratio += std::log(v / v_mis), ++ratios;
+                }
+            }
+            s.std_error = std::sqrt(variance_sum) / done;
+            s.rel_mse = rel.mean();
+            s.ns_per_estimate = 1e9 * seconds / static_cast<double>(s.estimates);
+            s.efficiency = s.variance > 0 ? 1 / (s.variance * seconds / static_cast<double>(s.estimates)) : 0;
+            s.variance_ratio_vs_mis = ratios ? std::exp(log_ratio / ratios) : 0;
+            bc.techniques.push_back(s);
+        }
+        result.bsdfs.push_back(std::move(bc));
+    }
+    return result;
+}
+
+}  // namespace envmis
