@@ -8,7 +8,9 @@
 #include <random>
 #include <vector>
 
+#include "envmis/comparison.h"
 #include "envmis/envmap.h"
+#include "envmis/estimator.h"
 #include "reference.h"
 
 namespace {
@@ -70,6 +72,20 @@ void pdf(benchmark::State& state) {
     }
 }
 
+// One MIS estimate (1 environment + 1 BSDF sample) of direct lighting, at shading points
+// spread over the sphere: the throughput of the variance study.
+void estimate(benchmark::State& state, const char* technique, envmis::Bsdf bsdf) {
+    envmis::EnvMapOptions options;
+    options.compensation.enabled = envmis::Technique::parse(technique).compensated;
+    const EnvMap map(sky(static_cast<uint32_t>(state.range(0))), options);
+    const envmis::DirectLightingEstimator estimator(map, envmis::Technique::parse(technique));
+    const auto points = envmis::sphere_points(64);
+    envmis::Pcg32 rng(5);
+    size_t i = 0;
+    for (auto _ : state) benchmark::DoNotOptimize(estimator.estimate(points[i++ & 63], bsdf, rng));
+    state.counters["estimates/s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+
 void sizes(benchmark::internal::Benchmark* b) { b->Arg(1024)->Arg(8192)->Unit(benchmark::kMillisecond); }
 void sizes_ns(benchmark::internal::Benchmark* b) { b->Arg(1024)->Arg(8192)->Unit(benchmark::kNanosecond); }
 
@@ -79,6 +95,9 @@ BENCHMARK(sample<EnvMap>)->Name("sample/guided")->Apply(sizes_ns);
 BENCHMARK(sample<TextbookEnvMap>)->Name("sample/textbook")->Apply(sizes_ns);
 BENCHMARK(pdf<EnvMap>)->Name("pdf/guided")->Apply(sizes_ns);
 BENCHMARK(pdf<TextbookEnvMap>)->Name("pdf/textbook")->Apply(sizes_ns);
+BENCHMARK_CAPTURE(estimate, mis_balance_lambert, "mis-balance", envmis::Bsdf::lambert())->Name("estimate/mis-balance/lambert")->Arg(1024);
+BENCHMARK_CAPTURE(estimate, mis_balance_comp_lambert, "mis-balance-comp", envmis::Bsdf::lambert())->Name("estimate/mis-balance-comp/lambert")->Arg(1024);
+BENCHMARK_CAPTURE(estimate, mis_balance_ggx, "mis-balance", envmis::Bsdf::ggx(0.1f))->Name("estimate/mis-balance/ggx:0.1")->Arg(1024);
 
 }  // namespace
 

@@ -14,6 +14,7 @@
 // no virtual calls, usable on the device.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <string_view>
@@ -72,9 +73,10 @@ ENVMIS_HD inline Vec3 sample_visible_normal(Vec3 wo, float alpha, Vec2 u) noexce
     const float len2 = vh.x * vh.x + vh.y * vh.y;
     const Vec3 t1 = len2 > 0 ? Vec3{-vh.y, vh.x, 0} * (1 / std::sqrt(len2)) : Vec3{1, 0, 0};
     const Vec3 t2 = cross(vh, t1);
-    const float r = std::sqrt(u.x), phi = 2 * kPiF * u.y;
-    const float p1 = r * std::cos(phi), s = 0.5f * (1 + vh.z);
-    const float p2 = (1 - s) * std::sqrt(std::max(0.0f, 1 - p1 * p1)) + s * r * std::sin(phi);
+    const float r = std::sqrt(u.x);
+    const SinCos phi = fast_sincos(2 * kPiF * u.y);
+    const float p1 = r * phi.cos, s = 0.5f * (1 + vh.z);
+    const float p2 = (1 - s) * std::sqrt(std::max(0.0f, 1 - p1 * p1)) + s * r * phi.sin;
     const Vec3 nh = t1 * p1 + t2 * p2 + vh * std::sqrt(std::max(0.0f, 1 - p1 * p1 - p2 * p2));
     return normalize(Vec3{alpha * nh.x, alpha * nh.y, std::max(1e-7f, nh.z)});
 }
@@ -127,8 +129,8 @@ ENVMIS_HD inline BsdfSample Bsdf::sample(Vec3 wo, Vec2 u) const noexcept {
         case BsdfKind::lambert: wi = sample_cosine_hemisphere(u); break;
         case BsdfKind::phong: {
             const float cos_a = std::pow(u.x, 1 / (exponent + 1)), sin_a = std::sqrt(std::max(0.0f, 1 - cos_a * cos_a));
-            const float phi = 2 * kPiF * u.y;
-            wi = Frame::from_normal(reflect_z(wo)).to_world({sin_a * std::cos(phi), sin_a * std::sin(phi), cos_a});
+            const SinCos phi = fast_sincos(2 * kPiF * u.y);
+            wi = Frame::from_normal(reflect_z(wo)).to_world({sin_a * phi.cos, sin_a * phi.sin, cos_a});
             break;
         }
         case BsdfKind::ggx: wi = reflect(wo, ggx::sample_visible_normal(wo, alpha, u)); break;

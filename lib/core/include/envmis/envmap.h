@@ -80,7 +80,7 @@ struct EnvMapView {
     ENVMIS_HD float pdf(Vec3 direction) const noexcept { return pdf_uv(equirect_uv(to_canonical(axes, direction))); }
     // Solid-angle pdf at image point uv; bit-identical to sample(u).pdf when uv = sample(u).uv.
     ENVMIS_HD float pdf_uv(Vec2 uv) const noexcept {
-        return solid_angle_pdf(distribution.pdf(uv), std::sin(kPiF * uv.y));
+        return solid_angle_pdf(distribution.pdf(uv), std::max(fast_sincos(kPiF * uv.y).sin, 0.0f));
     }
     // Radiance arriving from `direction` (nearest texel).
     ENVMIS_HD Rgb eval(Vec3 direction) const noexcept { return eval_uv(equirect_uv(to_canonical(axes, direction))); }

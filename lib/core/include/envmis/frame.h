@@ -6,8 +6,10 @@
 // gives the same frame, on the host and on the device.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
+#include "envmis/fast_math.h"
 #include "envmis/math.h"
 
 namespace envmis {
@@ -36,8 +38,8 @@ ENVMIS_HD inline Vec2 sample_disk(Vec2 u) noexcept {
     if (a == 0 && b == 0) return {0, 0};
     const bool wide = std::abs(a) > std::abs(b);
     const float r = wide ? a : b;
-    const float phi = wide ? (kPiF / 4) * (b / a) : (kPiF / 2) - (kPiF / 4) * (a / b);
-    return {r * std::cos(phi), r * std::sin(phi)};
+    const SinCos p = fast_sincos(wide ? (kPiF / 4) * (b / a) : (kPiF / 2) - (kPiF / 4) * (a / b));
+    return {r * p.cos, r * p.sin};
 }
 
 // Direction with density cos(theta) / pi on the upper (z > 0) hemisphere.

@@ -12,10 +12,12 @@
 // solid-angle density p / (2 pi^2 sin theta).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <string_view>
 
+#include "envmis/fast_math.h"
 #include "envmis/math.h"
 
 namespace envmis {
@@ -54,16 +56,17 @@ ENVMIS_HD inline Vec3 to_canonical(const Axes& a, Vec3 world) noexcept {
 
 // Canonical direction of image point uv, with sin(theta) (>= 0) alongside.
 ENVMIS_HD inline Vec3 equirect_direction(Vec2 uv, float* sin_theta = nullptr) noexcept {
-    const float theta = kPiF * uv.y, phi = 2 * kPiF * uv.x;
-    const float st = std::sin(theta);
+    const SinCos t = fast_sincos(kPiF * uv.y), p = fast_sincos(2 * kPiF * uv.x);
+    const float st = std::max(t.sin, 0.0f);
     if (sin_theta) *sin_theta = st;
-    return {st * std::cos(phi), st * std::sin(phi), std::cos(theta)};
+    return {st * p.cos, st * p.sin, t.cos};
 }
 
 // Image point of a canonical unit direction; the inverse of equirect_direction.
 ENVMIS_HD inline Vec2 equirect_uv(Vec3 d) noexcept {
-    const float theta = std::acos(clamp(d.z, -1.0f, 1.0f));
-    float phi = std::atan2(d.y, d.x);
+    const float z = clamp(d.z, -1.0f, 1.0f);
+    const float theta = fast_atan2(std::sqrt(std::max(0.0f, (1 - z) * (1 + z))), z);
+    float phi = fast_atan2(d.y, d.x);
     if (phi < 0) phi += 2 * kPiF;
     return {clamp(phi / (2 * kPiF), 0.0f, kOneMinusEpsilon), clamp(theta / kPiF, 0.0f, kOneMinusEpsilon)};
 }
