@@ -127,8 +127,8 @@ TEST(ColourConfig, ResolvesUnknownNamesToEmpty) {
 // tag says nothing about the encoding and must not resolve.
 TEST(ColourConfig, LeavesOpenImageIOsAmbiguousRec709TagUnresolved) { EXPECT_EQ(shipped().resolve("Rec709"), ""); }
 
-TEST(ColourConfig, LumaOfLinRec709IsTheRec709YRow) {
-    expect_luma_near(shipped().luma("lin_rec709"), 0.2126f, 0.7152f, 0.0722f, 1e-4f);
+TEST(ColourConfig, LumaOfLinRec709IsExactlyBt709) {
+    expect_luma_near(shipped().luma("lin_rec709"), 0.2126f, 0.7152f, 0.0722f, 1e-7f);
 }
 
 // Luma is the Y row of the conversion to CIE XYZ D65, which for ACEScg includes the
@@ -146,7 +146,8 @@ TEST(ColourConfig, LuminanceDoesNotDependOnTheWorkingSpace) {
     const LumaCoefficients k709 = shipped().luma("lin_rec709"), kcg = shipped().luma("ACEScg");
     for (size_t i = 0; i < rec709.size(); ++i) {
         const float expected = luminance(rec709[i], k709);
-        EXPECT_NEAR(luminance(acescg[i], kcg), expected, 1e-5f * std::max(1.0f, expected)) << i;
+        // Up to the rounding of BT.709's published weights (0.2126 for 0.212639, ...).
+        EXPECT_NEAR(luminance(acescg[i], kcg), expected, 3e-4f * std::max(1.0f, expected)) << i;
     }
 }
 

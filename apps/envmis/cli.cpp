@@ -1,5 +1,6 @@
 #include "cli.h"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -21,6 +22,27 @@ void add_map_flags(CLI::App& app, MapFlags& flags) {
         ->capture_default_str();
     app.add_option("--axes", flags.axes, "World frame of directions: z-up, y-up or a signed permutation like x,z,-y")
         ->capture_default_str();
+}
+
+namespace {
+// A signal handler can reach only static storage.
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_signal(int) { g_interrupted = true; }
+}  // namespace
+
+void install_interrupt_handler() {
+    struct sigaction action {};
+    action.sa_handler = on_signal;
+    action.sa_flags = SA_RESETHAND;  // the second signal takes the default action
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, nullptr);
+    sigaction(SIGTERM, &action, nullptr);
+}
+
+const std::atomic<bool>& interrupted() { return g_interrupted; }
+
+void throw_if_interrupted() {
+    if (g_interrupted) throw std::runtime_error("interrupted");
 }
 
 double milliseconds_since(std::chrono::steady_clock::time_point start) {

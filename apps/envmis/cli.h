@@ -2,6 +2,7 @@
 // loading a map from a table or an image, timing, progress and the summary printout.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -42,6 +43,14 @@ LoadedMap load_map(const std::string& path, const MapFlags& flags);
 void print_summary(std::ostream& out, const LoadedMap& loaded);
 
 double milliseconds_since(std::chrono::steady_clock::time_point start);
+
+// Ctrl-C (SIGINT) and SIGTERM set a flag that long loops check, so that they stop
+// cleanly: `compare` reports what is done, writers throw and remove their temporary
+// files. A second signal ends the process at once.
+void install_interrupt_handler();
+const std::atomic<bool>& interrupted();
+// Throws std::runtime_error("interrupted") once a signal has arrived.
+void throw_if_interrupted();
 
 // Progress on stderr, only when stderr is a terminal: "label  42%".
 class Progress {

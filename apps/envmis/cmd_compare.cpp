@@ -1,6 +1,5 @@
 // envmis compare IN: the variance study. Estimates direct lighting on analytic BSDFs with
 // every technique at equal sample count and reports how much MIS compensation gains.
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -18,11 +17,6 @@
 
 namespace envmis::cli {
 namespace {
-
-// Set by Ctrl-C; the study stops between points and still reports what is done. A
-// signal handler can only reach static storage.
-std::atomic<bool> g_interrupted{false};
-extern "C" void on_interrupt(int) { g_interrupted = true; }
 
 Vec3 parse_vector(const std::string& text, const char* what) {
     float x = 0, y = 0, z = 0;
@@ -147,9 +141,8 @@ Subcommand add_compare(CLI::App& app) {
                     points = sphere_points(args->points);
                 }
 
-                std::signal(SIGINT, on_interrupt);
                 Progress progress("compare", points.size());
-                const Comparison result = compare(plain, compensated, points, options, &g_interrupted,
+                const Comparison result = compare(plain, compensated, points, options, &interrupted(),
                                                   [&](size_t done, size_t) { progress.update(done); });
 
                 std::ostringstream header;
@@ -200,7 +193,7 @@ Subcommand add_compare(CLI::App& app) {
                 }
                 if (!args->images.empty()) {
                     const auto montage = render_comparison(plain, compensated, options, args->render, args->images,
-                                                           loaded.source.name, &g_interrupted);
+                                                           loaded.source.name, &interrupted());
                     std::cout << "pictures: " << args->images << " (montage: " << montage.string() << ")\n";
                 }
             }};

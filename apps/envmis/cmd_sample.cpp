@@ -37,7 +37,10 @@ void write_samples(std::ostream& out, const EnvMap& map, uint64_t n, uint64_t se
         put(line, s.direction.z, ',');
         put(line, s.pdf, '\n');
         out << line;
-        if ((i & 0xffff) == 0) progress.update(i);
+        if ((i & 0xffff) == 0) {
+            progress.update(i);
+            throw_if_interrupted();
+        }
     }
 }
 

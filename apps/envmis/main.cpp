@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
     }
+    install_interrupt_handler();
     try {
         for (const Subcommand& s : subcommands)
             if (s.app->parsed()) s.run();

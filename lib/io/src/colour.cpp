@@ -102,7 +102,12 @@ std::string ColourConfig::resolve(const std::string& name) const {
 
 LumaCoefficients ColourConfig::luma(const std::string& space) const {
     const auto cs = impl_->space(space);
-    if (impl_->xyz.empty() || cs->isData()) {
+    // The config's declared coefficients belong to its scene_linear space: for Rec.709
+    // they are BT.709's own rounded weights (0.2126, 0.7152, 0.0722), which documents
+    // and independent checks use, rather than the XYZ row they round (0.212639, ...).
+    const auto scene_linear = impl_->config->getColorSpace(OCIO::ROLE_SCENE_LINEAR);
+    const bool is_scene_linear = scene_linear && std::string(scene_linear->getName()) == cs->getName();
+    if (impl_->xyz.empty() || cs->isData() || is_scene_linear) {
         double k[3];
         impl_->config->getDefaultLumaCoefs(k);
         return {static_cast<float>(k[0]), static_cast<float>(k[1]), static_cast<float>(k[2])};

@@ -115,11 +115,13 @@ std::string write_file(const fs::path& file, const char* format, const OIIO::Ima
 
 // Readers never see a partial file: AtomicFile renames it into place only when complete.
 void write_atomically(const fs::path& path, const char* format, const OIIO::ImageSpec& spec, const void* pixels) {
-    AtomicFile file(path);
-    std::string error = write_file(file.temporary(), format, spec, pixels);
-    if (!error.empty()) fail(path, "cannot write (" + error + ")");
     try {
+        AtomicFile file(path);
+        const std::string error = write_file(file.temporary(), format, spec, pixels);
+        if (!error.empty()) fail(path, "cannot write (" + error + ")");
         file.commit();
+    } catch (const ImageError&) {
+        throw;
     } catch (const std::runtime_error& e) {
         throw ImageError(e.what());
     }

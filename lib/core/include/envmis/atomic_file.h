@@ -14,8 +14,8 @@ namespace envmis {
 
 class AtomicFile {
 public:
-    // `extension` is appended to the temporary name, for writers that choose the format
-    // from it (".png"); by default the destination's own extension is used.
+    // The temporary name ends in the destination's extension, for writers that choose
+    // the format from it. Throws std::runtime_error if the destination's folder is missing.
     explicit AtomicFile(std::filesystem::path destination);
     AtomicFile(const AtomicFile&) = delete;
     AtomicFile& operator=(const AtomicFile&) = delete;

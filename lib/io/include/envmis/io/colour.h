@@ -4,9 +4,11 @@
 // the source tree or the install prefix). The shipped config defines, among others:
 //   lin_rec709 (scene_linear, the default working space), ACEScg, ACES2065-1, sRGB
 //   (sRGB-encoded Rec.709), CIE-XYZ-D65, raw.
-// Luma coefficients of a working space are the Y row of its RGB -> CIE XYZ matrix,
-// found by converting the three primaries with OCIO; a config without an XYZ space
-// falls back to the config's default luma coefficients.
+// Luma coefficients: for the config's scene_linear space, the config's declared `luma`
+// (for lin_rec709 exactly BT.709's 0.2126, 0.7152, 0.0722); for other spaces the Y row
+// of their RGB -> CIE XYZ matrix, found by converting the three primaries with OCIO (for
+// ACEScg about 0.2677, 0.6743, 0.0580: luminance as seen under D65, the same in either
+// working space); a config without an XYZ space uses its declared `luma` throughout.
 #pragma once
 
 #include <filesystem>
