@@ -229,6 +229,8 @@ Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
     payload_hash.update(density_bytes);
     payload_hash.update(radiance_bytes);
     if (in.take<uint64_t>("payload checksum") != payload_hash.digest()) in.fail("corrupted payload (checksum mismatch)");
+    if (in.position() != bytes.size())
+        in.fail(std::to_string(bytes.size() - in.position()) + " bytes of trailing data after the payload");
 
     std::vector<float> density(texels);
     std::memcpy(density.data(), density_bytes.data(), density_bytes.size());

@@ -1,0 +1,39 @@
+# Install tests (included from tests/CMakeLists.txt): install this build into a fresh
+# prefix, then configure, build and run tests/consumer against it with
+# find_package(envmis), as a downstream project would. Catches headers, data files and
+# dependencies missing from the install, which the in-tree tests never notice.
+# Skipped without envmis::io (the consumer uses it) and for sanitizer or fuzz builds,
+# whose instrumented libraries nobody installs.
+if(NOT ENVMIS_BUILD_IO OR ENVMIS_SANITIZE OR ENVMIS_FUZZ)
+  return()
+endif()
+
+set(envmis_consumer_dir ${CMAKE_CURRENT_BINARY_DIR}/consumer)
+set(envmis_consumer_prefix ${envmis_consumer_dir}/prefix)
+
+# Emptied first, so that a file dropped from the install rules cannot linger from an
+# earlier run.
+add_test(NAME consumer.clean COMMAND ${CMAKE_COMMAND} -E rm -rf ${envmis_consumer_prefix})
+add_test(NAME consumer.install
+  COMMAND ${CMAKE_COMMAND} --install ${CMAKE_BINARY_DIR} --prefix ${envmis_consumer_prefix} --config $<CONFIG>)
+set_tests_properties(consumer.clean PROPERTIES FIXTURES_SETUP envmis_consumer_clean)
+set_tests_properties(consumer.install PROPERTIES
+  FIXTURES_REQUIRED envmis_consumer_clean FIXTURES_SETUP envmis_installed)
+
+foreach(kind core io)
+  set(build ${envmis_consumer_dir}/build-${kind})
+  add_test(NAME consumer.${kind}
+    COMMAND ${CMAKE_CTEST_COMMAND} --build-and-test ${CMAKE_CURRENT_LIST_DIR} ${build}
+      --build-generator ${CMAKE_GENERATOR}
+      --build-makeprogram ${CMAKE_MAKE_PROGRAM}
+      --build-project envmis_consumer
+      --build-target consumer_${kind}
+      --build-options -DCMAKE_PREFIX_PATH=${envmis_consumer_prefix} -DCMAKE_BUILD_TYPE=$<CONFIG>
+        -DCMAKE_CXX_COMPILER=${CMAKE_CXX_COMPILER}
+      --test-command consumer_${kind} ${build}/work)
+  # $OCIO points at the installed config: the library would otherwise find the one in
+  # this source tree first.
+  set_tests_properties(consumer.${kind} PROPERTIES FIXTURES_REQUIRED envmis_installed LABELS consumer TIMEOUT 600
+    ENVIRONMENT OCIO=${envmis_consumer_prefix}/${CMAKE_INSTALL_DATADIR}/envmis/ocio/config.ocio)
+endforeach()
+set_tests_properties(consumer.clean consumer.install PROPERTIES LABELS consumer)
