@@ -125,6 +125,7 @@ Subcommand add_compare(CLI::App& app) {
                 options.allocation = {args->env_samples, args->bsdf_samples};
                 options.threads = args->threads ? args->threads : std::max(1u, std::thread::hardware_concurrency());
 
+                if (!args->images.empty()) std::filesystem::create_directories(args->images);
                 MapFlags flags = args->map;
                 flags.no_compensate = false;
                 const LoadedMap loaded = load_map(args->input, flags);

@@ -14,7 +14,7 @@ namespace envmis::cli {
 struct RenderOptions {
     std::string size = "768x256";  // WxH
     uint32_t spp = 16;             // estimates per pixel for each technique
-    uint32_t reference_spp = 1024; // estimates per pixel of the reference (mis-power)
+    uint32_t reference_spp = 512;  // estimates per pixel of the reference (mis-power)
 };
 
 // Writes reference.{exr,png}, <technique>.{exr,png}, <technique>-relmse.png and
