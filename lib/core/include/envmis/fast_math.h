@@ -33,25 +33,22 @@ ENVMIS_HD inline SinCos fast_sincos(float x) noexcept {
     return {((q & 2) ? -sin_x : sin_x) * sign, ((q + 1) & 2) ? -cos_x : cos_x};
 }
 
-// atan(x) for x >= 0.
-ENVMIS_HD inline float fast_atan_positive(float x) noexcept {
-    float offset = 0;
-    if (x > 2.414213562373095f) {
-        offset = kPiF / 2, x = -1 / x;
-    } else if (x > 0.4142135623730950f) {
-        offset = kPiF / 4, x = (x - 1) / (x + 1);
-    }
-    const float z = x * x;
-    return offset + (((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z - 3.33329491539e-1f) * z * x + x;
-}
-
-// atan2(y, x) in [-pi, pi]; 0 for (0, 0).
+// atan2(y, x) in [-pi, pi]; 0 for (0, 0). Branch-free: the quadrant and range choices
+// are selects, since directions arrive in random octants and mispredicted branches
+// would cost more than the arithmetic. One division: atan(n / d) with n <= d, reduced
+// to |r| <= tan(pi/8) by atan(n / d) = pi/4 + atan((n - d) / (n + d)).
 ENVMIS_HD inline float fast_atan2(float y, float x) noexcept {
-    if (x == 0 && y == 0) return 0;
     const float ax = std::abs(x), ay = std::abs(y);
-    float a = ay <= ax ? fast_atan_positive(ay / ax) : kPiF / 2 - fast_atan_positive(ax / ay);
-    if (x < 0) a = kPiF - a;
-    return y < 0 ? -a : a;
+    const bool swap = ay > ax;
+    const float n = swap ? ax : ay, d = swap ? ay : ax;
+    const bool reduce = n > 0.41421356237309515f * d;
+    const float num = reduce ? n - d : n, den = reduce ? n + d : d;
+    const float r = den > 0 ? num / den : 0.0f, z = r * r;
+    float a = (((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z - 3.33329491539e-1f) * z * r + r;
+    a += reduce ? kPiF / 4 : 0.0f;
+    a = swap ? kPiF / 2 - a : a;
+    a = x < 0 ? kPiF - a : a;
+    return std::copysign(a, y);
 }
 
 }  // namespace envmis

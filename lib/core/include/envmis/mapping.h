@@ -66,9 +66,10 @@ ENVMIS_HD inline Vec3 equirect_direction(Vec2 uv, float* sin_theta = nullptr) no
 ENVMIS_HD inline Vec2 equirect_uv(Vec3 d) noexcept {
     const float z = clamp(d.z, -1.0f, 1.0f);
     const float theta = fast_atan2(std::sqrt(std::max(0.0f, (1 - z) * (1 + z))), z);
-    float phi = fast_atan2(d.y, d.x);
-    if (phi < 0) phi += 2 * kPiF;
-    return {clamp(phi / (2 * kPiF), 0.0f, kOneMinusEpsilon), clamp(theta / kPiF, 0.0f, kOneMinusEpsilon)};
+    const float phi = fast_atan2(d.y, d.x);
+    constexpr float kInvPi = static_cast<float>(1 / kPi);
+    const float u = 0.5f * kInvPi * (phi < 0 ? phi + 2 * kPiF : phi);
+    return {clamp(u, 0.0f, kOneMinusEpsilon), clamp(theta * kInvPi, 0.0f, kOneMinusEpsilon)};
 }
 
 // sin(theta) at the centre of image row y of h: the row's weight in every
