@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "envmis/io/image_io.h"
+#include "errors.h"
 
 namespace envmis::io {
 namespace {
@@ -58,16 +59,9 @@ private:
     fs::path path_;
 };
 
-// Expects `action` to throw an ImageError whose message contains each of `parts`.
 template <class Action>
 void expect_image_error(Action&& action, std::initializer_list<std::string> parts) {
-    try {
-        action();
-        ADD_FAILURE() << "no ImageError";
-    } catch (const ImageError& e) {
-        for (const std::string& part : parts)
-            EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "'" << part << "' not in: " << e.what();
-    }
+    test::expect_error<ImageError>(std::forward<Action>(action), parts);
 }
 
 ColourConfig shipped() { return ColourConfig(kShippedConfig); }

@@ -20,6 +20,7 @@
 
 #include "envmis/hash.h"
 #include "envmis/io/colour.h"
+#include "errors.h"
 
 namespace envmis::io {
 namespace {
@@ -98,16 +99,9 @@ std::vector<std::string> folder_entries(const fs::path& dir) {
     return names;
 }
 
-// Expects `action` to throw an ImageError whose message contains each of `parts`.
 template <class Action>
 void expect_image_error(Action&& action, std::initializer_list<std::string> parts) {
-    try {
-        action();
-        ADD_FAILURE() << "no ImageError";
-    } catch (const ImageError& e) {
-        for (const std::string& part : parts)
-            EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "'" << part << "' not in: " << e.what();
-    }
+    test::expect_error<ImageError>(std::forward<Action>(action), parts);
 }
 
 // These expectations are about the shipped OCIO config, whatever $OCIO the runner has.

@@ -112,21 +112,17 @@ double exact_variance(const EnvMap& env, Technique technique, Allocation allocat
         const double f = luminance(multiply(n.radiance, bsdf.eval(wo, n.wi)), luma);
         if (f == 0) return;
         const double p_env = env.pdf_uv(n.uv), p_bsdf = bsdf.pdf(wo, n.wi);
-        const bool mis = strategy == Strategy::mis;
-        if (n_env > 0 && p_env > 0) {
-            const double w = mis ? mis_weight(technique.heuristic, static_cast<float>(n_env * p_env),
-                                              static_cast<float>(n_bsdf * p_bsdf))
-                                 : 1.0;
-            acc.env1 += f * w * n.solid_angle;
-            acc.env2 += f * f * w * w / p_env * n.solid_angle;
-        }
-        if (n_bsdf > 0 && p_bsdf > 0) {
-            const double w = mis ? mis_weight(technique.heuristic, static_cast<float>(n_bsdf * p_bsdf),
-                                              static_cast<float>(n_env * p_env))
-                                 : 1.0;
-            acc.bsdf1 += f * w * n.solid_angle;
-            acc.bsdf2 += f * f * w * w / p_bsdf * n.solid_angle;
-        }
+        // One technique's contribution: weight against the other, first and second moments.
+        auto add = [&](double n_self, double p_self, double n_other, double p_other, double& first, double& second) {
+            if (!(n_self > 0 && p_self > 0)) return;
+            const double w = strategy == Strategy::mis ? mis_weight(technique.heuristic, static_cast<float>(n_self * p_self),
+                                                                    static_cast<float>(n_other * p_other))
+                                                       : 1.0;
+            first += f * w * n.solid_angle;
+            second += f * f * w * w / p_self * n.solid_angle;
+        };
+        add(n_env, p_env, n_bsdf, p_bsdf, acc.env1, acc.env2);
+        add(n_bsdf, p_bsdf, n_env, p_env, acc.bsdf1, acc.bsdf2);
     });
     double variance = 0;
     if (n_env > 0) variance += (m.env2 - m.env1 * m.env1) / n_env;
