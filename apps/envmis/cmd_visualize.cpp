@@ -41,22 +41,26 @@ Subcommand add_visualize(CLI::App& app) {
     add_map_flags(*sub, args->map);
     return {sub, [args] {
                 const LoadedMap loaded = load_map(args->input, args->map);
-                EnvMapOptions plain = loaded.map.options(), compensated = plain;
-                plain.compensation.enabled = false;
-                compensated.compensation.enabled = true;
-                const EnvMap maps[2] = {EnvMap(loaded.map.radiance(), plain), EnvMap(loaded.map.radiance(), compensated)};
+                // The loaded map is one of the two densities; build only the other.
+                const bool loaded_compensated = loaded.map.options().compensation.enabled;
+                EnvMapOptions other_options = loaded.map.options();
+                other_options.compensation.enabled = !loaded_compensated;
+                const EnvMap other(loaded.map.radiance(), other_options);
+                const EnvMap* maps[2] = {loaded_compensated ? &other : &loaded.map, loaded_compensated ? &loaded.map : &other};
+                const EnvMapOptions& plain = maps[0]->options();
+                const EnvMapOptions& compensated = maps[1]->options();
 
                 const uint32_t w = loaded.map.width(), h = loaded.map.height();
                 const uint32_t pw = std::min(args->panel_width, std::max(w, 64u));
                 const uint32_t ph = std::max(1u, static_cast<uint32_t>(static_cast<uint64_t>(pw) * h / w));
                 std::vector<float> pdfs[2];
-                for (int i = 0; i < 2; ++i) pdfs[i] = io::resize(pdf_image(maps[i]), w, h, pw, ph);
+                for (int i = 0; i < 2; ++i) pdfs[i] = io::resize(pdf_image(*maps[i]), w, h, pw, ph);
                 const io::ColourScale scale = io::shared_log_scale({pdfs[0], pdfs[1]});
 
                 char caption[256];
                 std::snprintf(caption, sizeof caption, "%s  %ux%u  mean luminance %.3g  alpha %.3g: compensation zeroes %.1f%% of texels",
-                              loaded.source.name.c_str(), w, h, maps[1].stats().mean_luminance, compensated.compensation.alpha,
-                              100.0 * maps[1].stats().zeroed_texels / (static_cast<double>(w) * h));
+                              loaded.source.name.c_str(), w, h, maps[1]->stats().mean_luminance, compensated.compensation.alpha,
+                              100.0 * maps[1]->stats().zeroed_texels / (static_cast<double>(w) * h));
                 const io::Panel panels[] = {
                     {io::tonemap(io::resize(loaded.map.radiance(), pw, ph), 0, plain.luma), "radiance (tone-mapped)", false},
                     {io::false_colour(pdfs[0], pw, ph, scale), "pdf without compensation", true},
