@@ -207,7 +207,7 @@ TEST(EnvMap, SingleTexelMapWorks) {
         const EnvSample s = map.sample(rng.uniform2());
         EXPECT_FLOAT_EQ(s.radiance.r, 2.0f);
         if (s.pdf > 0) {
-            EXPECT_NEAR(s.pdf * kTwoPiSquared * std::sin(kPiF * s.uv.y), 1.0f, 1e-5f);
+            EXPECT_NEAR(s.pdf * kTwoPiSquared * std::sin(kPi * double{s.uv.y}), 1.0, 1e-5);
         }
     }
 }

@@ -1,7 +1,9 @@
 // Specification of the fast trigonometry (fast_math.h): close to double precision.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "envmis/fast_math.h"
 
@@ -32,6 +34,20 @@ TEST(FastMath, Atan2Within4e7EverywhereIncludingAxes) {
     EXPECT_FLOAT_EQ(fast_atan2(1, 0), kPiF / 2);
     EXPECT_FLOAT_EQ(fast_atan2(0, -1), kPiF);
     EXPECT_FLOAT_EQ(fast_atan2(-1, 0), -kPiF / 2);
+}
+
+TEST(FastMath, TurnTableSinCosWithin1e7OverTheTurnAndBeyond) {
+    const std::vector<SinCos> table = make_turn_table();
+    double worst = 0;
+    for (int i = -1000000; i <= 3000000; ++i) {
+        const float t = static_cast<float>(i) * 1e-6f;  // [-1, 3] turns
+        const SinCos sc = sincos_turns(table.data(), t);
+        const double a = 2 * kPi * double{t};
+        worst = std::max({worst, std::abs(sc.sin - std::sin(a)), std::abs(sc.cos - std::cos(a))});
+    }
+    EXPECT_LT(worst, 1.2e-7);  // two ulps of 1
+    EXPECT_EQ(sincos_turns(table.data(), 0.0f).sin, 0.0f);
+    EXPECT_EQ(sincos_turns(table.data(), 0.25f).cos, table[256].cos);
 }
 
 }  // namespace

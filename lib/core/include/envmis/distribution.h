@@ -53,8 +53,10 @@ struct CdfView {
     ENVMIS_HD uint32_t width(uint32_t i) const noexcept { return (i + 1 < n ? start[i + 1] : kCdfUnits) - start[i]; }
 
     // The cell holding unit u * 2^31, and the position inside it.
+    // Single precision throughout: x is exact (a power-of-two scale of u), and so are
+    // its integer part t and the fraction x - t; only the offset's division rounds.
     ENVMIS_HD CellHit invert(float u) const noexcept {
-        const double x = static_cast<double>(u) * kCdfUnits;
+        const float x = u * static_cast<float>(kCdfUnits);
         const auto t = static_cast<uint32_t>(x);
         const auto k = static_cast<uint32_t>((static_cast<uint64_t>(t) * n) >> 31);
         uint32_t lo = guide[k], hi = k + 1 < n ? guide[k + 1] : n - 1;
@@ -62,7 +64,8 @@ struct CdfView {
             const uint32_t mid = (lo + hi + 1) / 2;
             if (start[mid] <= t) lo = mid; else hi = mid - 1;
         }
-        const auto offset = static_cast<float>((x - start[lo]) / width(lo));
+        const float offset = (static_cast<float>(t - start[lo]) + (x - static_cast<float>(t))) /
+                             static_cast<float>(width(lo));
         return {lo, clamp(offset, 0.0f, kOneMinusEpsilon)};
     }
 

@@ -68,11 +68,13 @@ struct EnvMapView {
     Distribution2DView distribution;
     const Rgb* radiance = nullptr;
     Axes axes;
+    const SinCos* turns = nullptr;  // make_turn_table() (fast_math.h)
 
     ENVMIS_HD EnvSample sample(Vec2 u) const noexcept {
         const auto s = distribution.sample(u);
-        float sin_theta = 0;
-        const Vec3 canonical = equirect_direction(s.p, &sin_theta);
+        const SinCos theta = sincos_turns(turns, 0.5f * s.p.y), phi = sincos_turns(turns, s.p.x);
+        const float sin_theta = std::max(theta.sin, 0.0f);
+        const Vec3 canonical{sin_theta * phi.cos, sin_theta * phi.sin, theta.cos};
         return {to_world(axes, canonical), solid_angle_pdf(s.pdf, sin_theta),
                 radiance[static_cast<size_t>(s.y) * distribution.w + s.x], s.p};
     }
@@ -80,7 +82,7 @@ struct EnvMapView {
     ENVMIS_HD float pdf(Vec3 direction) const noexcept { return pdf_uv(equirect_uv(to_canonical(axes, direction))); }
     // Solid-angle pdf at image point uv; bit-identical to sample(u).pdf when uv = sample(u).uv.
     ENVMIS_HD float pdf_uv(Vec2 uv) const noexcept {
-        return solid_angle_pdf(distribution.pdf(uv), std::max(fast_sincos(kPiF * uv.y).sin, 0.0f));
+        return solid_angle_pdf(distribution.pdf(uv), std::max(sincos_turns(turns, 0.5f * uv.y).sin, 0.0f));
     }
     // Radiance arriving from `direction` (nearest texel).
     ENVMIS_HD Rgb eval(Vec3 direction) const noexcept { return eval_uv(equirect_uv(to_canonical(axes, direction))); }
@@ -117,7 +119,9 @@ public:
     EnvMap(RgbImage radiance, std::span<const float> density, const EnvMapOptions& options,
            const EnvMapStats& stats);
 
-    EnvMapView view() const noexcept { return {distribution_.view(), radiance_.pixels.data(), options_.axes}; }
+    EnvMapView view() const noexcept {
+        return {distribution_.view(), radiance_.pixels.data(), options_.axes, turns_.data()};
+    }
     EnvSample sample(Vec2 u) const noexcept { return view().sample(u); }
     float pdf(Vec3 direction) const noexcept { return view().pdf(direction); }
     float pdf_uv(Vec2 uv) const noexcept { return view().pdf_uv(uv); }
@@ -146,6 +150,7 @@ private:
 
     RgbImage radiance_;
     Distribution2D distribution_;
+    std::vector<SinCos> turns_ = make_turn_table();
     EnvMapOptions options_;
     EnvMapStats stats_;
 };
