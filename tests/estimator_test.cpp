@@ -34,31 +34,43 @@ Maps load_maps(const std::string& file) {
     return make_maps(file, image.image, image.luma);
 }
 
-const std::vector<const char*> kTechniques = {"env", "bsdf", "mis-balance", "mis-power", "mis-balance-comp",
-                                              "mis-power-comp"};
+// Every technique but env-comp, which is refused (see below).
+std::vector<Technique> valid_techniques() {
+    std::vector<Technique> t;
+    for (const Technique& technique : Technique::all())
+        if (technique.name() != "env-comp") t.push_back(technique);
+    return t;
+}
 
 std::vector<ShadingPoint> points() {
     return {{{0, 0, 1}, normalize(Vec3{0.3f, 0.2f, 1})}, {normalize(Vec3{0.7f, -0.2f, 0.3f}), normalize(Vec3{0.4f, 0.5f, 0.6f})}};
+}
+
+// The standard error of the mean of n estimates. The exact variance gives a trustworthy
+// one even where rare, bright samples (a small sun hit by BSDF sampling) make the sample
+// variance unreliable. Adaptive techniques have no exact variance: the larger of their
+// sample variance and balance MIS's exact variance over the same density stands in.
+double standard_error(const Maps& maps, Technique t, const Bsdf& bsdf, const ShadingPoint& p, const RunningStats& stats) {
+    const double n = static_cast<double>(stats.count());
+    if (!t.adaptive()) return std::sqrt(exact_variance(t.compensated ? maps.compensated : maps.plain, t, {}, bsdf, p, 4) / n);
+    const Technique balance{Strategy::mis, Heuristic::balance, t.compensated};
+    const double balance_variance = exact_variance(t.compensated ? maps.compensated : maps.plain, balance, {}, bsdf, p, 4);
+    return std::sqrt(std::max(stats.variance(), balance_variance) / n);
 }
 
 void expect_unbiased(const Maps& maps, uint64_t seed) {
     for (const Bsdf& bsdf : {Bsdf::lambert(), Bsdf::phong(50), Bsdf::ggx(0.1f)})
         for (const ShadingPoint& p : points()) {
             const double reference = reflected_radiance(maps.plain, bsdf, p, {1e-5, 32}).luminance;
-            for (const char* name : kTechniques) {
-                const Technique t = Technique::parse(name);
-                const EnvMap& env = t.compensated ? maps.compensated : maps.plain;
-                const DirectLightingEstimator estimator(env, t);
+            for (const Technique& t : valid_techniques()) {
+                const DirectLightingEstimator estimator(maps.plain, maps.compensated, t);
                 Pcg32 rng(seed++);
+                PointState state;
                 RunningStats stats;
-                const int n = 50000;
-                for (int i = 0; i < n; ++i) stats.add(luminance(estimator.estimate(p, bsdf, rng), env.options().luma));
-                // The exact variance gives a trustworthy standard error even where rare,
-                // bright samples (a small sun hit by BSDF sampling) make the sample variance
-                // unreliable.
-                const double se = std::sqrt(exact_variance(env, t, {}, bsdf, p, 4) / n);
-                EXPECT_NEAR(stats.mean(), reference, 4 * se + 1e-6 * reference)
-                    << maps.name << " " << bsdf.name() << " " << name << " normal.z=" << p.normal.z;
+                for (int i = 0; i < 50000; ++i)
+                    stats.add(luminance(estimator.estimate(p, bsdf, rng, state), maps.plain.options().luma));
+                EXPECT_NEAR(stats.mean(), reference, 4 * standard_error(maps, t, bsdf, p, stats) + 1e-6 * reference)
+                    << maps.name << " " << bsdf.name() << " " << t.name() << " normal.z=" << p.normal.z;
             }
         }
 }
@@ -98,18 +110,87 @@ TEST(Estimator, RefusesEnvironmentSamplingAloneOverACompensatedDensity) {
     EXPECT_THROW(DirectLightingEstimator(maps.plain, Technique::parse("mis-balance"), {0, 2}), std::invalid_argument);
 }
 
-TEST(Technique, NamesRoundTrip) {
-    for (const char* name : {"env", "env-comp", "bsdf", "mis-balance", "mis-power", "mis-balance-comp", "mis-power-comp"})
-        EXPECT_EQ(Technique::parse(name).name(), name);
-    EXPECT_THROW(Technique::parse("mis"), std::invalid_argument);
+TEST(Estimator, OptimalMisLowersLambertVarianceUnderASunnyMap) {
+    // Geometric mean over normals of measured variance ratios against balance MIS over
+    // the same density: optimal weights may lose a little where balance is already near
+    // optimal, but not on average.
+    const Maps maps = load_maps("rooitou_park_1k.hdr");
+    const Bsdf lambert = Bsdf::lambert();
+    for (const char* pair : {"mis-optimal", "mis-optimal-comp"}) {
+        const Technique optimal = Technique::parse(pair);
+        const Technique balance{Strategy::mis, Heuristic::balance, optimal.compensated};
+        double log_ratio = 0;
+        const int k = 8;
+        for (int i = 0; i < k; ++i) {
+            const double z = 1 - (2 * i + 1.0) / k, r = std::sqrt(1 - z * z), phi = 2.399963 * i;
+            const Vec3 n{static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z)};
+            const ShadingPoint p{n, n};
+            RunningStats stats[2];
+            for (int j = 0; j < 2; ++j) {
+                const DirectLightingEstimator estimator(maps.plain, maps.compensated, j ? optimal : balance);
+                Pcg32 rng(77, i);
+                PointState state;
+                for (int e = 0; e < 4096; ++e) stats[j].add(luminance(estimator.estimate(p, lambert, rng, state), {}));
+            }
+            log_ratio += std::log(stats[1].variance() / stats[0].variance()) / k;
+        }
+        EXPECT_LT(std::exp(log_ratio), 0.95) << pair;
+    }
 }
 
-TEST(MisWeight, BalanceAndPowerSumToOne) {
-    for (Heuristic h : {Heuristic::balance, Heuristic::power})
-        for (auto [a, b] : {std::pair{1.0f, 3.0f}, std::pair{0.2f, 0.0f}, std::pair{5.0f, 5.0f}})
-            EXPECT_NEAR(mis_weight(h, a, b) + mis_weight(h, b, a), 1.0f, 1e-6f);
-    EXPECT_FLOAT_EQ(mis_weight(Heuristic::balance, 1, 3), 0.25f);
-    EXPECT_FLOAT_EQ(mis_weight(Heuristic::power, 1, 3), 0.1f);
+TEST(Estimator, OptimalMisFallsBackToBalanceOnASingularSystemAndSaysSo) {
+    // A constant map: compensation falls back to the plain density, so the mixture's
+    // three control variates hold the same density twice.
+    const Maps maps = make_maps("constant", test::constant_map(64, 32, {1, 1, 1}));
+    ASSERT_EQ(maps.compensated.stats().fallback, DensityFallback::uncompensated);
+    const DirectLightingEstimator all(maps.plain, maps.compensated, Technique::parse("mis-optimal-all"));
+    Pcg32 rng(5);
+    PointState state;
+    for (int i = 0; i < 64; ++i) all.estimate({}, Bsdf::lambert(), rng, state);
+    EXPECT_FALSE(state.optimal.solved);
+    EXPECT_EQ(state.ill_conditioned, 4u);  // at 8, 16, 32 and 64 estimates
+    for (const auto& row : state.optimal.alpha)
+        for (float a : row) EXPECT_EQ(a, 0.0f);
+    // A well-posed pair learns non-zero coefficients.
+    const DirectLightingEstimator pair(maps.plain, maps.compensated, Technique::parse("mis-optimal"));
+    PointState learnt;
+    for (int i = 0; i < 64; ++i) pair.estimate({}, Bsdf::lambert(), rng, learnt);
+    EXPECT_TRUE(learnt.optimal.solved);
+    EXPECT_EQ(learnt.ill_conditioned, 0u);
+    EXPECT_NE(learnt.optimal.alpha[0][0], 0.0f);
+}
+
+TEST(Estimator, MultiSampleBalanceMisBeatsOneSampleMis) {
+    // Stratification over the techniques: drawing exactly one sample of each never has
+    // higher variance than picking techniques at random (exact variances).
+    const Maps maps = load_maps("rooitou_park_1k.hdr");
+    for (const Bsdf& bsdf : {Bsdf::lambert(), Bsdf::phong(50)})
+        for (const ShadingPoint& p : points()) {
+            const double multi = exact_variance(maps.plain, Technique::parse("mis-balance"), {}, bsdf, p, 2);
+            const double one = exact_variance(maps.plain, Technique::parse("one-sample"), {}, bsdf, p, 2);
+            EXPECT_LE(multi, one * (1 + 1e-9)) << bsdf.name();
+        }
+}
+
+TEST(Estimator, MixtureNeedsBothMaps) {
+    const Maps maps = make_maps("sun", test::sun_sky_map(64, 32));
+    EXPECT_THROW(DirectLightingEstimator(maps.compensated, Technique::parse("mis-optimal-all")), std::invalid_argument);
+    EXPECT_THROW(exact_variance(maps.plain, Technique::parse("mis-optimal"), {}, Bsdf::lambert(), {}, 1), std::invalid_argument);
+}
+
+TEST(Technique, NamesRoundTrip) {
+    std::vector<std::string> names;
+    for (const Technique& t : Technique::all()) {
+        EXPECT_EQ(Technique::parse(t.name()), t);
+        names.push_back(t.name());
+    }
+    EXPECT_EQ(names.size(), 14u);
+    for (const char* name : {"env", "env-comp", "bsdf", "mis-balance", "mis-power", "mis-balance-comp", "mis-power-comp",
+                             "mis-optimal", "mis-optimal-comp", "mis-optimal-all", "mis-var", "mis-var-comp", "one-sample",
+                             "one-sample-comp"})
+        EXPECT_EQ(Technique::parse(name).name(), name);
+    EXPECT_THROW(Technique::parse("mis"), std::invalid_argument);
+    EXPECT_THROW(Technique::parse("mis-balance-all"), std::invalid_argument);
 }
 
 }  // namespace

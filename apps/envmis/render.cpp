@@ -98,7 +98,7 @@ std::filesystem::path render_comparison(const EnvMap& plain, const EnvMap& compe
     io::write_exr(folder / "reference.exr", reference);
     std::vector<std::pair<std::string, RgbImage>> renders;
     for (const Technique& t : options.techniques) {
-        const DirectLightingEstimator estimator(t.compensated ? compensated : plain, t, options.allocation);
+        const DirectLightingEstimator estimator(plain, compensated, t, options.allocation);
         renders.emplace_back(t.name(), render(scene, estimator, options.bsdfs, render_options.spp, options.seed,
                                               options.threads, stop));
         io::write_exr(folder / (t.name() + ".exr"), renders.back().second);

@@ -14,6 +14,7 @@ namespace {
 struct Cell {
     RunningStats estimates, squared_relative_error;
     double seconds = 0;
+    bool ill_conditioned = false;  // optimal MIS ended on balance weights
 };
 
 }  // namespace
@@ -45,9 +46,10 @@ std::vector<ShadingPoint> sphere_points(uint32_t k) {
 Rgb average_estimate(const DirectLightingEstimator& estimator, const ShadingPoint& point, const Bsdf& bsdf,
                      uint32_t spp, uint64_t seed, uint64_t stream) {
     Pcg32 rng(seed, stream);
+    PointState state;
     double r = 0, g = 0, b = 0;
     for (uint32_t i = 0; i < spp; ++i) {
-        const Rgb e = estimator.estimate(point, bsdf, rng);
+        const Rgb e = estimator.estimate(point, bsdf, rng, state);
         r += e.r, g += e.g, b += e.b;
     }
     return {static_cast<float>(r / spp), static_cast<float>(g / spp), static_cast<float>(b / spp)};
@@ -60,7 +62,7 @@ Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<con
         throw std::invalid_argument("compare: needs at least one BSDF, technique, shading point and sample");
     std::vector<DirectLightingEstimator> estimators;
     for (const Technique& t : options.techniques)
-        estimators.emplace_back(t.compensated ? compensated : plain, t, options.allocation);
+        estimators.emplace_back(plain, compensated, t, options.allocation);
     const size_t nb = options.bsdfs.size(), nt = options.techniques.size();
     const uint32_t threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
     const LumaCoefficients luma = plain.options().luma;
@@ -82,13 +84,16 @@ Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<con
                 const double reference = references[done * nb + b];
                 Cell& cell = cells[first + job];
                 Pcg32 rng(options.seed, (done * nb + b) * nt + t);
+                PointState state;
                 const auto start = std::chrono::steady_clock::now();
                 for (uint32_t i = 0; i < options.spp; ++i) {
-                    const double x = luminance(estimators[t].estimate(point, options.bsdfs[b], rng), luma);
+                    const double x = luminance(estimators[t].estimate(point, options.bsdfs[b], rng, state), luma);
                     cell.estimates.add(x);
                     if (reference > 0) cell.squared_relative_error.add((x - reference) * (x - reference) / (reference * reference));
                 }
                 cell.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+                cell.ill_conditioned = options.techniques[t].heuristic == Heuristic::optimal && state.estimates >= 8 &&
+                                       !state.optimal.solved;
             }
         };
         std::vector<std::jthread> pool;
@@ -119,6 +124,7 @@ Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<con
                 rel.merge(c.squared_relative_error);
                 seconds += c.seconds;
                 s.estimates += c.estimates.count();
+                s.ill_conditioned_points += c.ill_conditioned;
                 if (mis_index < nt) {
                     const double v = c.estimates.variance(), v_mis = cells[(p * nb + b) * nt + mis_index].estimates.variance();
                     if (v > 0 && v_mis > 0) log_ratio += std::log(v / v_mis), ++ratios;

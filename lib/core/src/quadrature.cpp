@@ -1,6 +1,7 @@
 #include "envmis/quadrature.h"
 
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 #include "envmis/frame.h"
@@ -103,15 +104,27 @@ double exact_variance(const EnvMap& env, Technique technique, Allocation allocat
             return *this;
         }
     };
+    if (technique.adaptive())
+        throw std::invalid_argument("exact_variance: " + technique.name() +
+                                    " learns its weights from its own samples; its variance has no closed form");
     const Strategy strategy = technique.strategy;
-    const double n_env = strategy == Strategy::env ? allocation.total() : (strategy == Strategy::mis ? allocation.env : 0);
-    const double n_bsdf = strategy == Strategy::bsdf ? allocation.total() : (strategy == Strategy::mis ? allocation.bsdf : 0);
+    const bool both = strategy == Strategy::mis || strategy == Strategy::one_sample;
+    const double n_env = strategy == Strategy::env ? allocation.total() : (both ? allocation.env : 0);
+    const double n_bsdf = strategy == Strategy::bsdf ? allocation.total() : (both ? allocation.bsdf : 0);
     const Vec3 wo = Frame::from_normal(point.normal).to_local(point.wo);
     const LumaCoefficients luma = env.options().luma;
     const Moments m = integrate<Moments>(env, point, subdivisions, [&](Moments& acc, const Node& n) {
         const double f = luminance(multiply(n.radiance, bsdf.eval(wo, n.wi)), luma);
         if (f == 0) return;
         const double p_env = env.pdf_uv(n.uv), p_bsdf = bsdf.pdf(wo, n.wi);
+        if (strategy == Strategy::one_sample) {
+            // total() draws z = f / Q from the mixture Q / total: the estimate's variance
+            // is integral f^2 / Q - (integral f)^2 / total. Kept in the env moments.
+            const double q = n_env * p_env + n_bsdf * p_bsdf;
+            acc.env1 += f * n.solid_angle;
+            if (q > 0) acc.env2 += f * f / q * n.solid_angle;
+            return;
+        }
         // One technique's contribution: weight against the other, first and second moments.
         auto add = [&](double n_self, double p_self, double n_other, double p_other, double& first, double& second) {
             if (!(n_self > 0 && p_self > 0)) return;
@@ -124,6 +137,7 @@ double exact_variance(const EnvMap& env, Technique technique, Allocation allocat
         add(n_env, p_env, n_bsdf, p_bsdf, acc.env1, acc.env2);
         add(n_bsdf, p_bsdf, n_env, p_env, acc.bsdf1, acc.bsdf2);
     });
+    if (strategy == Strategy::one_sample) return m.env2 - m.env1 * m.env1 / allocation.total();
     double variance = 0;
     if (n_env > 0) variance += (m.env2 - m.env1 * m.env1) / n_env;
     if (n_bsdf > 0) variance += (m.bsdf2 - m.bsdf1 * m.bsdf1) / n_bsdf;

@@ -7,8 +7,10 @@
 //
 // The cosine factor lives here and only here: eval(wo, wi) returns f(wo, wi) cos(theta_i),
 // the BSDF part of the direct-lighting integrand L(wi) f cos(theta_i). pdf(wo, wi) is
-// the solid-angle density of sample(wo, u); sample returns eval(wo, wi) with it, so
-// value / pdf is the sampling weight.
+// the solid-angle density of sample(wo, u) over the whole sphere (Phong and GGX also draw
+// directions below the surface, whose value is 0), so it integrates to 1 whenever wo is
+// above the surface; sample returns eval(wo, wi) with it, so value / pdf is the
+// sampling weight.
 //
 // A Bsdf is a small value type (a kind and its parameters) with branch-on-kind methods:
 // no virtual calls, usable on the device.
@@ -113,7 +115,9 @@ ENVMIS_HD inline float Bsdf::pdf(Vec3 wo, Vec3 wi) const noexcept {
             return c > 0 ? (exponent + 1) / (2 * kPiF) * std::pow(c, exponent) : 0.0f;
         }
         case BsdfKind::ggx: {
-            if (wi.z <= 0) return 0;
+            // Reflections of wo about a visible normal; those that go below the surface
+            // are drawn too (with no value), so the density covers them, as for Phong:
+            // it integrates to 1 over the sphere, as optimal MIS's control variates must.
             const Vec3 m = normalize(wo + wi);
             const float g1 = 1 / (1 + ggx::lambda(wo, alpha));
             return dot(wo, m) > 0 ? g1 * ggx::distribution(m, alpha) / (4 * wo.z) : 0.0f;

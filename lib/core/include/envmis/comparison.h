@@ -47,6 +47,9 @@ struct TechniqueStats {
     double mean = 0, reference = 0, variance = 0, std_error = 0, rel_mse = 0;
     double ns_per_estimate = 0, efficiency = 0, variance_ratio_vs_mis = 0;
     uint64_t estimates = 0;
+    // Optimal MIS: points whose linear system stayed singular, so that their estimates
+    // kept the balance heuristic's weights.
+    uint32_t ill_conditioned_points = 0;
 };
 
 struct BsdfComparison {
@@ -73,8 +76,8 @@ Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<con
                    const ComparisonOptions& options, const std::atomic<bool>* stop = nullptr,
                    const std::function<void(size_t, size_t)>& progress = {});
 
-// Runs `spp` estimates of `technique` at one point and returns their mean (RGB):
-// one pixel of a rendered comparison.
+// Runs `spp` estimates of `technique` at one point, learning as adaptive techniques do,
+// and returns their mean (RGB): one pixel of a rendered comparison.
 Rgb average_estimate(const DirectLightingEstimator& estimator, const ShadingPoint& point, const Bsdf& bsdf,
                      uint32_t spp, uint64_t seed, uint64_t stream);
 

@@ -3,12 +3,21 @@
 //   L_o(wo) = integral over the sphere of L(wi) f(wo, wi) cos(theta_i) dwi
 //
 // by environment sampling, BSDF sampling, or multiple importance sampling of both
-// (Veach 1995) with the balance or power heuristic, over the plain (luminance) or the
-// MIS-compensated environment density (Karlik et al. 2019).
+// (Veach 1995) with the balance, power, variance-aware (Grittmann et al. 2019) or
+// optimal (Kondapaneni et al. 2019) weights of mis_weights.h, over the plain (luminance)
+// or the MIS-compensated environment density (Karlik et al. 2019); and one-sample MIS,
+// which picks one technique at random per sample (balance heuristic).
 //
 // Equal sample count: every technique spends Allocation::total() samples per estimate
 // (1 environment + 1 BSDF sample for MIS by default, 2 samples of its one kind for a
-// single technique), so variances compare directly.
+// single technique, 2 randomly chosen ones for one-sample MIS), so variances compare
+// directly.
+//
+// Adaptive techniques learn at each shading point from the estimates made there before:
+// optimal MIS the moments of its linear system, variance-aware MIS each technique's
+// variance. The learnt values change at 8, 16, 32, ... estimates (progressively, as in
+// both papers); until the 8th estimate both are the balance heuristic. An estimate uses
+// only what earlier, independent estimates learnt, so every estimate is unbiased.
 //
 // A compensated density is zero where the radiance is not (envmap.h): sampling it
 // alone is biased, so an environment-only technique over an incomplete map is refused
@@ -18,25 +27,37 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "envmis/bsdf.h"
 #include "envmis/envmap.h"
+#include "envmis/mis_weights.h"
 #include "envmis/random.h"
 
 namespace envmis {
 
-enum class Strategy : uint32_t { env, bsdf, mis };
-enum class Heuristic : uint32_t { balance, power };
+enum class Strategy : uint32_t { env, bsdf, mis, one_sample };
+enum class Heuristic : uint32_t { balance, power, optimal, variance_aware };
 
 struct Technique {
     Strategy strategy = Strategy::mis;
     Heuristic heuristic = Heuristic::balance;
     bool compensated = false;  // the environment technique samples the compensated density
+    // The environment technique samples the equal mixture of the plain and the
+    // compensated density, and optimal MIS takes all three densities (plain,
+    // compensated, BSDF) as control variates: a 3 x 3 system.
+    bool mixture = false;
 
-    // Names: env, env-comp, bsdf, mis-balance, mis-power, mis-balance-comp, mis-power-comp.
-    // Throws std::invalid_argument for other text.
+    // Names: env, env-comp, bsdf, mis-balance, mis-power, mis-optimal, mis-var, each
+    // MIS name also with -comp, mis-optimal-all (the mixture), one-sample and
+    // one-sample-comp. Throws std::invalid_argument for other text.
     static Technique parse(std::string_view name);
+    static std::vector<Technique> all();
     std::string name() const;
+    // Learns at each shading point (PointState).
+    bool adaptive() const noexcept {
+        return strategy == Strategy::mis && (heuristic == Heuristic::optimal || heuristic == Heuristic::variance_aware);
+    }
     friend bool operator==(const Technique&, const Technique&) = default;
 };
 
@@ -54,27 +75,57 @@ struct ShadingPoint {
 
 // MIS weight of a technique with density-times-count a against another with b.
 ENVMIS_HD inline float mis_weight(Heuristic h, float a, float b) noexcept {
-    if (h == Heuristic::power) a *= a, b *= b;
-    return a > 0 ? a / (a + b) : 0.0f;
+    const float q[2] = {a, b};
+    return h == Heuristic::power ? power_weight(q, 2, 0) : balance_weight(q, 2, 0);
 }
+
+// What an adaptive technique has learnt at one shading point. Start a fresh one for
+// every point; the techniques that do not learn leave it untouched.
+struct PointState {
+    uint32_t estimates = 0;     // made at this point so far
+    uint32_t next_update = 8;   // the estimate count at which the learnt values change
+    // Optimal MIS: sums over samples of c_k c_l / Q^2 and f c_k / Q^2 (Q = sum n p),
+    // unbiased estimates of the system's integrals up to a common factor.
+    double a[kMaxTechniques * kMaxTechniques] = {};
+    double b[kMaxTechniques * 3] = {};
+    OptimalAlpha optimal;       // alpha = 0 (balance) until the first update
+    uint32_t ill_conditioned = 0;  // updates that found the system singular: balance kept
+    // Variance-aware MIS: moments of each technique's own estimate luminance(f) / p.
+    double sum[2] = {}, sum2[2] = {};
+    uint64_t count[2] = {};
+    float nu[2] = {1, 1};
+};
 
 class DirectLightingEstimator {
 public:
-    // `env` is the map the technique samples: plain for plain techniques, compensated for
-    // compensated ones. Throws std::invalid_argument if the technique samples only the
-    // environment and env is not complete (a compensated density), if the allocation
-    // spends no sample, or if MIS is given a zero count for one of its techniques.
+    // `plain` and `compensated` are the same map without and with compensation; the
+    // technique samples the one it names (both for the mixture). Throws
+    // std::invalid_argument if the technique samples only the environment over an
+    // incomplete (compensated) density, if the allocation spends no sample, or if MIS
+    // is given a zero count for one of its techniques.
+    DirectLightingEstimator(const EnvMap& plain, const EnvMap& compensated, Technique technique,
+                            Allocation allocation = {});
+    // The same for a technique that needs one map (not the mixture): `env` is the map
+    // it samples, plain or compensated.
     DirectLightingEstimator(const EnvMap& env, Technique technique, Allocation allocation = {});
 
-    // One estimate of L_o (RGB radiance), from allocation.total() samples drawn with rng.
-    // noexcept and allocation-free.
-    Rgb estimate(const ShadingPoint& point, const Bsdf& bsdf, Pcg32& rng) const noexcept;
+    // One estimate of L_o (RGB radiance), from allocation.total() samples drawn with
+    // rng; adaptive techniques read and update `state`, the point's. noexcept and
+    // allocation-free.
+    Rgb estimate(const ShadingPoint& point, const Bsdf& bsdf, Pcg32& rng, PointState& state) const noexcept;
+    // The same with a throwaway state: adaptive techniques act as the balance heuristic.
+    Rgb estimate(const ShadingPoint& point, const Bsdf& bsdf, Pcg32& rng) const noexcept {
+        PointState state;
+        return estimate(point, bsdf, rng, state);
+    }
 
     Technique technique() const noexcept { return technique_; }
     Allocation allocation() const noexcept { return allocation_; }
 
 private:
-    EnvMapView env_;
+    EnvMapView env_;    // the sampled density
+    EnvMapView other_;  // the plain density, which the mixture also samples
+    LumaCoefficients luma_;
     Technique technique_;
     Allocation allocation_;
 };

@@ -36,7 +36,9 @@ QuadratureResult reflected_radiance(const EnvMap& map, const Bsdf& bsdf, const S
 // The exact variance of one estimate's luminance by `technique` with `allocation`
 // (estimator.h), sampling `env` (plain or compensated, as the technique says) and
 // taking radiance from it: for MIS, sum over its two techniques of
-// (integral of f^2 w^2 / p - (integral of f w)^2) / n, at a fixed subdivision s.
+// (integral of f^2 w^2 / p - (integral of f w)^2) / n; for one-sample MIS,
+// integral of f^2 / Q - (integral of f)^2 / total, Q = sum n p; at a fixed subdivision
+// s. Throws std::invalid_argument for an adaptive technique: its weights are learnt.
 double exact_variance(const EnvMap& env, Technique technique, Allocation allocation, const Bsdf& bsdf,
                       const ShadingPoint& point, int subdivisions);
 
