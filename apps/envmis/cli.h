@@ -77,5 +77,6 @@ Subcommand add_sample(CLI::App& app);
 Subcommand add_visualize(CLI::App& app);
 Subcommand add_bench(CLI::App& app);
 Subcommand add_compare(CLI::App& app);
+Subcommand add_report(CLI::App& app);
 
 }  // namespace envmis::cli

@@ -25,6 +25,7 @@ constexpr Technique kAll[] = {
     {Strategy::mis, Heuristic::power, true},
     {Strategy::mis, Heuristic::optimal, true},
     {Strategy::mis, Heuristic::variance_aware, true},
+    {Strategy::mis, Heuristic::balance, true, true},
     {Strategy::mis, Heuristic::optimal, true, true},
     {Strategy::one_sample},
     {Strategy::one_sample, Heuristic::balance, true},

@@ -104,9 +104,10 @@ double exact_variance(const EnvMap& env, Technique technique, Allocation allocat
             return *this;
         }
     };
-    if (technique.adaptive())
+    if (technique.adaptive() || technique.mixture)
         throw std::invalid_argument("exact_variance: " + technique.name() +
-                                    " learns its weights from its own samples; its variance has no closed form");
+                                    (technique.adaptive() ? " learns its weights from its own samples; its variance has no closed form"
+                                                          : " samples two maps; pass one technique of one map"));
     const Strategy strategy = technique.strategy;
     const bool both = strategy == Strategy::mis || strategy == Strategy::one_sample;
     const double n_env = strategy == Strategy::env ? allocation.total() : (both ? allocation.env : 0);

@@ -44,13 +44,13 @@ struct Technique {
     Heuristic heuristic = Heuristic::balance;
     bool compensated = false;  // the environment technique samples the compensated density
     // The environment technique samples the equal mixture of the plain and the
-    // compensated density, and optimal MIS takes all three densities (plain,
+    // compensated density (-all); optimal MIS then takes all three densities (plain,
     // compensated, BSDF) as control variates: a 3 x 3 system.
     bool mixture = false;
 
     // Names: env, env-comp, bsdf, mis-balance, mis-power, mis-optimal, mis-var, each
-    // MIS name also with -comp, mis-optimal-all (the mixture), one-sample and
-    // one-sample-comp. Throws std::invalid_argument for other text.
+    // MIS name also with -comp, mis-balance-all and mis-optimal-all (the mixture),
+    // one-sample and one-sample-comp. Throws std::invalid_argument for other text.
     static Technique parse(std::string_view name);
     static std::vector<Technique> all();
     std::string name() const;

@@ -38,7 +38,8 @@ QuadratureResult reflected_radiance(const EnvMap& map, const Bsdf& bsdf, const S
 // taking radiance from it: for MIS, sum over its two techniques of
 // (integral of f^2 w^2 / p - (integral of f w)^2) / n; for one-sample MIS,
 // integral of f^2 / Q - (integral of f)^2 / total, Q = sum n p; at a fixed subdivision
-// s. Throws std::invalid_argument for an adaptive technique: its weights are learnt.
+// s. Throws std::invalid_argument for an adaptive technique (its weights are learnt)
+// and for the mixture (it samples two maps).
 double exact_variance(const EnvMap& env, Technique technique, Allocation allocation, const Bsdf& bsdf,
                       const ShadingPoint& point, int subdivisions);
 

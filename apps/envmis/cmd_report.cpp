@@ -1,0 +1,164 @@
+// envmis report RESULTS.json... -o OUT.md: one Markdown report from the JSON files of
+// several `envmis compare` runs (one per map): a summary of every technique's variance
+// relative to balance MIS per (map, BSDF) case, its geometric mean over all cases, the
+// technique that gains most, and each run's full table.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "envmis/atomic_file.h"
+
+namespace envmis::cli {
+namespace {
+
+using nlohmann::json;
+
+json read_results(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw std::runtime_error(path + ": cannot open");
+    json j;
+    try {
+        j = json::parse(in);
+    } catch (const json::exception& e) {
+        throw std::runtime_error(path + ": not JSON (" + e.what() + ")");
+    }
+    if (!j.contains("inputs") || !j.contains("results") || !j["results"].is_array())
+        throw std::runtime_error(path + ": not the JSON of envmis compare (no inputs and results)");
+    return j;
+}
+
+std::string number(double v, const char* format = "%.4g") {
+    char text[32];
+    std::snprintf(text, sizeof text, format, v);
+    return text;
+}
+
+// One (map, BSDF) case: each technique's variance relative to mis-balance.
+struct Case {
+    std::string map, bsdf;
+    std::map<std::string, double> ratio;
+};
+
+void write_report(std::ostream& out, const std::vector<json>& runs, const std::string& title, const std::string& command) {
+    std::vector<std::string> techniques;  // in the order of the first run that has them
+    std::vector<Case> cases;
+    for (const json& run : runs) {
+        const std::string map = run["inputs"].value("map", "?");
+        for (const json& r : run["results"]) {
+            const std::string bsdf = r["bsdf"], technique = r["technique"];
+            if (std::find(techniques.begin(), techniques.end(), technique) == techniques.end()) techniques.push_back(technique);
+            auto it = std::find_if(cases.begin(), cases.end(), [&](const Case& c) { return c.map == map && c.bsdf == bsdf; });
+            if (it == cases.end()) it = cases.insert(cases.end(), Case{map, bsdf, {}});
+            it->ratio[technique] = r["variance_ratio_vs_mis"];
+        }
+    }
+    std::erase(techniques, "mis-balance");
+
+    out << "# " << title << "\n\n";
+    if (!command.empty()) out << "Made by `" << command << "`.\n\n";
+    const json& first = runs.front()["inputs"];
+    out << "Every technique spends the same number of samples per estimate (" << first.value("env_samples", 1) << " environment + "
+        << first.value("bsdf_samples", 1) << " BSDF for MIS). Figures are variances of one estimate relative to balance "
+        << "MIS over the plain density (`mis-balance`), as the geometric mean over " << first.value("points_done", 0)
+        << " shading points of the per-point ratios; " << first.value("spp", 0)
+        << " estimates per point. Below 1 is better than balance MIS.\n\n";
+
+    // Summary: one row per case, one column per technique, and the geometric mean row.
+    out << "## Variance relative to balance MIS\n\n| map | bsdf |";
+    for (const std::string& t : techniques) out << " " << t << " |";
+    out << "\n|---|---|";
+    for (size_t i = 0; i < techniques.size(); ++i) out << "---:|";
+    out << "\n";
+    std::map<std::string, std::pair<double, int>> log_sum;
+    for (const Case& c : cases) {
+        out << "| " << c.map << " | " << c.bsdf << " |";
+        for (const std::string& t : techniques) {
+            const auto it = c.ratio.find(t);
+            const bool valid = it != c.ratio.end() && it->second > 0;
+            out << " " << (valid ? number(it->second, "%.3f") : "") << " |";
+            if (valid) log_sum[t].first += std::log(it->second), ++log_sum[t].second;
+        }
+        out << "\n";
+    }
+    out << "| **geometric mean** | |";
+    std::string best;
+    double best_ratio = INFINITY;
+    for (const std::string& t : techniques) {
+        const auto& [sum, n] = log_sum[t];
+        const double g = n ? std::exp(sum / n) : NAN;
+        out << " **" << (n ? number(g, "%.3f") : "") << "** |";
+        // Single techniques are left out of the choice: their rare, bright samples (a sun
+        // found by BSDF sampling) are often missing from a finite run, which then
+        // understates their variance.
+        if (t.starts_with("mis-") && n == static_cast<int>(cases.size()) && g < best_ratio) best_ratio = g, best = t;
+    }
+    out << "\n\n";
+    if (!best.empty())
+        out << "**Lowest variance of the MIS techniques across the table: `" << best << "`, " << number(1 / best_ratio, "%.2f")
+            << "x lower variance than balance MIS (geometric mean over " << cases.size() << " cases).**\n\n";
+
+    // Optimal MIS against balance MIS over the same density, case by case.
+    const std::pair<const char*, const char*> pairs[] = {
+        {"mis-optimal", "mis-balance"}, {"mis-optimal-comp", "mis-balance-comp"}, {"mis-optimal-all", "mis-balance-all"}};
+    bool header = false;
+    for (const Case& c : cases)
+        for (const auto& [optimal, balance] : pairs) {
+            const auto o = c.ratio.find(optimal);
+            const double b = std::string(balance) == "mis-balance" ? 1.0 : (c.ratio.count(balance) ? c.ratio.at(balance) : 0.0);
+            if (o == c.ratio.end() || !(b > 0)) continue;
+            if (!header) {
+                out << "## Optimal weights against balance weights over the same density\n\n"
+                    << "| map | bsdf | optimal | balance | variance optimal / balance |\n|---|---|---|---|---:|\n";
+                header = true;
+            }
+            out << "| " << c.map << " | " << c.bsdf << " | " << optimal << " | " << balance << " | "
+                << number(o->second / b, "%.3f") << " |\n";
+        }
+    if (header) out << "\n";
+
+    for (const json& run : runs) {
+        const json& in = run["inputs"];
+        out << "## " << in.value("map", "?") << " (" << in.value("width", 0) << "x" << in.value("height", 0) << "), alpha "
+            << number(in.value("alpha", 1.0), "%.3g") << "\n\n"
+            << "| bsdf | technique | mean | reference | variance | std_error | rel_mse | ns/estimate | efficiency | var/mis |\n"
+            << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        for (const json& r : run["results"])
+            out << "| " << r["bsdf"].get<std::string>() << " | " << r["technique"].get<std::string>() << " | "
+                << number(r["mean"]) << " | " << number(r["reference"]) << " | " << number(r["variance"]) << " | "
+                << number(r["std_error"], "%.3g") << " | " << number(r["rel_mse"]) << " | "
+                << number(r["ns_per_estimate"], "%.0f") << " | " << number(r["efficiency"]) << " | "
+                << number(r["variance_ratio_vs_mis"], "%.3f") << " |\n";
+        out << "\n";
+    }
+}
+
+}  // namespace
+
+Subcommand add_report(CLI::App& app) {
+    struct Args {
+        std::vector<std::string> inputs;
+        std::string output, title = "envmis results", command;
+    };
+    auto args = std::make_shared<Args>();
+    CLI::App* sub = app.add_subcommand("report", "Markdown report from the JSON of envmis compare runs (one per map)");
+    sub->add_option("results", args->inputs, "JSON files written by envmis compare --json")->required();
+    sub->add_option("-o,--output", args->output, "Markdown file to write")->required();
+    sub->add_option("--title", args->title, "Title of the report")->capture_default_str();
+    sub->add_option("--command", args->command, "The command that made the results, quoted in the report");
+    return {sub, [args] {
+                std::vector<json> runs;
+                for (const std::string& path : args->inputs) runs.push_back(read_results(path));
+                write_file_atomically(args->output,
+                                      [&](std::ostream& out) { write_report(out, runs, args->title, args->command); });
+                std::cout << "report: " << args->output << " (" << runs.size() << " runs)\n";
+            }};
+}
+
+}  // namespace envmis::cli
