@@ -30,7 +30,8 @@ protected:
         for (const auto& [technique, ratio] : ratios)
             j["results"].push_back({{"bsdf", "lambert"}, {"technique", technique}, {"mean", 1.0}, {"reference", 1.0},
                                     {"variance", ratio}, {"std_error", 0.01}, {"rel_mse", 0.1}, {"ns_per_estimate", 100.0},
-                                    {"efficiency", 1e7 / ratio}, {"variance_ratio_vs_mis", ratio}, {"estimates", 256}});
+                                    {"efficiency", 1e7 / ratio}, {"variance_ratio_vs_mis", ratio}, {"estimates", 256},
+                                    {"point_variances", {ratio, ratio}}, {"point_variance_rel_se", {0.01, 0.01}}});
         const fs::path path = dir_ / (map + ".json");
         std::ofstream(path) << j.dump();
         return path;
@@ -58,15 +59,20 @@ protected:
 
 TEST_F(Report, SummarisesCasesWithGeometricMeansAndNamesTheBestMisTechnique) {
     const fs::path a = write_run("a", {{"mis-balance", 1}, {"bsdf", 0.01}, {"mis-optimal", 0.5}, {"mis-balance-comp", 0.8}});
-    const fs::path b = write_run("b", {{"mis-balance", 1}, {"bsdf", 0.01}, {"mis-optimal", 0.8}, {"mis-balance-comp", 0.2}});
+    const fs::path b = write_run(
+        "b", {{"mis-balance", 1}, {"bsdf", 0.01}, {"mis-optimal", 0.8}, {"mis-balance-comp", 0.2}, {"mis-optimal-comp", 0.3}});
     ASSERT_EQ(run(a.string() + " " + b.string() + " -o " + (dir_ / "r.md").string() + " --command 'bash x.sh'"), 0);
     const std::string md = read(dir_ / "r.md");
     EXPECT_NE(md.find("Made by `bash x.sh`"), std::string::npos);
     EXPECT_NE(md.find("| a | lambert | 0.010 | 0.500 | 0.800 |"), std::string::npos) << md;
     // sqrt(0.5 * 0.8) = 0.632, sqrt(0.8 * 0.2) = 0.4: compensation wins; bsdf is not a candidate.
-    EXPECT_NE(md.find("| **geometric mean** | | **0.010** | **0.632** | **0.400** |"), std::string::npos) << md;
+    // mis-optimal-comp, measured on one map only, is no candidate either.
+    EXPECT_NE(md.find("| **geometric mean** | | **0.010** | **0.632** | **0.400** | **0.300** |"), std::string::npos) << md;
     EXPECT_NE(md.find("`mis-balance-comp`, 2.50x lower variance than balance MIS"), std::string::npos) << md;
-    EXPECT_NE(md.find("| a | lambert | mis-optimal | mis-balance | 0.500 |"), std::string::npos) << md;
+    // Paired per point: log standard error sqrt(2 (0.01^2 + 0.01^2)) / 2 = 0.01.
+    EXPECT_NE(md.find("| a | lambert | mis-optimal | mis-balance | 0.500 | 0.010 | yes |"), std::string::npos) << md;
+    EXPECT_NE(md.find("| b | lambert | mis-optimal-comp | mis-balance-comp | 1.500 | 0.010 | **no** |"), std::string::npos) << md;
+    EXPECT_NE(md.find("within error in 2 of 3 cases"), std::string::npos) << md;
     EXPECT_NE(md.find("## a (8x4)"), std::string::npos);
 }
 

@@ -10,12 +10,27 @@
 namespace envmis {
 namespace {
 
+// Interleaved batches per cell: the spread of their variances is the noise of the
+// cell's variance estimate, whatever the estimates' distribution.
+constexpr uint32_t kBatches = 8;
+
 // What one (point, BSDF, technique) cell of the study measured.
 struct Cell {
     RunningStats estimates, squared_relative_error;
+    RunningStats batches[kBatches];
     double seconds = 0;
     bool ill_conditioned = false;  // optimal MIS ended on balance weights
 };
+
+double square(double x) { return x * x; }
+
+// Standard error of a cell's variance estimate relative to it, from its batches.
+double relative_standard_error(const Cell& c) {
+    RunningStats variances;
+    for (const RunningStats& b : c.batches) variances.add(b.variance());
+    const double v = c.estimates.variance();
+    return v > 0 ? variances.standard_error() / v : 0.0;
+}
 
 }  // namespace
 
@@ -89,6 +104,7 @@ Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<con
                 for (uint32_t i = 0; i < options.spp; ++i) {
                     const double x = luminance(estimators[t].estimate(point, options.bsdfs[b], rng, state), luma);
                     cell.estimates.add(x);
+                    cell.batches[i % kBatches].add(x);
                     if (reference > 0) cell.squared_relative_error.add((x - reference) * (x - reference) / (reference * reference));
                 }
                 cell.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -113,7 +129,7 @@ Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<con
         for (size_t t = 0; t < nt; ++t) {
             TechniqueStats s{options.techniques[t]};
             RunningStats rel;
-            double seconds = 0, variance_sum = 0, log_ratio = 0;
+            double seconds = 0, variance_sum = 0, log_ratio = 0, log_ratio_se2 = 0;
             size_t ratios = 0;
             for (size_t p = 0; p < done; ++p) {
                 const Cell& c = cells[(p * nb + b) * nt + t];
@@ -125,16 +141,23 @@ Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<con
                 seconds += c.seconds;
                 s.estimates += c.estimates.count();
                 s.ill_conditioned_points += c.ill_conditioned;
-                if (mis_index < nt) {
-                    const double v = c.estimates.variance(), v_mis = cells[(p * nb + b) * nt + mis_index].estimates.variance();
-                    if (v > 0 && v_mis > 0) log_ratio += std::log(v / v_mis), ++ratios;
+                s.point_variances.push_back(c.estimates.variance());
+                s.point_variance_rel_se.push_back(relative_standard_error(c));
+                if (mis_index < nt && t != mis_index) {
+                    const Cell& mis = cells[(p * nb + b) * nt + mis_index];
+                    const double v = c.estimates.variance(), v_mis = mis.estimates.variance();
+                    if (v > 0 && v_mis > 0) {
+                        log_ratio += std::log(v / v_mis), ++ratios;
+                        log_ratio_se2 += square(relative_standard_error(c)) + square(relative_standard_error(mis));
+                    }
                 }
             }
             s.std_error = std::sqrt(variance_sum) / done;
             s.rel_mse = rel.mean();
             s.ns_per_estimate = 1e9 * seconds / static_cast<double>(s.estimates);
             s.efficiency = s.variance > 0 ? 1 / (s.variance * seconds / static_cast<double>(s.estimates)) : 0;
-            s.variance_ratio_vs_mis = ratios ? std::exp(log_ratio / ratios) : 0;
+            s.variance_ratio_vs_mis = t == mis_index ? 1.0 : (ratios ? std::exp(log_ratio / ratios) : 0);
+            s.variance_ratio_log_std_error = ratios ? std::sqrt(log_ratio_se2) / static_cast<double>(ratios) : 0;
             bc.techniques.push_back(s);
         }
         result.bsdfs.push_back(std::move(bc));

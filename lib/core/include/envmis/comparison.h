@@ -11,6 +11,9 @@
 //   efficiency                  1 / (variance * seconds per estimate)
 //   variance_ratio_vs_mis       geometric mean over points of variance / variance of
 //                               mis-balance (each point counts equally, bright or dim)
+//   variance_ratio_log_std_error  standard error of log(variance_ratio_vs_mis): the
+//                               noise of each point's variance estimate, measured as
+//                               the spread of the variances of 8 interleaved batches
 //
 // Determinism: every (point, BSDF, technique) draws from its own PCG32 stream derived
 // from the seed, so the estimates do not depend on the number of threads.
@@ -47,9 +50,12 @@ struct TechniqueStats {
     double mean = 0, reference = 0, variance = 0, std_error = 0, rel_mse = 0;
     double ns_per_estimate = 0, efficiency = 0, variance_ratio_vs_mis = 0;
     uint64_t estimates = 0;
+    double variance_ratio_log_std_error = 0;
     // Optimal MIS: points whose linear system stayed singular, so that their estimates
     // kept the balance heuristic's weights.
     uint32_t ill_conditioned_points = 0;
+    // Per point, in order: the variance of one estimate and its relative standard error.
+    std::vector<double> point_variances, point_variance_rel_se;
 };
 
 struct BsdfComparison {
