@@ -44,7 +44,15 @@ const char* heuristic_name(Heuristic h) noexcept {
 // Relearns what the adaptive techniques use from everything the point has seen.
 void update(PointState& s, Heuristic h, int m) noexcept {
     if (h == Heuristic::optimal) {
-        const OptimalAlpha solved = solve_optimal_alpha(s.a, s.b, m);
+        // A ridge of 1% of the diagonal: the plain and compensated densities are nearly
+        // collinear control variates, and coefficients learnt from noisy sums swing along
+        // that direction. Any alpha keeps the estimate unbiased; the ridge trades a little
+        // of the exact optimum for much less noise (measured on studio.exr, phong:50,
+        // mis-optimal-all: 1.27 -> 0.94 of balance MIS's variance; Lambert gains kept).
+        constexpr double kRidge = 0.01;
+        double a[kMaxTechniques * kMaxTechniques];
+        for (int i = 0; i < m * m; ++i) a[i] = s.a[i] * (i % (m + 1) == 0 ? 1 + kRidge : 1);
+        const OptimalAlpha solved = solve_optimal_alpha(a, s.b, m);
         s.optimal = solved;  // alpha = 0 (balance) when unsolved
         s.ill_conditioned += !solved.solved;
         return;
