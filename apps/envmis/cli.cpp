@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -15,8 +16,26 @@ namespace envmis::cli {
 
 void add_map_flags(CLI::App& app, MapFlags& flags) {
     app.add_flag("--no-compensate", flags.no_compensate, "Sample proportionally to luminance (no MIS compensation)");
-    app.add_option("--alpha", flags.alpha, "Compensation strength: q = max(L - alpha * mean(L), 0)")
-        ->check(CLI::NonNegativeNumber);
+    const CLI::Validator alpha_value(
+        [](std::string& text) -> std::string {
+            if (text == "auto") return {};
+            char* end = nullptr;
+            const float alpha = std::strtof(text.c_str(), &end);
+            if (end != text.c_str() && *end == '\0' && alpha >= 0 && std::isfinite(alpha)) return {};
+            return "'" + text + "': expected a number >= 0 or auto";
+        },
+        "");
+    app.add_option_function<std::string>(
+           "--alpha",
+           [&flags](const std::string& text) {
+               flags.alpha_auto = text == "auto";
+               if (!flags.alpha_auto) flags.alpha = std::strtof(text.c_str(), nullptr);
+           },
+           "Compensation strength: q = max(L - alpha * mean(L), 0); auto: the candidate with the lowest exact MIS "
+           "variance (alpha.h; compare chooses per BSDF)")
+        ->type_name("ALPHA|auto")
+        ->default_str("1")
+        ->check(alpha_value);
     app.add_option("--colorspace", flags.colorspace, "Input colour space (default: from the file's metadata)");
     app.add_option("--working-space", flags.working_space, "Linear working colour space, e.g. lin_rec709 or ACEScg")
         ->capture_default_str();
@@ -64,6 +83,10 @@ LoadedMap load_map(const std::string& path, const MapFlags& flags) {
     options.compensation = {!flags.no_compensate, flags.alpha};
     options.luma = image.luma;
     options.axes = Axes::parse(flags.axes);
+    if (flags.alpha_auto && !flags.no_compensate) {
+        loaded.alpha_choice = choose_alpha(image.image, options);
+        options.compensation.alpha = loaded.alpha_choice->alpha;
+    }
     const auto build_start = std::chrono::steady_clock::now();
     loaded.map = EnvMap(std::move(image.image), options);
     loaded.build_ms = milliseconds_since(build_start);
@@ -97,6 +120,10 @@ void print_summary(std::ostream& out, const LoadedMap& loaded) {
             << s.zeroed_texels << " texels with radiance (" << 100.0 * s.zeroed_texels / texels << "%)\n";
     else
         out << "  compensation  off\n";
+    if (const auto& c = loaded.alpha_choice)
+        out << "  alpha auto    " << c->alpha << " of " << c->candidates.size()
+            << " candidates, by the exact variance of mis-balance-comp over mis-balance on a " << c->width << "x"
+            << c->height << " copy (" << std::setprecision(3) << 1e3 * c->seconds << std::setprecision(4) << " ms)\n";
     out << "  bad pixels    " << s.bad_pixels.nan << " NaN, " << s.bad_pixels.infinite << " Inf, " << s.bad_pixels.negative
         << " negative channel values (replaced by 0)\n";
     out << "  fallback      " << to_string(s.fallback) << "\n";

@@ -6,11 +6,13 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <ostream>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
+#include "envmis/alpha.h"
 #include "envmis/envmap.h"
 #include "envmis/table.h"
 
@@ -20,6 +22,7 @@ namespace envmis::cli {
 struct MapFlags {
     bool no_compensate = false;
     float alpha = 1.0f;
+    bool alpha_auto = false;  // --alpha auto: choose_alpha() (alpha.h) picks it, map-wide
     std::string colorspace;                 // input colour space; empty: from the file
     std::string working_space = "lin_rec709";
     std::string axes = "z-up";
@@ -34,6 +37,7 @@ struct LoadedMap {
     std::string format;  // "envmis table", "openexr", "hdr", ...
     uint32_t channels = 3;
     double load_ms = 0, build_ms = 0;
+    std::optional<AlphaChoice> alpha_choice = {};  // with --alpha auto, for an image
 };
 
 // Reads a table (recognised by its magic) or loads an image and builds its map.

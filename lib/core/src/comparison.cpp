@@ -36,7 +36,8 @@ double relative_standard_error(const Cell& c) {
 
 std::vector<Technique> ComparisonOptions::default_techniques() {
     std::vector<Technique> t;
-    for (const char* name : {"env", "bsdf", "mis-balance", "mis-power", "mis-balance-comp", "mis-power-comp"})
+    for (const char* name : {"env", "bsdf", "mis-balance", "mis-power", "mis-balance-comp", "mis-power-comp",
+                             "mis-optimal-comp", "mis-optimal-all"})
         t.push_back(Technique::parse(name));
     return t;
 }
@@ -127,7 +128,8 @@ Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<con
     for (size_t b = 0; b < nb; ++b) {
         BsdfComparison bc{options.bsdfs[b], {}};
         for (size_t t = 0; t < nt; ++t) {
-            TechniqueStats s{options.techniques[t]};
+            TechniqueStats s;
+            s.technique = options.techniques[t];
             RunningStats rel;
             double seconds = 0, variance_sum = 0, log_ratio = 0, log_ratio_se2 = 0;
             size_t ratios = 0;
