@@ -1,7 +1,8 @@
 // envmis report RESULTS.json... -o OUT.md: one Markdown report from the JSON files of
-// several `envmis compare` runs (one per map): a summary of every technique's variance
-// relative to balance MIS per (map, BSDF) case, its geometric mean over all cases, the
-// technique that gains most, and each run's full table.
+// `envmis compare` runs: a summary of every technique's variance relative to balance
+// MIS per (map, BSDF) case, its geometric mean over all cases, the technique that gains
+// most, optimal against balance weights, the compensation-strength and allocation
+// sweeps, links to the plots, and each run's full table.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -30,7 +31,8 @@ json read_results(const std::string& path) {
     } catch (const json::exception& e) {
         throw std::runtime_error(path + ": not JSON (" + e.what() + ")");
     }
-    if (!j.contains("inputs") || !j.contains("results") || !j["results"].is_array())
+    const bool measured = (j.contains("results") && j["results"].is_array()) || j.contains("sweep") || j.contains("allocation");
+    if (!j.contains("inputs") || !measured)
         throw std::runtime_error(path + ": not the JSON of envmis compare (no inputs and results)");
     return j;
 }
@@ -67,16 +69,86 @@ std::optional<std::pair<double, double>> paired_ratio(const Case& c, const std::
     return std::pair{std::exp(log_sum / n), std::sqrt(se2) / n};
 }
 
-void write_report(std::ostream& out, const std::vector<json>& runs, const std::string& title, const std::string& command) {
+// The name of a run's map without its extension: the folder of its plots.
+std::string stem(const json& run) {
+    const std::string map = run["inputs"].value("map", "map");
+    return map.substr(0, map.rfind('.'));
+}
+
+// Compensation strength: for every (map, BSDF), the best alpha of the sweep, the
+// automatic choice, and how their variances compare.
+void write_strength(std::ostream& out, const std::vector<json>& runs) {
+    size_t within = 0, total = 0, never_worse = 0;
+    bool header = false;
+    for (const json& run : runs) {
+        if (!run.contains("sweep_best")) continue;
+        if (!header) {
+            out << "## Compensation strength: `--alpha auto` against the sweep\n\n"
+                << "Variance of mis-balance-comp relative to mis-balance at each alpha of the sweep (exact, by quadrature, "
+                   "when the sweep ran with `--exact`); auto's choice (exact variances on a 128-wide copy of the map) "
+                   "against the sweep's best alpha and against alpha = 0 (no compensation).\n\n"
+                << "| map | bsdf | best alpha | best ratio | auto alpha | auto / best | auto / alpha 0 |\n"
+                << "|---|---|---:|---:|---:|---:|---:|\n";
+            header = true;
+        }
+        for (const json& b : run["sweep_best"]) {
+            if (!b.contains("auto_alpha")) continue;
+            const double vs_best = b["auto_vs_best"], vs_zero = b["auto_vs_alpha0"];
+            within += vs_best <= 1.05, never_worse += vs_zero <= 1.05, ++total;
+            out << "| " << run["inputs"].value("map", "?") << " | " << b["bsdf"].get<std::string>() << " | "
+                << number(b["best_alpha"], "%.3g") << " | " << number(b["best_ratio"], "%.3f") << " | "
+                << number(b["auto_alpha"], "%.3g") << " | " << number(vs_best, "%.3f") << " | " << number(vs_zero, "%.3f")
+                << " |\n";
+        }
+    }
+    if (total)
+        out << "\nAuto is within 5% of the best alpha in " << within << " of " << total
+            << " cases and at most 5% worse than alpha = 0 in " << never_worse << " of " << total << ".\n\n";
+}
+
+// Sample allocation: the most efficient n_env:n_bsdf split per (map, BSDF, technique).
+void write_allocation(std::ostream& out, const std::vector<json>& runs) {
+    bool header = false;
+    for (const json& run : runs) {
+        if (!run.contains("allocation")) continue;
+        if (!header) {
+            out << "## Sample allocation\n\n"
+                << "For a fixed number of samples per estimate, every split between environment and BSDF samples; "
+                   "efficiency = 1 / (variance x time per estimate). The best split, and its efficiency relative to the "
+                   "even (or nearest to even) split.\n\n"
+                << "| map | bsdf | technique | best env:bsdf | efficiency | vs even split |\n|---|---|---|---:|---:|---:|\n";
+            header = true;
+        }
+        std::map<std::pair<std::string, std::string>, std::vector<const json*>> groups;
+        for (const json& a : run["allocation"]) groups[{a["bsdf"], a["technique"]}].push_back(&a);
+        for (const auto& [key, rows] : groups) {
+            const json* best = nullptr;
+            const json* even = nullptr;
+            for (const json* r : rows) {
+                if (!best || (*r)["efficiency"].get<double>() > (*best)["efficiency"].get<double>()) best = r;
+                const int gap = std::abs((*r)["env_samples"].get<int>() - (*r)["bsdf_samples"].get<int>());
+                if (!even || gap < std::abs((*even)["env_samples"].get<int>() - (*even)["bsdf_samples"].get<int>())) even = r;
+            }
+            out << "| " << run["inputs"].value("map", "?") << " | " << key.first << " | " << key.second << " | "
+                << (*best)["env_samples"].get<int>() << ":" << (*best)["bsdf_samples"].get<int>() << " | "
+                << number((*best)["efficiency"]) << " | "
+                << number((*best)["efficiency"].get<double>() / (*even)["efficiency"].get<double>(), "%.2f") << "x |\n";
+        }
+    }
+    if (header) out << "\n";
+}
+
+void write_report(std::ostream& out, const std::vector<json>& runs, const std::string& title, const std::string& command,
+                  const std::string& plots) {
     std::vector<std::string> techniques;  // in the order of the first run that has them
     std::vector<Case> cases;
     for (const json& run : runs) {
         const std::string map = run["inputs"].value("map", "?");
-        for (const json& r : run["results"]) {
+        for (const json& r : run.value("results", json::array())) {
             const std::string bsdf = r["bsdf"], technique = r["technique"];
             if (std::find(techniques.begin(), techniques.end(), technique) == techniques.end()) techniques.push_back(technique);
             auto it = std::find_if(cases.begin(), cases.end(), [&](const Case& c) { return c.map == map && c.bsdf == bsdf; });
-            if (it == cases.end()) it = cases.insert(cases.end(), Case{map, bsdf, {}});
+            if (it == cases.end()) it = cases.insert(cases.end(), Case{map, bsdf, {}, {}});
             it->ratio[technique] = r["variance_ratio_vs_mis"];
             if (r.contains("point_variances") && r.contains("point_variance_rel_se"))
                 it->points[technique] = {r["point_variances"].get<std::vector<double>>(),
@@ -87,7 +159,8 @@ void write_report(std::ostream& out, const std::vector<json>& runs, const std::s
 
     out << "# " << title << "\n\n";
     if (!command.empty()) out << "Made by `" << command << "`.\n\n";
-    const json& first = runs.front()["inputs"];
+    const auto with_results = std::find_if(runs.begin(), runs.end(), [](const json& r) { return r.contains("results"); });
+    const json& first = (with_results != runs.end() ? *with_results : runs.front())["inputs"];
     out << "Every technique spends the same number of samples per estimate (" << first.value("env_samples", 1) << " environment + "
         << first.value("bsdf_samples", 1) << " BSDF for MIS). Figures are variances of one estimate relative to balance "
         << "MIS over the plain density (`mis-balance`), as the geometric mean over " << first.value("points_done", 0)
@@ -157,7 +230,24 @@ void write_report(std::ostream& out, const std::vector<json>& runs, const std::s
         out << "\nOptimal MIS is at most balance MIS within error in " << cases_within << " of " << cases_total
             << " cases.\n\n";
 
+    write_strength(out, runs);
+    write_allocation(out, runs);
+    if (!plots.empty()) {
+        out << "## Plots\n\n";
+        std::vector<std::string> seen;
+        for (const json& run : runs) {
+            const std::string name = stem(run);
+            if (std::find(seen.begin(), seen.end(), name) != seen.end()) continue;
+            seen.push_back(name);
+            out << "### " << run["inputs"].value("map", "?") << "\n\n";
+            for (const char* plot : {"variance_vs_balance", "alpha_sweep", "allocation"})
+                out << "![" << name << " " << plot << "](" << plots << "/" << name << "/" << plot << ".png)\n";
+            out << "\n";
+        }
+    }
+
     for (const json& run : runs) {
+        if (!run.contains("results")) continue;
         const json& in = run["inputs"];
         out << "## " << in.value("map", "?") << " (" << in.value("width", 0) << "x" << in.value("height", 0) << "), alpha "
             << number(in.value("alpha", 1.0), "%.3g") << "\n\n"
@@ -178,7 +268,7 @@ void write_report(std::ostream& out, const std::vector<json>& runs, const std::s
 Subcommand add_report(CLI::App& app) {
     struct Args {
         std::vector<std::string> inputs;
-        std::string output, title = "envmis results", command;
+        std::string output, title = "envmis results", command, plots;
     };
     auto args = std::make_shared<Args>();
     CLI::App* sub = app.add_subcommand("report", "Markdown report from the JSON of envmis compare runs (one per map)");
@@ -186,11 +276,13 @@ Subcommand add_report(CLI::App& app) {
     sub->add_option("-o,--output", args->output, "Markdown file to write")->required();
     sub->add_option("--title", args->title, "Title of the report")->capture_default_str();
     sub->add_option("--command", args->command, "The command that made the results, quoted in the report");
+    sub->add_option("--plots", args->plots,
+                    "Folder, relative to the report, holding each map's plots (MAP/variance_vs_balance.png, ...)");
     return {sub, [args] {
                 std::vector<json> runs;
                 for (const std::string& path : args->inputs) runs.push_back(read_results(path));
                 write_file_atomically(args->output,
-                                      [&](std::ostream& out) { write_report(out, runs, args->title, args->command); });
+                                      [&](std::ostream& out) { write_report(out, runs, args->title, args->command, args->plots); });
                 std::cout << "report: " << args->output << " (" << runs.size() << " runs)\n";
             }};
 }
