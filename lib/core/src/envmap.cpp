@@ -7,6 +7,10 @@
 #include <stdexcept>
 #include <string>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "parallel.h"
 
 namespace envmis {
@@ -23,7 +27,8 @@ std::string_view to_string(DensityFallback f) noexcept {
 namespace {
 
 constexpr size_t kMaxTexels = size_t{1} << 31;
-constexpr uint32_t kRowsPerThread = 8;
+// Rows per task of the parallel passes.
+constexpr uint32_t kRowsPerChunk = 8;
 
 void check_image(const RgbImage& image) {
     const size_t n = size_t{image.width} * image.height;
@@ -61,63 +66,113 @@ struct RowStats {
     uint64_t zeroed = 0;
 };
 
-// Pass 1: repairs a row's pixels and sums its luminance. Luminance is linear, so the
-// row sum is the luma-weighted sum of the channel sums: one flat loop over 3w floats in
-// twelve float lanes (four pixels) that the compiler vectorises, flushed into doubles
-// every 64 pixels so that long rows lose no precision.
-void scan_row(Rgb* pixels, uint32_t w, const LumaCoefficients& luma, RowStats& r) noexcept {
-    // A channel is clean when its bits, read as an unsigned integer, lie below those of
-    // +Inf: that excludes negative values (sign bit), Inf and NaN in one comparison.
-    const auto* bits = reinterpret_cast<const uint32_t*>(&pixels[0].r);
-    uint32_t highest = 0;
-    for (uint32_t i = 0; i < 3 * w; ++i) highest = std::max(highest, bits[i]);
-    if (highest >= 0x7f800000u)
-        for (uint32_t x = 0; x < w; ++x) sanitize_pixel(pixels[x], r.bad);
-
-    constexpr uint32_t kLanes = 12, kFlush = 64 * 3;
-    const float* channels = &pixels[0].r;
-    const uint32_t n = 3 * w;
+// Pass 1 over a row, reading its pixels once: the row sum of luminance, and each
+// texel's luminance, as float bits into `bits` (the memory pass 2 reads it from), with
+// its extremes (exact in any order: luminance is never NaN). Returns false, with nothing
+// usable computed, if a channel is negative, NaN or infinite: the caller repairs the row
+// and scans it again.
+//
+// Luminance is linear, so the row sum is the luma-weighted sum of the channel sums,
+// accumulated in twelve float lanes (the channels of four pixels) flushed into doubles
+// every 64 pixels so that long rows lose no precision. A channel is clean when its bits,
+// read as an unsigned integer, lie below those of +Inf: that excludes negative values
+// (sign bit), Inf and NaN; exactly then neither b nor 0x7f7fffff - b has the top bit
+// set, so ORs of both test every channel. With SSE2 four pixels go at a time, shuffles
+// turning their twelve interleaved channels into a vector per channel (which the
+// compiler does not do by itself); otherwise, and for the last pixels, `take` does the
+// same operations one pixel at a time.
+bool scan_row(const Rgb* pixels, uint32_t w, const LumaCoefficients& luma, uint32_t* bits, RowStats& r) noexcept {
+    constexpr uint32_t kLanes = 12, kGroupsPerFlush = 16;
+    constexpr float kInf = std::numeric_limits<float>::infinity();
     float lane[kLanes] = {};
     double channel_sum[3] = {0, 0, 0};
     auto flush = [&] {
         for (uint32_t j = 0; j < kLanes; ++j) channel_sum[j % 3] += lane[j], lane[j] = 0;
     };
-    uint32_t i = 0;
-    for (; i + kLanes <= n; i += kLanes) {
-        for (uint32_t j = 0; j < kLanes; ++j) lane[j] += channels[i + j];
-        if ((i + kLanes) % kFlush == 0) flush();
+    uint32_t dirty = 0;
+    float high = 0, low = kInf;  // low: the smallest positive luminance
+    auto take = [&](uint32_t x, uint32_t first_lane) {
+        const float channel[3] = {pixels[x].r, pixels[x].g, pixels[x].b};
+        for (uint32_t c = 0; c < 3; ++c) {
+            lane[first_lane + c] += channel[c];
+            const auto b = std::bit_cast<uint32_t>(channel[c]);
+            dirty |= b | (0x7f7fffffu - b);
+        }
+        const float l = texel_luminance(pixels[x], luma);
+        bits[x] = std::bit_cast<uint32_t>(l);
+        high = std::max(high, l);
+        low = std::min(low, l > 0 ? l : kInf);
+    };
+    uint32_t x = 0;
+#if defined(__SSE2__)
+    const __m128 kr = _mm_set1_ps(luma.r), kg = _mm_set1_ps(luma.g), kb = _mm_set1_ps(luma.b);
+    const __m128 top = _mm_set1_ps(std::numeric_limits<float>::max()), zero = _mm_setzero_ps(), inf = _mm_set1_ps(kInf);
+    const __m128i clean_limit = _mm_set1_epi32(0x7f7fffff);
+    __m128 lanes[3] = {zero, zero, zero}, highs = zero, lows = inf;
+    __m128i dirt = _mm_setzero_si128();
+    for (uint32_t group = 1; x + 4 <= w; x += 4, ++group) {
+        const float* c = &pixels[x].r;
+        const __m128 v[3] = {_mm_loadu_ps(c), _mm_loadu_ps(c + 4), _mm_loadu_ps(c + 8)};  // r0g0b0r1 g1b1r2g2 b2r3g3b3
+        for (uint32_t k = 0; k < 3; ++k) {
+            lanes[k] = _mm_add_ps(lanes[k], v[k]);
+            const __m128i b = _mm_castps_si128(v[k]);
+            dirt = _mm_or_si128(dirt, _mm_or_si128(b, _mm_sub_epi32(clean_limit, b)));
+        }
+        if (group % kGroupsPerFlush == 0) {
+            for (uint32_t k = 0; k < 3; ++k) _mm_storeu_ps(lane + 4 * k, lanes[k]), lanes[k] = zero;
+            flush();
+        }
+        const __m128 rg = _mm_shuffle_ps(v[1], v[2], _MM_SHUFFLE(2, 1, 3, 2));  // r2 g2 r3 g3
+        const __m128 gb = _mm_shuffle_ps(v[0], v[1], _MM_SHUFFLE(1, 0, 2, 1));  // g0 b0 g1 b1
+        const __m128 red = _mm_shuffle_ps(v[0], rg, _MM_SHUFFLE(2, 0, 3, 0));
+        const __m128 green = _mm_shuffle_ps(gb, rg, _MM_SHUFFLE(3, 1, 2, 0));
+        const __m128 blue = _mm_shuffle_ps(gb, v[2], _MM_SHUFFLE(3, 0, 3, 1));
+        // min(top, l) and max(l, high) pick as std::min(l, top) and std::max(high, l) do.
+        const __m128 l =
+            _mm_min_ps(top, _mm_add_ps(_mm_add_ps(_mm_mul_ps(kr, red), _mm_mul_ps(kg, green)), _mm_mul_ps(kb, blue)));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(bits + x), _mm_castps_si128(l));
+        highs = _mm_max_ps(l, highs);
+        const __m128 positive = _mm_cmpgt_ps(l, zero);
+        lows = _mm_min_ps(_mm_or_ps(_mm_and_ps(positive, l), _mm_andnot_ps(positive, inf)), lows);
     }
-    for (; i < n; ++i) lane[i % 3] += channels[i];
+    for (uint32_t k = 0; k < 3; ++k) _mm_storeu_ps(lane + 4 * k, lanes[k]);
+    float lane_high[4], lane_low[4];
+    uint32_t lane_dirt[4];
+    _mm_storeu_ps(lane_high, highs);
+    _mm_storeu_ps(lane_low, lows);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(lane_dirt), dirt);
+    for (uint32_t j = 0; j < 4; ++j)
+        high = std::max(high, lane_high[j]), low = std::min(low, lane_low[j]), dirty |= lane_dirt[j];
+#else
+    for (uint32_t group = 1; x + 4 <= w; x += 4, ++group) {
+        for (uint32_t p = 0; p < 4; ++p) take(x + p, 3 * p);
+        if (group % kGroupsPerFlush == 0) flush();
+    }
+#endif
+    for (; x < w; ++x) take(x, 0);
     flush();
     r.sum = luma.r * channel_sum[0] + luma.g * channel_sum[1] + luma.b * channel_sum[2];
+    r.max = high;
+    r.min_positive = low;
+    return !(dirty >> 31);
 }
 
-// Pass 2: row y of the density q sin(theta_y), and its luminance statistics. Luminance
-// goes into `row` first and is transformed in place, in three loops simple enough to
-// vectorise. The statistics read the float bits as integers: for non-negative floats
-// their order is the values' order, and integer min/max reduce in any order.
-void density_row(const Rgb* pixels, uint32_t w, float sin_theta, const LumaCoefficients& luma, float threshold,
-                 bool uniform, std::span<float> row, RowStats& r) noexcept {
-    for (uint32_t x = 0; x < w; ++x) row[x] = texel_luminance(pixels[x], luma);
-    const auto* bits = reinterpret_cast<const int32_t*>(row.data());
-    constexpr int32_t kNone = 0x7fffffff;
-    int32_t max_bits = 0, min_bits_minus_one = kNone;  // 0 - 1 wraps to kNone, so zeros drop out
+// Pass 2: row y of the density q sin(theta_y) from its luminance bits; returns the
+// number of texels with L > 0 that compensation zeroes.
+uint32_t density_row(const uint32_t* luminance, uint32_t w, float sin_theta, float threshold, bool uniform,
+                     float* row) noexcept {
+    if (uniform) {
+        std::fill_n(row, w, sin_theta);
+        return 0;
+    }
     uint32_t zeroed = 0;
     for (uint32_t x = 0; x < w; ++x) {
-        max_bits = std::max(max_bits, bits[x]);
-        min_bits_minus_one = std::min(min_bits_minus_one, (bits[x] - 1) & kNone);
-        zeroed += (bits[x] > 0) & (row[x] <= threshold);
+        const auto l = std::bit_cast<float>(luminance[x]);
+        zeroed += (static_cast<int32_t>(luminance[x]) > 0) & (l <= threshold);
+        // max(L - t, 0) is compensate(L, t): for L > t the difference of two floats is > 0.
+        row[x] = std::max(l - threshold, 0.0f) * sin_theta;
     }
-    r.max = std::bit_cast<float>(max_bits);
-    r.min_positive = min_bits_minus_one == kNone ? std::numeric_limits<float>::infinity()
-                                                 : std::bit_cast<float>(min_bits_minus_one + 1);
-    r.zeroed = uniform ? 0 : zeroed;
-    if (uniform) {
-        std::fill(row.begin(), row.end(), sin_theta);
-        return;
-    }
-    // max(L - t, 0) is compensate(L, t): for L > t the difference of two floats is > 0.
-    for (uint32_t x = 0; x < w; ++x) row[x] = std::max(row[x] - threshold, 0.0f) * sin_theta;
+    return zeroed;
 }
 
 }  // namespace
@@ -128,13 +183,24 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : radiance_(std::mo
     const uint32_t w = radiance_.width, h = radiance_.height;
     Rgb* pixels = radiance_.pixels.data();
 
-    // Pass 1 gives Lbar; pass 2, the distribution's build, recomputes luminance rather
-    // than holding it: reading the pixels again is cheaper than writing and reading
-    // another w x h buffer.
+    // Pass 1 gives Lbar, and keeps each texel's luminance in the memory that the start
+    // table will occupy: pass 2 then reads 4 bytes a texel instead of the 12 of RGB.
     std::vector<RowStats> rows(h);
-    detail::parallel_for(h, kRowsPerThread, [&](uint32_t lo, uint32_t hi) {
-        for (uint32_t y = lo; y < hi; ++y) scan_row(pixels + size_t{y} * w, w, options_.luma, rows[y]);
-    });
+    auto luminance = [&] {
+        LargeVector<uint32_t> bits(size_t{w} * h);
+        detail::parallel_for(h, kRowsPerChunk, [&](uint32_t lo, uint32_t hi) {
+            for (uint32_t y = lo; y < hi; ++y) {
+                const size_t offset = size_t{y} * w;
+                Rgb* row = pixels + offset;
+                if (!scan_row(row, w, options_.luma, bits.data() + offset, rows[y])) {
+                    for (uint32_t x = 0; x < w; ++x) sanitize_pixel(row[x], rows[y].bad);
+                    scan_row(row, w, options_.luma, bits.data() + offset, rows[y]);
+                }
+            }
+        });
+        return bits;
+    };
+    LargeVector<uint32_t> luminance_bits = luminance();
     std::vector<double> row_sums(h);
     for (uint32_t y = 0; y < h; ++y) {
         row_sums[y] = rows[y].sum;
@@ -143,21 +209,19 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : radiance_(std::mo
     stats_.mean_luminance = solid_angle_mean_of_rows(row_sums, w);
 
     // A black map is sampled uniformly; a map that compensation zeroes whole (a constant
-    // one) is rebuilt without compensation.
+    // one) is rebuilt without compensation, from its luminance computed again.
     if (!(stats_.mean_luminance > 0)) stats_.fallback = DensityFallback::uniform;
     if (options_.compensation.enabled && stats_.fallback == DensityFallback::none)
         stats_.threshold = compensation_threshold(stats_.mean_luminance, options_.compensation.alpha);
-    auto build = [&] {
-        distribution_ = Distribution2D(w, h, [&](uint32_t y, std::span<float> row) {
-            density_row(pixels + size_t{y} * w, w, row_sin_theta(y, h), options_.luma, stats_.threshold,
-                        stats_.fallback == DensityFallback::uniform, row, rows[y]);
-        });
+    const auto density = [&](uint32_t y, std::span<const uint32_t> cells, std::span<float> row) {
+        rows[y].zeroed = density_row(cells.data(), w, row_sin_theta(y, h), stats_.threshold,
+                                     stats_.fallback == DensityFallback::uniform, row.data());
     };
-    build();
+    distribution_ = Distribution2D(w, h, std::move(luminance_bits), density);
     if (stats_.threshold > 0 && distribution_.uniform_fallback()) {
         stats_.fallback = DensityFallback::uncompensated;
         stats_.threshold = 0;
-        build();
+        distribution_ = Distribution2D(w, h, luminance(), density);
     }
     float min_positive = std::numeric_limits<float>::infinity();
     for (const RowStats& r : rows) {
@@ -187,10 +251,13 @@ EnvMap::EnvMap(RgbImage radiance, std::span<const float> density, const EnvMapOp
 std::vector<float> EnvMap::density() const {
     const uint32_t w = width(), h = height();
     std::vector<float> out(size_t{w} * h);
+    std::vector<uint32_t> luminance(w);
     RowStats unused;
-    for (uint32_t y = 0; y < h; ++y)
-        density_row(radiance_.pixels.data() + size_t{y} * w, w, row_sin_theta(y, h), options_.luma, stats_.threshold,
-                    stats_.fallback == DensityFallback::uniform, std::span(out).subspan(size_t{y} * w, w), unused);
+    for (uint32_t y = 0; y < h; ++y) {
+        scan_row(radiance_.pixels.data() + size_t{y} * w, w, options_.luma, luminance.data(), unused);
+        density_row(luminance.data(), w, row_sin_theta(y, h), stats_.threshold,
+                    stats_.fallback == DensityFallback::uniform, out.data() + size_t{y} * w);
+    }
     return out;
 }
 

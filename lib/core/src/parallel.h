@@ -4,29 +4,37 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <thread>
 #include <vector>
 
 namespace envmis::detail {
 
-// Calls fn(lo, hi) on disjoint chunks covering [0, n). Small ranges run inline.
+// Calls fn(lo, hi) on disjoint chunks of `chunk` indices (the last one shorter)
+// covering [0, n). Threads take the next chunk as they finish one, so that ranges whose
+// indices cost unevenly (a sky's bright and black rows) still keep every core busy to
+// the end. A range of one chunk runs inline.
 template <class Fn>
-void parallel_for(uint32_t n, uint32_t min_per_thread, Fn&& fn) {
-    const uint32_t cores = std::max(1u, std::thread::hardware_concurrency());
-    const uint32_t threads = std::min(cores, std::max(1u, n / std::max(1u, min_per_thread)));
+void parallel_for(uint32_t n, uint32_t chunk, Fn&& fn) {
+    chunk = std::max(1u, chunk);
+    const uint32_t chunks = n / chunk + (n % chunk != 0);
+    const uint32_t threads = std::min(std::max(1u, std::thread::hardware_concurrency()), chunks);
     if (threads <= 1) {
         fn(0u, n);
         return;
     }
+    std::atomic<uint32_t> next{0};
+    auto work = [&] {
+        for (uint32_t c; (c = next.fetch_add(1, std::memory_order_relaxed)) < chunks;) {
+            const uint32_t lo = c * chunk;
+            fn(lo, lo + std::min(chunk, n - lo));
+        }
+    };
     std::vector<std::jthread> pool;
     pool.reserve(threads - 1);
-    const uint32_t chunk = (n + threads - 1) / threads;
-    for (uint32_t t = 1; t < threads; ++t) {
-        const uint32_t lo = std::min(n, t * chunk), hi = std::min(n, lo + chunk);
-        pool.emplace_back([&fn, lo, hi] { fn(lo, hi); });
-    }
-    fn(0u, std::min(n, chunk));
+    for (uint32_t t = 1; t < threads; ++t) pool.emplace_back(work);
+    work();
 }
 
 }  // namespace envmis::detail

@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <vector>
 
 #include "envmis/allocator.h"
 #include "envmis/math.h"
@@ -100,12 +101,32 @@ ENVMIS_HD inline float point_in_cell(uint32_t index, float offset, uint32_t n) n
     return clamp(x, 0.0f, kOneMinusEpsilon);
 }
 
+// The uniform CDF over n cells: what build_cdf gives a function without a positive value.
+struct UniformCdf {
+    std::vector<uint32_t> start;
+    std::vector<uint16_t> guide;
+
+    explicit UniformCdf(uint32_t n);
+};
+
+// Working memory of build_cdf for up to n cells, reusable from one call to the next.
+// `uniform`, when given (over the same n cells), is copied for a function without a
+// positive value rather than built again: the rows of a 2D distribution share one.
+struct CdfScratch {
+    std::vector<double> prefix;
+    std::vector<uint16_t> marks;
+    const UniformCdf* uniform = nullptr;
+
+    explicit CdfScratch(uint32_t n, const UniformCdf* shared_uniform = nullptr)
+        : prefix(n), marks(size_t{n} + 1), uniform(shared_uniform) {}
+};
+
 // Fills start and guide (n each) from func and returns the sum of func (double); adds
 // the number of negative, NaN or infinite values to `invalid` (the caller rejects them).
-// A zero function gets a uniform CDF. `scratch` is space for n doubles.
+// A zero function gets a uniform CDF.
 template <class T>
 double build_cdf(const T* func, uint32_t n, uint32_t* start, uint16_t* guide, uint32_t& invalid,
-                 double* scratch) noexcept;
+                 CdfScratch& scratch) noexcept;
 
 }  // namespace detail
 
@@ -204,6 +225,9 @@ public:
     // Fills `row` (w values) with the function on row y; called once per row, from
     // several threads at a time for different rows.
     using RowFunction = std::function<void(uint32_t y, std::span<float> row)>;
+    // The same from `cells`, row y of the values given to the constructor that takes
+    // them, read before the build overwrites them.
+    using CellRowFunction = std::function<void(uint32_t y, std::span<const uint32_t> cells, std::span<float> row)>;
 
     Distribution2D() = default;
     // Throws std::invalid_argument on a size mismatch, w or h outside [1, 65536], or a
@@ -213,6 +237,10 @@ public:
     Distribution2D(std::span<const float> func, uint32_t w, uint32_t h);
     // The same from a function evaluated row by row, never held whole in memory.
     Distribution2D(uint32_t w, uint32_t h, const RowFunction& rows);
+    // The same, building the start table in `cells` (w h values) and each row from its
+    // previous contents: a caller with per-cell data to derive the function from (EnvMap:
+    // luminance) needs no second w x h buffer.
+    Distribution2D(uint32_t w, uint32_t h, LargeVector<uint32_t> cells, const CellRowFunction& rows);
 
     Distribution2DView view() const noexcept {
         return {start_.data(), guide_.data(), {marginal_start_.data(), marginal_guide_.data(), h_}, w_, h_};
