@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "envmis/comparison.h"
 #include "envmis/estimator.h"
 #include "envmis/io/image_io.h"
 #include "envmis/quadrature.h"
@@ -87,11 +88,9 @@ TEST(Estimator, CompensationLowersLambertVarianceUnderASunnyMap) {
     const Maps maps = load_maps("rooitou_park_1k.hdr");
     const Bsdf lambert = Bsdf::lambert();
     double log_ratio = 0;
-    const int k = 12;
-    for (int i = 0; i < k; ++i) {
-        const double z = 1 - (2 * i + 1.0) / k, r = std::sqrt(1 - z * z), phi = 2.399963 * i;
-        const Vec3 n{static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z)};
-        const ShadingPoint p{n, n};
+    const auto normals = sphere_points(12);
+    const double k = static_cast<double>(normals.size());
+    for (const ShadingPoint& p : normals) {
         const double plain = exact_variance(maps.plain, Technique::parse("mis-balance"), {}, lambert, p, 2);
         const double compensated = exact_variance(maps.compensated, Technique::parse("mis-balance-comp"), {}, lambert, p, 2);
         log_ratio += std::log(compensated / plain) / k;
@@ -121,11 +120,10 @@ TEST(Estimator, OptimalMisLowersLambertVarianceUnderASunnyMap) {
         const Technique optimal = Technique::parse(pair);
         const Technique balance{Strategy::mis, Heuristic::balance, optimal.compensated};
         double log_ratio = 0;
-        const int k = 8;
-        for (int i = 0; i < k; ++i) {
-            const double z = 1 - (2 * i + 1.0) / k, r = std::sqrt(1 - z * z), phi = 2.399963 * i;
-            const Vec3 n{static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z)};
-            const ShadingPoint p{n, n};
+        const auto normals = sphere_points(8);
+        const double k = static_cast<double>(normals.size());
+        for (uint64_t i = 0; i < normals.size(); ++i) {
+            const ShadingPoint& p = normals[i];
             RunningStats stats[2];
             for (int j = 0; j < 2; ++j) {
                 const DirectLightingEstimator estimator(maps.plain, maps.compensated, j ? optimal : balance);
