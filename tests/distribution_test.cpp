@@ -231,6 +231,27 @@ TEST(Distribution1D, SingleCellAndAllZero) {
     EXPECT_FLOAT_EQ(zero.pdf(0.5f), 1.0f);
 }
 
+// The point of a sample is the float nearest (index + offset) / n inside cell `index`.
+// Power-of-two n take a float-only path: it must give the very same float.
+TEST(PointInCell, IsTheNearestFloatInsideTheCellForEverySize) {
+    const auto reference = [](uint32_t index, float offset, uint32_t n) {
+        float x = static_cast<float>((index + static_cast<double>(offset)) / n);
+        while (detail::cell_of(x, n) > index) x = std::nextafter(x, 0.0f);
+        while (detail::cell_of(x, n) < index) x = std::nextafter(x, 1.0f);
+        return std::min(x, kOneMinusEpsilon);  // cell_of counts 1 in the last cell
+    };
+    Rng rng(17);
+    for (uint32_t n : {1u, 2u, 3u, 7u, 64u, 1000u, 1024u, 4096u, 8191u, 8192u, 65535u, 65536u}) {
+        for (int i = 0; i < 20000; ++i) {
+            const uint32_t index = std::min(static_cast<uint32_t>(rng.uniform() * n), n - 1);
+            const float offset = i % 4 == 0 ? kOneMinusEpsilon : (i % 4 == 1 ? 0.0f : rng.uniform());
+            const float x = detail::point_in_cell(index, offset, n);
+            ASSERT_EQ(x, reference(index, offset, n)) << "n=" << n << " index=" << index << " offset=" << offset;
+            ASSERT_EQ(detail::cell_of(x, n), index);
+        }
+    }
+}
+
 TEST(Distribution1D, RejectsInvalidInput) {
     EXPECT_THROW(Distribution1D(std::vector<float>{}), std::invalid_argument);
     EXPECT_THROW(Distribution1D(std::vector<float>(65537, 1.0f)), std::invalid_argument);

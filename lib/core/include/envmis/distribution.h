@@ -94,6 +94,15 @@ ENVMIS_HD inline float offset_in_cell(float x, uint32_t i, uint32_t n) noexcept 
 // float can step over a cell edge, and one step back always suffices because a cell is
 // many float ulps wide.
 ENVMIS_HD inline float point_in_cell(uint32_t index, float offset, uint32_t n) noexcept {
+    if ((n & (n - 1)) == 0) {
+        // Power-of-two n (most maps): index / n and offset / n are exact floats, so
+        // their sum rounds once, to the same float as the division below, and can only
+        // round up onto the next cell's edge, which is exact too.
+        const float inv_n = 1.0f / static_cast<float>(n);
+        const float x = static_cast<float>(index) * inv_n + offset * inv_n;
+        const float next_edge = static_cast<float>(index + 1) * inv_n;
+        return x < next_edge ? x : bit_cast<float>(bit_cast<uint32_t>(next_edge) - 1);
+    }
     float x = static_cast<float>((index + static_cast<double>(offset)) / n);
     const uint32_t c = cell_of(x, n);
     if (c > index) x = ::nextafterf(x, 0.0f);

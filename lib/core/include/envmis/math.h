@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #if defined(__CUDACC__)
 #define ENVMIS_HD __host__ __device__
@@ -54,6 +55,15 @@ struct LumaCoefficients {
 };
 
 ENVMIS_HD inline float luminance(Rgb c, LumaCoefficients k) noexcept { return k.r * c.r + k.g * c.g + k.b * c.b; }
+
+// std::bit_cast for device code too (memcpy is the portable, optimised-away form).
+template <class To, class From>
+ENVMIS_HD inline To bit_cast(const From& from) noexcept {
+    static_assert(sizeof(To) == sizeof(From));
+    To to;
+    std::memcpy(&to, &from, sizeof(To));
+    return to;
+}
 
 template <class T>
 ENVMIS_HD constexpr T clamp(T v, T lo, T hi) noexcept {
