@@ -62,7 +62,7 @@ ENVMIS_HD inline float distribution(Vec3 m, float alpha) noexcept {
 }
 // Smith's Lambda(v) for GGX.
 ENVMIS_HD inline float lambda(Vec3 v, float alpha) noexcept {
-    const float c2 = v.z * v.z, s2 = std::max(0.0f, 1 - c2);
+    const float c2 = v.z * v.z, s2 = max(0.0f, 1 - c2);
     return c2 > 0 ? 0.5f * (std::sqrt(1 + alpha * alpha * s2 / c2) - 1) : 0.0f;
 }
 ENVMIS_HD inline Rgb schlick(Rgb f0, float cos_theta) noexcept {
@@ -78,9 +78,9 @@ ENVMIS_HD inline Vec3 sample_visible_normal(Vec3 wo, float alpha, Vec2 u) noexce
     const float r = std::sqrt(u.x);
     const SinCos phi = fast_sincos(2 * kPiF * u.y);
     const float p1 = r * phi.cos, s = 0.5f * (1 + vh.z);
-    const float p2 = (1 - s) * std::sqrt(std::max(0.0f, 1 - p1 * p1)) + s * r * phi.sin;
-    const Vec3 nh = t1 * p1 + t2 * p2 + vh * std::sqrt(std::max(0.0f, 1 - p1 * p1 - p2 * p2));
-    return normalize(Vec3{alpha * nh.x, alpha * nh.y, std::max(1e-7f, nh.z)});
+    const float p2 = (1 - s) * std::sqrt(max(0.0f, 1 - p1 * p1)) + s * r * phi.sin;
+    const Vec3 nh = t1 * p1 + t2 * p2 + vh * std::sqrt(max(0.0f, 1 - p1 * p1 - p2 * p2));
+    return normalize(Vec3{alpha * nh.x, alpha * nh.y, max(1e-7f, nh.z)});
 }
 
 }  // namespace ggx
@@ -132,7 +132,7 @@ ENVMIS_HD inline BsdfSample Bsdf::sample(Vec3 wo, Vec2 u) const noexcept {
     switch (kind) {
         case BsdfKind::lambert: wi = sample_cosine_hemisphere(u); break;
         case BsdfKind::phong: {
-            const float cos_a = std::pow(u.x, 1 / (exponent + 1)), sin_a = std::sqrt(std::max(0.0f, 1 - cos_a * cos_a));
+            const float cos_a = std::pow(u.x, 1 / (exponent + 1)), sin_a = std::sqrt(max(0.0f, 1 - cos_a * cos_a));
             const SinCos phi = fast_sincos(2 * kPiF * u.y);
             wi = Frame::from_normal(reflect_z(wo)).to_world({sin_a * phi.cos, sin_a * phi.sin, cos_a});
             break;

@@ -73,7 +73,7 @@ struct EnvMapView {
     ENVMIS_HD EnvSample sample(Vec2 u) const noexcept {
         const auto s = distribution.sample(u);
         const SinCos theta = sincos_turns(turns, 0.5f * s.p.y), phi = sincos_turns(turns, s.p.x);
-        const float sin_theta = std::max(theta.sin, 0.0f);
+        const float sin_theta = max(theta.sin, 0.0f);
         const Vec3 canonical{sin_theta * phi.cos, sin_theta * phi.sin, theta.cos};
         return {to_world(axes, canonical), solid_angle_pdf(s.pdf, sin_theta),
                 radiance[static_cast<size_t>(s.y) * distribution.w + s.x], s.p};
@@ -82,7 +82,7 @@ struct EnvMapView {
     ENVMIS_HD float pdf(Vec3 direction) const noexcept { return pdf_uv(equirect_uv(to_canonical(axes, direction))); }
     // Solid-angle pdf at image point uv; bit-identical to sample(u).pdf when uv = sample(u).uv.
     ENVMIS_HD float pdf_uv(Vec2 uv) const noexcept {
-        return solid_angle_pdf(distribution.pdf(uv), std::max(sincos_turns(turns, 0.5f * uv.y).sin, 0.0f));
+        return solid_angle_pdf(distribution.pdf(uv), max(sincos_turns(turns, 0.5f * uv.y).sin, 0.0f));
     }
     // Radiance arriving from `direction` (nearest texel).
     ENVMIS_HD Rgb eval(Vec3 direction) const noexcept { return eval_uv(equirect_uv(to_canonical(axes, direction))); }

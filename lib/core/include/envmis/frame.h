@@ -45,7 +45,7 @@ ENVMIS_HD inline Vec2 sample_disk(Vec2 u) noexcept {
 // Direction with density cos(theta) / pi on the upper (z > 0) hemisphere.
 ENVMIS_HD inline Vec3 sample_cosine_hemisphere(Vec2 u) noexcept {
     const Vec2 d = sample_disk(u);
-    return {d.x, d.y, std::sqrt(std::max(0.0f, 1 - d.x * d.x - d.y * d.y))};
+    return {d.x, d.y, std::sqrt(max(0.0f, 1 - d.x * d.x - d.y * d.y))};
 }
 
 }  // namespace envmis

@@ -57,7 +57,7 @@ ENVMIS_HD inline Vec3 to_canonical(const Axes& a, Vec3 world) noexcept {
 // Canonical direction of image point uv, with sin(theta) (>= 0) alongside.
 ENVMIS_HD inline Vec3 equirect_direction(Vec2 uv, float* sin_theta = nullptr) noexcept {
     const SinCos t = fast_sincos(kPiF * uv.y), p = fast_sincos(2 * kPiF * uv.x);
-    const float st = std::max(t.sin, 0.0f);
+    const float st = max(t.sin, 0.0f);
     if (sin_theta) *sin_theta = st;
     return {st * p.cos, st * p.sin, t.cos};
 }
@@ -65,7 +65,7 @@ ENVMIS_HD inline Vec3 equirect_direction(Vec2 uv, float* sin_theta = nullptr) no
 // Image point of a canonical unit direction; the inverse of equirect_direction.
 ENVMIS_HD inline Vec2 equirect_uv(Vec3 d) noexcept {
     const float z = clamp(d.z, -1.0f, 1.0f);
-    const float theta = fast_atan2(std::sqrt(std::max(0.0f, (1 - z) * (1 + z))), z);
+    const float theta = fast_atan2(std::sqrt(max(0.0f, (1 - z) * (1 + z))), z);
     const float phi = fast_atan2(d.y, d.x);
     constexpr float kInvPi = static_cast<float>(1 / kPi);
     const float u = 0.5f * kInvPi * (phi < 0 ? phi + 2 * kPiF : phi);

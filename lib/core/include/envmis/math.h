@@ -65,6 +65,17 @@ ENVMIS_HD inline To bit_cast(const From& from) noexcept {
     return to;
 }
 
+// std::min and std::max are host functions to a CUDA compiler: the sampling path
+// uses these (same semantics).
+template <class T>
+ENVMIS_HD constexpr T min(T a, T b) noexcept {
+    return b < a ? b : a;
+}
+template <class T>
+ENVMIS_HD constexpr T max(T a, T b) noexcept {
+    return a < b ? b : a;
+}
+
 template <class T>
 ENVMIS_HD constexpr T clamp(T v, T lo, T hi) noexcept {
     return v < lo ? lo : (hi < v ? hi : v);
