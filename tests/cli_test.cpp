@@ -265,11 +265,35 @@ TEST_F(Cli, PrecomputeWritesATableAndPrintsTheSummary) {
     EXPECT_EQ(read_file(file("studio.envmis")).substr(1, 7), "ENVMIS\x1a");
 }
 
+// convert makes a square equal-area map with the same power; precompute samples it as
+// such when told, and says so; converting back gives the latitude-longitude size.
+TEST_F(Cli, ConvertToEqualAreaAndBack) {
+    const Result to = envmis({"convert", (kBundled / "studio.exr").string(), "-o", "square.exr", "--to", "equal-area",
+                              "--size", "128"});
+    ASSERT_EQ(to.exit_code, 0) << to;
+    EXPECT_TRUE(contains(to.out, R"(\(1024x512 equirect\) -> square.exr \(128x128 equal-area\))")) << to;
+    const Result table = envmis({"precompute", "square.exr", "-o", "square.envmis", "--mapping", "equal-area"});
+    ASSERT_EQ(table.exit_code, 0) << table;
+    EXPECT_TRUE(contains(table.out, R"(mapping +equal-area)")) << table;
+    const Result info = envmis({"info", "square.envmis"});
+    EXPECT_TRUE(contains(info.out, R"(mapping +equal-area)")) << info;
+    const Result square_as_equirect = envmis({"info", "square.exr"});
+    EXPECT_TRUE(contains(square_as_equirect.err, "is square; it is read as equirect")) << square_as_equirect;
+    const Result back = envmis({"convert", "square.exr", "-o", "back.exr", "--from", "equal-area", "--to", "equirect",
+                                "--size", "64"});
+    ASSERT_EQ(back.exit_code, 0) << back;
+    EXPECT_TRUE(contains(back.out, R"(-> back.exr \(128x64 equirect\))")) << back;
+    expect_one_line_error(envmis({"convert", "missing.exr", "-o", "x.exr"}), "missing.exr", "");
+    expect_one_line_error(envmis({"precompute", (kBundled / "studio.exr").string(), "-o", "x.envmis", "--mapping",
+                                  "equal-area"}),
+                          "studio.exr", "must be square");
+}
+
 TEST_F(Cli, InfoDescribesATableAndTheImageItCameFrom) {
     ASSERT_EQ(envmis({"precompute", (kBundled / "studio.exr").string(), "-o", "studio.envmis"}).exit_code, 0);
     const Result table = envmis({"info", "studio.envmis"});
     ASSERT_EQ(table.exit_code, 0) << table;
-    EXPECT_TRUE(contains(table.out, "studio.envmis: envmis table, format version 1")) << table;
+    EXPECT_TRUE(contains(table.out, "studio.envmis: envmis table, format version 2")) << table;
     expect_studio_summary(table);
 
     const Result image = envmis({"info", (kBundled / "studio.exr").string()});
@@ -400,10 +424,10 @@ INSTANTIATE_TEST_SUITE_P(
                      for (char& b : bytes) b = static_cast<char>((x = x * 1664525u + 1013904223u) >> 24);
                      write_file(p, bytes);
                  }},
-        BadInput{"TableOfANewerVersion", "newer.envmis", "version 2.*newer",
+        BadInput{"TableOfANewerVersion", "newer.envmis", "version 3.*newer",
                  [](Cli& t, const fs::path& p) {
                      // The format version: uint32, little-endian, at byte 8.
-                     t.damaged_table(p, [](std::string& bytes) { bytes.replace(8, 4, std::string("\x02\0\0\0", 4)); });
+                     t.damaged_table(p, [](std::string& bytes) { bytes.replace(8, 4, std::string("\x03\0\0\0", 4)); });
                  }},
         BadInput{"Folder", "folder.exr", "directory", [](Cli&, const fs::path& p) { fs::create_directory(p); }}),
     [](const testing::TestParamInfo<BadInput>& info) { return info.param.name; });

@@ -90,6 +90,59 @@ TEST(EnvMap, DirectionsFollowTheDocumentedDensity) {
         }
 }
 
+// An equal-area map: texel (x, y) has mass q(x, y) (every texel covers 4 pi / (w h)),
+// Lbar is the plain mean, and the solid-angle pdf is the image density / (4 pi).
+TEST(EnvMap, EqualAreaMapsFollowTheirDensity) {
+    uint64_t seed = 300;
+    for (const RgbImage& image : {test::sun_sky_map(32, 32), test::random_map(24, 24, 5), test::random_map(5, 5, 6)})
+        for (bool compensate : {false, true}) {
+            EnvMapOptions o = options(compensate);
+            o.mapping = Mapping::equal_area;
+            const EnvMap map(image, o);
+            const uint32_t w = image.width, h = image.height;
+            std::vector<double> lum(size_t{w} * h), mass(lum.size());
+            double mean = 0;
+            for (size_t i = 0; i < lum.size(); ++i) {
+                const Rgb p = image.pixels[i];
+                lum[i] = 0.2126 * p.r + 0.7152 * p.g + 0.0722 * p.b;
+                mean += lum[i] / static_cast<double>(lum.size());
+            }
+            EXPECT_NEAR(map.stats().mean_luminance, mean, 1e-6 * mean);
+            for (size_t i = 0; i < lum.size(); ++i) mass[i] = std::max(lum[i] - (compensate ? mean : 0.0), 0.0);
+            const double total = std::accumulate(mass.begin(), mass.end(), 0.0);
+
+            const size_t n = std::max<size_t>(100000, 30 * mass.size());
+            std::vector<double> observed(mass.size()), expected(mass.size());
+            for (size_t i = 0; i < mass.size(); ++i) expected[i] = n * mass[i] / total;
+            Rng rng(seed++);
+            for (size_t i = 0; i < n; ++i) {
+                const EnvSample s = map.sample(rng.uniform2());
+                ASSERT_EQ(s.pdf, map.pdf_uv(s.uv));
+                // Bins from the direction alone, through the inverse mapping.
+                const Vec2 uv = equal_area_uv(s.direction);
+                observed[size_t{detail::cell_of(uv.y, h)} * w + detail::cell_of(uv.x, w)] += 1;
+                // The solid-angle pdf, from the mass of the sample's texel alone.
+                const size_t own = size_t{detail::cell_of(s.uv.y, h)} * w + detail::cell_of(s.uv.x, w);
+                const double expected_pdf = mass[own] / total * (w * h) / (4 * kPi);
+                ASSERT_NEAR(s.pdf, expected_pdf, 1e-3 * expected_pdf + 1e-7 * w * h);
+            }
+            const auto chi = test::chi_square(expected, observed);
+            EXPECT_GT(chi.p_value, kLevel) << w << "x" << h << " compensate=" << compensate << ": " << chi.describe();
+
+            // Midpoint rule over the square, 4x finer than the texels, each point's pdf
+            // taken from its direction: the integral of the pdf over the sphere is 1.
+            double integral = 0;
+            const uint32_t n4 = 4 * w;
+            for (uint32_t j = 0; j < n4; ++j)
+                for (uint32_t i = 0; i < n4; ++i)
+                    integral += map.pdf(equal_area_direction({(i + 0.5f) / n4, (j + 0.5f) / n4}));
+            EXPECT_NEAR(integral * 4 * kPi / (static_cast<double>(n4) * n4), 1.0, 1e-3) << w << "x" << h << " compensate=" << compensate;
+        }
+    EnvMapOptions o;
+    o.mapping = Mapping::equal_area;
+    EXPECT_THROW(EnvMap(test::random_map(8, 4, 1), o), std::invalid_argument);  // not square
+}
+
 TEST(EnvMap, CompensationStrengthAlphaIsHonoured) {
     const RgbImage image = test::random_map(32, 16, 3);
     for (float alpha : {0.0f, 0.5f, 2.0f}) {

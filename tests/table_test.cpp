@@ -6,6 +6,7 @@
 #include <fstream>
 #include <vector>
 
+#include "envmis/hash.h"
 #include "envmis/table.h"
 #include "maps.h"
 #include "stats.h"
@@ -121,6 +122,50 @@ TEST_F(TableTest, ForeignFilesAreRejected) {
     expect_rejected(path, "not an envmis table");
     expect_rejected(dir_ / "missing.envmis", "no such file");
     expect_rejected(dir_, "not a regular file");
+}
+
+TEST_F(TableTest, EqualAreaTablesRoundTrip) {
+    EnvMapOptions o;
+    o.mapping = Mapping::equal_area;
+    const EnvMap map(test::sun_sky_map(48, 48), o);
+    const fs::path path = dir_ / "square.envmis";
+    write_table(path, map, source_);
+    const Table loaded = read_table(path);
+    EXPECT_EQ(loaded.map.options().mapping, Mapping::equal_area);
+    test::Rng rng(9);
+    for (int i = 0; i < 10000; ++i) {
+        const Vec2 u = rng.uniform2();
+        const EnvSample a = map.sample(u), b = loaded.map.sample(u);
+        ASSERT_EQ(a.pdf, b.pdf);
+        ASSERT_EQ(a.direction.x, b.direction.x);
+        ASSERT_EQ(a.direction.z, b.direction.z);
+    }
+}
+
+// Version 1 had a reserved zero byte where version 2 keeps the mapping: such files are
+// equirectangular and still read; a version 1 file with another byte there is corrupt.
+TEST_F(TableTest, VersionOneTablesStillRead) {
+    const fs::path path = saved_table();
+    std::vector<char> bytes = bytes_of(path);
+    const uint32_t one = 1, preamble = 32;
+    uint32_t m = 0;  // metadata size
+    std::memcpy(&m, bytes.data() + 24, sizeof m);
+    std::memcpy(bytes.data() + 8, &one, sizeof one);
+    const size_t mapping_byte = preamble + 5 * 4 + 3 * 4 + 3;  // after size, kind, flags, alpha, luma, axes
+    ASSERT_EQ(bytes[mapping_byte], 1);                          // equirect, as version 2 writes it
+    const auto reseal = [&] {
+        const uint64_t digest = hash64(std::as_bytes(std::span(bytes.data(), preamble + m)));
+        std::memcpy(bytes.data() + preamble + m, &digest, sizeof digest);
+        write_bytes(path, bytes);
+    };
+    bytes[mapping_byte] = 0;
+    reseal();
+    const Table loaded = read_table(path);
+    EXPECT_EQ(loaded.map.options().mapping, Mapping::equirect);
+    EXPECT_EQ(loaded.map.sample({0.3f, 0.6f}).pdf, map_.sample({0.3f, 0.6f}).pdf);
+    bytes[mapping_byte] = 2;
+    reseal();
+    expect_rejected(path, "unknown mapping");
 }
 
 TEST_F(TableTest, NewerVersionsAreRejectedWithAnUpgradeHint) {

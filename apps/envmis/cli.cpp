@@ -36,6 +36,9 @@ void add_map_flags(CLI::App& app, MapFlags& flags) {
         ->type_name("ALPHA|auto")
         ->default_str("1")
         ->check(alpha_value);
+    app.add_option("--mapping", flags.mapping, "Image mapping: equirect (latitude-longitude) or equal-area (octahedral, square)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"equirect", "equal-area"}));
     app.add_option("--colorspace", flags.colorspace, "Input colour space (default: from the file's metadata)");
     app.add_option("--working-space", flags.working_space, "Linear working colour space, e.g. lin_rec709 or ACEScg")
         ->capture_default_str();
@@ -83,6 +86,13 @@ LoadedMap load_map(const std::string& path, const MapFlags& flags) {
     options.compensation = {!flags.no_compensate, flags.alpha};
     options.luma = image.luma;
     options.axes = Axes::parse(flags.axes);
+    options.mapping = parse_mapping(flags.mapping);
+    if (options.mapping == Mapping::equal_area && image.image.width != image.image.height)
+        throw std::runtime_error(path + ": an equal-area map must be square, this one is " +
+                                 std::to_string(image.image.width) + "x" + std::to_string(image.image.height));
+    if (options.mapping == Mapping::equirect && image.image.width == image.image.height && image.image.width > 1)
+        std::cerr << "note: " << path << " is square; it is read as equirect (pass --mapping equal-area for an "
+                  << "equal-area octahedral map)\n";
     if (flags.alpha_auto && !flags.no_compensate) {
         loaded.alpha_choice = choose_alpha(image.image, options);
         options.compensation.alpha = loaded.alpha_choice->alpha;
@@ -109,7 +119,7 @@ void print_summary(std::ostream& out, const LoadedMap& loaded) {
     out << "  size          " << m.width() << " x " << m.height() << "\n";
     out << "  colour        " << loaded.source.input_colorspace << " -> " << loaded.source.working_colorspace
         << ", luma (" << o.luma.r << ", " << o.luma.g << ", " << o.luma.b << ")\n";
-    out << "  axes          " << o.axes.to_string() << "\n";
+    out << "  mapping       " << to_string(o.mapping) << ", axes " << o.axes.to_string() << "\n";
     out << "  luminance     max " << s.max_luminance << ", min positive " << s.min_positive_luminance;
     if (s.min_positive_luminance > 0)
         out << ", dynamic range " << s.max_luminance / s.min_positive_luminance << " ("

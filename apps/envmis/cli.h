@@ -26,6 +26,7 @@ struct MapFlags {
     std::string colorspace;                 // input colour space; empty: from the file
     std::string working_space = "lin_rec709";
     std::string axes = "z-up";
+    std::string mapping = "equirect";  // or "equal-area" (a square image)
 };
 void add_map_flags(CLI::App& app, MapFlags& flags);
 
@@ -80,6 +81,7 @@ Subcommand add_info(CLI::App& app);
 Subcommand add_sample(CLI::App& app);
 Subcommand add_visualize(CLI::App& app);
 Subcommand add_bench(CLI::App& app);
+Subcommand add_convert(CLI::App& app);
 Subcommand add_compare(CLI::App& app);
 Subcommand add_report(CLI::App& app);
 

@@ -11,7 +11,7 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     app.set_version_flag("--version", "envmis 0.1.0");
     const std::vector<Subcommand> subcommands = {add_compare(app), add_report(app),    add_precompute(app), add_info(app),
-                                                 add_sample(app),  add_visualize(app), add_bench(app)};
+                                                 add_sample(app),  add_visualize(app), add_bench(app), add_convert(app)};
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

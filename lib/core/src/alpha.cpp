@@ -13,10 +13,11 @@ namespace envmis {
 namespace {
 
 // One halving step of downsample().
-RgbImage halve(const RgbImage& in) {
+RgbImage halve(const RgbImage& in, Mapping mapping) {
     const uint32_t w = in.width / 2, h = in.height / 2;
-    std::vector<double> sin_theta(in.height);
-    for (uint32_t y = 0; y < in.height; ++y) sin_theta[y] = std::sin(kPi * (y + 0.5) / in.height);
+    std::vector<double> sin_theta(in.height, 1.0);
+    if (mapping == Mapping::equirect)
+        for (uint32_t y = 0; y < in.height; ++y) sin_theta[y] = std::sin(kPi * (y + 0.5) / in.height);
     RgbImage out{w, h, std::vector<Rgb>(size_t{w} * h)};
     detail::parallel_for(h, 8, [&](uint32_t lo, uint32_t hi) {
         for (uint32_t row = lo; row < hi; ++row) {
@@ -69,10 +70,10 @@ std::vector<LogRatios> log_ratios(std::span<const double> variances, std::span<c
 
 }  // namespace
 
-RgbImage downsample(const RgbImage& image, uint32_t max_width) {
+RgbImage downsample(const RgbImage& image, uint32_t max_width, Mapping mapping) {
     if (!can_halve(image, max_width)) return image;
-    RgbImage small = halve(image);
-    while (can_halve(small, max_width)) small = halve(small);
+    RgbImage small = halve(image, mapping);
+    while (can_halve(small, max_width)) small = halve(small, mapping);
     return small;
 }
 
@@ -106,7 +107,7 @@ AlphaChoice choose_alpha(const RgbImage& radiance, const EnvMapOptions& map, con
     std::sort(alphas.begin(), alphas.end());
     alphas.erase(std::unique(alphas.begin(), alphas.end()), alphas.end());
 
-    const RgbImage small = downsample(radiance, options.max_width);
+    const RgbImage small = downsample(radiance, options.max_width, map.mapping);
     EnvMapOptions plain_options = map;
     plain_options.compensation.enabled = false;
     const EnvMap plain(small, plain_options);

@@ -30,7 +30,7 @@ constexpr size_t kMaxTexels = size_t{1} << 31;
 // Rows per task of the parallel passes.
 constexpr uint32_t kRowsPerChunk = 8;
 
-void check_image(const RgbImage& image) {
+void check_image(const RgbImage& image, Mapping mapping) {
     const size_t n = size_t{image.width} * image.height;
     if (image.width == 0 || image.height == 0 || image.width > kMaxCells1D || image.height > kMaxCells1D || n > kMaxTexels)
         throw std::invalid_argument("environment map size " + std::to_string(image.width) + "x" +
@@ -39,6 +39,9 @@ void check_image(const RgbImage& image) {
         throw std::invalid_argument("environment map: " + std::to_string(image.pixels.size()) +
                                     " pixels do not make a " + std::to_string(image.width) + "x" +
                                     std::to_string(image.height) + " image");
+    if (mapping == Mapping::equal_area && image.width != image.height)
+        throw std::invalid_argument("an equal-area map must be square, got " + std::to_string(image.width) + "x" +
+                                    std::to_string(image.height));
 }
 
 void check_options(const EnvMapOptions& o) {
@@ -46,6 +49,8 @@ void check_options(const EnvMapOptions& o) {
     if (!(a >= 0 && std::isfinite(a)))
         throw std::invalid_argument("compensation alpha must be finite and >= 0, got " + std::to_string(a));
     if (!o.axes.valid()) throw std::invalid_argument("invalid axes " + o.axes.to_string());
+    if (o.mapping != Mapping::equirect && o.mapping != Mapping::equal_area)
+        throw std::invalid_argument("unknown mapping " + std::to_string(static_cast<uint32_t>(o.mapping)));
     const LumaCoefficients k = o.luma;
     if (!(k.r >= 0 && k.g >= 0 && k.b >= 0 && k.r + k.g + k.b > 0 && std::isfinite(k.r + k.g + k.b)))
         throw std::invalid_argument("luma coefficients must be finite, >= 0 and not all 0");
@@ -157,12 +162,12 @@ bool scan_row(const Rgb* pixels, uint32_t w, const LumaCoefficients& luma, uint3
     return !(dirty >> 31);
 }
 
-// Pass 2: row y of the density q sin(theta_y) from its luminance bits; returns the
+// Pass 2: row y of the density q w_y (mapping.h: row_weight) from its luminance bits; returns the
 // number of texels with L > 0 that compensation zeroes.
-uint32_t density_row(const uint32_t* luminance, uint32_t w, float sin_theta, float threshold, bool uniform,
+uint32_t density_row(const uint32_t* luminance, uint32_t w, float weight, float threshold, bool uniform,
                      float* row) noexcept {
     if (uniform) {
-        std::fill_n(row, w, sin_theta);
+        std::fill_n(row, w, weight);
         return 0;
     }
     uint32_t zeroed = 0;
@@ -170,7 +175,7 @@ uint32_t density_row(const uint32_t* luminance, uint32_t w, float sin_theta, flo
         const auto l = std::bit_cast<float>(luminance[x]);
         zeroed += (static_cast<int32_t>(luminance[x]) > 0) & (l <= threshold);
         // max(L - t, 0) is compensate(L, t): for L > t the difference of two floats is > 0.
-        row[x] = std::max(l - threshold, 0.0f) * sin_theta;
+        row[x] = std::max(l - threshold, 0.0f) * weight;
     }
     return zeroed;
 }
@@ -178,7 +183,7 @@ uint32_t density_row(const uint32_t* luminance, uint32_t w, float sin_theta, flo
 }  // namespace
 
 EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : radiance_(std::move(image)), options_(options) {
-    check_image(radiance_);
+    check_image(radiance_, options_.mapping);
     check_options(options_);
     const uint32_t w = radiance_.width, h = radiance_.height;
     Rgb* pixels = radiance_.pixels.data();
@@ -206,7 +211,7 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : radiance_(std::mo
         row_sums[y] = rows[y].sum;
         stats_.bad_pixels += rows[y].bad;
     }
-    stats_.mean_luminance = solid_angle_mean_of_rows(row_sums, w);
+    stats_.mean_luminance = solid_angle_mean_of_rows(row_sums, w, options_.mapping);
 
     // A black map is sampled uniformly; a map that compensation zeroes whole (a constant
     // one) is rebuilt without compensation, from its luminance computed again.
@@ -214,7 +219,7 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : radiance_(std::mo
     if (options_.compensation.enabled && stats_.fallback == DensityFallback::none)
         stats_.threshold = compensation_threshold(stats_.mean_luminance, options_.compensation.alpha);
     const auto density = [&](uint32_t y, std::span<const uint32_t> cells, std::span<float> row) {
-        rows[y].zeroed = density_row(cells.data(), w, row_sin_theta(y, h), stats_.threshold,
+        rows[y].zeroed = density_row(cells.data(), w, row_weight(options_.mapping, y, h), stats_.threshold,
                                      stats_.fallback == DensityFallback::uniform, row.data());
     };
     distribution_ = Distribution2D(w, h, std::move(luminance_bits), density);
@@ -235,7 +240,7 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : radiance_(std::mo
 EnvMap::EnvMap(RgbImage radiance, std::span<const float> density, const EnvMapOptions& options,
                const EnvMapStats& stats)
     : radiance_(std::move(radiance)), options_(options), stats_(stats) {
-    check_image(radiance_);
+    check_image(radiance_, options_.mapping);
     check_options(options_);
     size_t bad = 0;
     for (const Rgb& p : radiance_.pixels) {
@@ -255,7 +260,7 @@ std::vector<float> EnvMap::density() const {
     RowStats unused;
     for (uint32_t y = 0; y < h; ++y) {
         scan_row(radiance_.pixels.data() + size_t{y} * w, w, options_.luma, luminance.data(), unused);
-        density_row(luminance.data(), w, row_sin_theta(y, h), stats_.threshold,
+        density_row(luminance.data(), w, row_weight(options_.mapping, y, h), stats_.threshold,
                     stats_.fallback == DensityFallback::uniform, out.data() + size_t{y} * w);
     }
     return out;

@@ -36,6 +36,14 @@ Axes Axes::parse(std::string_view text) {
     return axes;
 }
 
+std::string_view to_string(Mapping m) noexcept { return m == Mapping::equal_area ? "equal-area" : "equirect"; }
+
+Mapping parse_mapping(std::string_view text) {
+    if (text == "equirect") return Mapping::equirect;
+    if (text == "equal-area") return Mapping::equal_area;
+    throw std::invalid_argument("mapping '" + std::string(text) + "': expected equirect or equal-area");
+}
+
 std::string Axes::to_string() const {
     std::string s;
     for (int i = 0; i < 3; ++i) {

@@ -35,6 +35,23 @@ Acc integrate(const EnvMap& map, const ShadingPoint& point, int s, Fn&& fn) {
     const Rgb* radiance = map.radiance().pixels.data();
     const LumaCoefficients luma = map.options().luma;
     std::vector<Acc> rows(h);
+    if (map.options().mapping == Mapping::equal_area) {
+        // Every sub-cell of an equal-area map covers the same solid angle.
+        const double solid_angle = 4 * kPi / (static_cast<double>(ws) * h * s);
+        detail::parallel_for(h, 1, [&](uint32_t lo, uint32_t hi) {
+            for (uint32_t y = lo; y < hi; ++y)
+                for (uint32_t x = 0; x < w; ++x) {
+                    const Rgb l = radiance[size_t{y} * w + x];
+                    if (!(luminance(l, luma) > 0)) continue;
+                    for (int b = 0; b < s; ++b)
+                        for (int a = 0; a < s; ++a) {
+                            const Vec2 uv{static_cast<float>((x + (a + 0.5) / s) / w), static_cast<float>((y + (b + 0.5) / s) / h)};
+                            const Vec3 wi = frame.to_local(to_world(map.options().axes, equal_area_direction(uv)));
+                            if (wi.z > 0) fn(rows[y], Node{wi, solid_angle, l, uv});
+                        }
+                }
+        });
+    } else
     detail::parallel_for(h, 1, [&](uint32_t lo, uint32_t hi) {
         for (uint32_t y = lo; y < hi; ++y)
             for (int b = 0; b < s; ++b) {

@@ -93,7 +93,7 @@ std::vector<std::byte> metadata_block(const EnvMap& map, const TableSource& sour
     w.put(o.compensation.alpha);
     w.put(o.luma);
     w.put(o.axes);
-    w.put(uint8_t{0});
+    w.put(static_cast<uint8_t>(o.mapping));
     w.put(s.mean_luminance);
     w.put(s.threshold);
     w.put(s.max_luminance);
@@ -173,7 +173,7 @@ Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
     if (version > kTableVersion)
         in.fail("format version " + std::to_string(version) + " is newer than this envmis reads (version " +
                 std::to_string(kTableVersion) + "); upgrade envmis");
-    if (version != kTableVersion) in.fail("unknown format version " + std::to_string(version));
+    if (version != kTableVersion && version != 1) in.fail("unknown format version " + std::to_string(version));
     const auto total = in.take<uint64_t>("file size");
     if (total != bytes.size())
         in.fail(total > bytes.size() ? "truncated: header says " + std::to_string(total) + " bytes, file has " +
@@ -196,7 +196,8 @@ Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
     options.compensation.alpha = meta.take<float>("alpha");
     options.luma = meta.take<LumaCoefficients>("luma coefficients");
     options.axes = meta.take<Axes>("axes");
-    meta.take<uint8_t>("reserved");
+    // Version 1 had a reserved 0 here: every version 1 table is equirectangular.
+    const auto mapping = meta.take<uint8_t>("mapping");
     EnvMapStats stats;
     stats.mean_luminance = meta.take<double>("mean luminance");
     stats.threshold = meta.take<float>("threshold");
@@ -219,6 +220,11 @@ Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
     if (w == 0 || h == 0 || w > kMaxCells1D || h > kMaxCells1D || uint64_t{w} * h > kMaxTexels)
         in.fail("invalid size " + std::to_string(w) + "x" + std::to_string(h));
     if (sampler != kSamplerCdf) in.fail("unknown sampler kind " + std::to_string(sampler));
+    if (version == 1 ? mapping != 0 : mapping != 1 && mapping != 2)
+        in.fail("unknown mapping " + std::to_string(mapping));
+    options.mapping = mapping == 2 ? Mapping::equal_area : Mapping::equirect;
+    if (options.mapping == Mapping::equal_area && w != h)
+        in.fail("equal-area table of size " + std::to_string(w) + "x" + std::to_string(h) + " is not square");
     if (fallback > static_cast<uint32_t>(DensityFallback::uniform)) in.fail("unknown fallback " + std::to_string(fallback));
     stats.fallback = static_cast<DensityFallback>(fallback);
 

@@ -42,8 +42,9 @@ namespace envmis {
 // (compensation.h) is kept exactly, up to float rounding: the weights of every merged
 // pair of rows sum to the new row's sin(theta) times one constant, 2 cos(pi / 2h).
 // NaN, infinite and negative channel values count as 0, as EnvMap's build treats them.
+// An equal-area map's texels all weigh the same.
 // Cost: O(W H), one pass per halving.
-RgbImage downsample(const RgbImage& image, uint32_t max_width);
+RgbImage downsample(const RgbImage& image, uint32_t max_width, Mapping mapping = Mapping::equirect);
 
 // The exact variance (exact_variance, at `subdivisions`) of `technique` sampling `env`,
 // at every (BSDF, point): element b * points.size() + p.

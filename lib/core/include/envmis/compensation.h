@@ -4,7 +4,7 @@
 // Lbar is the solid-angle mean of the luminance over the sphere. On an equirectangular
 // image every texel of row y has solid angle proportional to sin(theta_y) (row centre),
 // so Lbar = sum_y sin(theta_y) sum_x L(x, y) / (w sum_y sin(theta_y)); a plain per-texel
-// mean would over-weight the poles.
+// mean would over-weight the poles. On an equal-area image it is the plain mean.
 //
 // The compensated density is zero where L <= alpha Lbar even if the radiance is not:
 // alone it is not a valid importance-sampling density (see EnvMap::complete()).
@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <span>
 
+#include "envmis/mapping.h"
 #include "envmis/math.h"
 
 namespace envmis {
@@ -23,10 +24,12 @@ struct CompensationOptions {
 };
 
 // Solid-angle-weighted mean of a w x h row-major luminance image (double sums).
-double solid_angle_mean(std::span<const float> luminance, uint32_t w, uint32_t h);
+double solid_angle_mean(std::span<const float> luminance, uint32_t w, uint32_t h,
+                        Mapping mapping = Mapping::equirect);
 
 // The same mean from the row sums (sum over x of L(x, y)) of a w-wide image.
-double solid_angle_mean_of_rows(std::span<const double> row_sums, uint32_t w) noexcept;
+double solid_angle_mean_of_rows(std::span<const double> row_sums, uint32_t w,
+                                Mapping mapping = Mapping::equirect) noexcept;
 
 // The threshold alpha * Lbar, rounded to float once so that every texel is compared
 // with the same value: a texel is zeroed exactly when L <= threshold.

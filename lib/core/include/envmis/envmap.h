@@ -1,13 +1,15 @@
-// An importance-sampled equirectangular environment map: the radiance image, its
-// sampling density (luminance, optionally MIS-compensated, times sin theta) and the
-// distribution that samples it.
+// An importance-sampled environment map: the radiance image, its sampling density
+// (luminance, optionally MIS-compensated, times the texel's relative solid angle) and
+// the distribution that samples it. Equirectangular by default, or equal-area
+// octahedral (a square image; mapping.h).
 //
 // Measure: `sample` and `pdf` speak solid angle (per steradian) over directions in the
 // world frame given by EnvMapOptions::axes (mapping.h). The density of texel (x, y) in
-// image space is proportional to q(x, y) sin(theta_y) (row centre), with
-// q = L (uncompensated) or max(L - alpha Lbar, 0) (compensated); the solid-angle pdf is
-// that image density / (2 pi^2 sin theta). Radiance is the texel's value (nearest), so
-// it is constant exactly where the density is.
+// image space is proportional to q(x, y) w_y, with q = L (uncompensated) or
+// max(L - alpha Lbar, 0) (compensated), and w_y = sin(theta_y) (row centre) for
+// equirect, 1 for equal-area; the solid-angle pdf is that image density divided by
+// 2 pi^2 sin theta (equirect) or 4 pi (equal-area). Radiance is the texel's value
+// (nearest), so it is constant exactly where the density is.
 //
 // Cost: build O(w h), parallel over rows (see `envmis bench` for figures); sample, pdf
 // and eval O(1), noexcept and allocation-free. Memory: 6 bytes per texel for the
@@ -41,6 +43,7 @@ struct EnvMapOptions {
     CompensationOptions compensation;  // enabled by default, alpha = 1
     LumaCoefficients luma;             // of the radiance's colour space (Rec.709 by default)
     Axes axes;                         // world frame of directions (z up by default)
+    Mapping mapping = Mapping::equirect;  // equal_area needs a square image
 };
 
 // What the build measured and did; recorded in table files.
@@ -69,23 +72,29 @@ struct EnvMapView {
     const Rgb* radiance = nullptr;
     Axes axes;
     const SinCos* turns = nullptr;  // make_turn_table() (fast_math.h)
+    Mapping mapping = Mapping::equirect;
 
     ENVMIS_HD EnvSample sample(Vec2 u) const noexcept {
         const auto s = distribution.sample(u);
+        const Rgb l = radiance[static_cast<size_t>(s.y) * distribution.w + s.x];
+        if (mapping == Mapping::equal_area)
+            return {to_world(axes, equal_area_direction(s.p)), s.pdf * (1 / kFourPi), l, s.p};
         const SinCos theta = sincos_turns(turns, 0.5f * s.p.y), phi = sincos_turns(turns, s.p.x);
         const float sin_theta = max(theta.sin, 0.0f);
         const Vec3 canonical{sin_theta * phi.cos, sin_theta * phi.sin, theta.cos};
-        return {to_world(axes, canonical), solid_angle_pdf(s.pdf, sin_theta),
-                radiance[static_cast<size_t>(s.y) * distribution.w + s.x], s.p};
+        return {to_world(axes, canonical), solid_angle_pdf(s.pdf, sin_theta), l, s.p};
     }
     // Solid-angle pdf of sampling `direction` (a unit vector in the world frame).
-    ENVMIS_HD float pdf(Vec3 direction) const noexcept { return pdf_uv(equirect_uv(to_canonical(axes, direction))); }
+    ENVMIS_HD float pdf(Vec3 direction) const noexcept { return pdf_uv(uv_of(direction)); }
     // Solid-angle pdf at image point uv; bit-identical to sample(u).pdf when uv = sample(u).uv.
     ENVMIS_HD float pdf_uv(Vec2 uv) const noexcept {
+        if (mapping == Mapping::equal_area) return distribution.pdf(uv) * (1 / kFourPi);
         return solid_angle_pdf(distribution.pdf(uv), max(sincos_turns(turns, 0.5f * uv.y).sin, 0.0f));
     }
+    // Image point of a world direction.
+    ENVMIS_HD Vec2 uv_of(Vec3 direction) const noexcept { return image_uv(mapping, to_canonical(axes, direction)); }
     // Radiance arriving from `direction` (nearest texel).
-    ENVMIS_HD Rgb eval(Vec3 direction) const noexcept { return eval_uv(equirect_uv(to_canonical(axes, direction))); }
+    ENVMIS_HD Rgb eval(Vec3 direction) const noexcept { return eval_uv(uv_of(direction)); }
     ENVMIS_HD Rgb eval_uv(Vec2 uv) const noexcept {
         const uint32_t x = detail::cell_of(uv.x, distribution.w), y = detail::cell_of(uv.y, distribution.h);
         return radiance[static_cast<size_t>(y) * distribution.w + x];
@@ -96,7 +105,7 @@ struct EnvMapView {
         float pdf = 0;
     };
     ENVMIS_HD Lookup lookup(Vec3 direction) const noexcept {
-        const Vec2 uv = equirect_uv(to_canonical(axes, direction));
+        const Vec2 uv = uv_of(direction);
         return {eval_uv(uv), pdf_uv(uv)};
     }
     // Image density to solid angle; 0 at the poles, where the mapping degenerates.
@@ -114,13 +123,13 @@ public:
     explicit EnvMap(RgbImage image, const EnvMapOptions& options = {});
 
     // Rebuilds a saved sampler from its parts (the table reader's path): the image
-    // density q(x, y) sin(theta_y) exactly as density() returned it. Gives bit-identical
+    // density q(x, y) w_y exactly as density() returned it. Gives bit-identical
     // samples to the map that was saved. Throws std::invalid_argument on inconsistent parts.
     EnvMap(RgbImage radiance, std::span<const float> density, const EnvMapOptions& options,
            const EnvMapStats& stats);
 
     EnvMapView view() const noexcept {
-        return {distribution_.view(), radiance_.pixels.data(), options_.axes, turns_.data()};
+        return {distribution_.view(), radiance_.pixels.data(), options_.axes, turns_.data(), options_.mapping};
     }
     EnvSample sample(Vec2 u) const noexcept { return view().sample(u); }
     float pdf(Vec3 direction) const noexcept { return view().pdf(direction); }
@@ -133,7 +142,7 @@ public:
     const EnvMapStats& stats() const noexcept { return stats_; }
     const RgbImage& radiance() const noexcept { return radiance_; }
     const Distribution2D& distribution() const noexcept { return distribution_; }
-    // The image-space density function, q(x, y) sin(theta_y), row-major, recomputed
+    // The image-space density function, q(x, y) w_y, row-major, recomputed
     // from the radiance exactly as the build computed it.
     std::vector<float> density() const;
 

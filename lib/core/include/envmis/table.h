@@ -1,6 +1,6 @@
 // Table files: a built EnvMap saved to disk, readable with envmis::core alone.
 //
-// The format (version 1) is specified in docs/table-format.md: a fixed preamble (magic,
+// The format (version 2; version 1 files are read too) is specified in docs/table-format.md: a fixed preamble (magic,
 // version, byte order, total size), a metadata block with the build options and the
 // source's name and content hash, a header checksum, then the payload (the image
 // density q sin(theta) and the RGB radiance, both float32) and a payload checksum.
@@ -24,7 +24,7 @@
 
 namespace envmis {
 
-inline constexpr uint32_t kTableVersion = 1;
+inline constexpr uint32_t kTableVersion = 2;
 
 // Where a table's map came from.
 struct TableSource {

@@ -1,0 +1,380 @@
+// envmis_example_render: direct lighting from an environment map in a small CPU ray
+// tracer, written to show how a renderer uses envmis (docs/integration.md walks through
+// it). Three spheres (Lambertian, Phong, GGX) stand on a Lambertian ground plane under
+// the map. Each pixel sample traces one camera ray; where it hits a surface, the light
+// arriving from the map is estimated with one environment sample and one BSDF sample,
+// combined by multiple importance sampling (balance heuristic). A sample direction
+// that hits any object is in shadow; nothing bounces further.
+//
+// Whether the environment density is MIS-compensated is decided by the table: build it
+// with `envmis precompute MAP -o T.envmis` (compensated, the default) or with
+// `--no-compensate`. A compensated density is zero over the dim parts of the map, so it
+// must be combined with BSDF sampling; `--technique env` refuses such a table.
+//
+// Usage:
+//   envmis_example_render TABLE -o OUT.exr [--size WxH] [--spp N] [--seed S] [--threads T]
+//                         [--technique mis|env|bsdf]
+//       writes OUT.exr (linear RGB, the table's working colour space) and a tone-mapped
+//       OUT.png. The image depends on the seed only, not on the number of threads.
+//   envmis_example_render --compare REF A [B] [--expect-ratio R]
+//       prints the relative MSE of A (and B) against REF, EXR files of one size (see
+//       relative_mse). With B and R, exits 1 unless relMSE(B) >= R * relMSE(A).
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include "envmis/bsdf.h"
+#include "envmis/envmap.h"
+#include "envmis/frame.h"
+#include "envmis/io/image_io.h"
+#include "envmis/io/picture.h"
+#include "envmis/random.h"
+#include "envmis/table.h"
+
+namespace {
+
+using envmis::Rgb;
+using envmis::Vec2;
+using envmis::Vec3;
+
+Rgb operator+(Rgb a, Rgb b) { return {a.r + b.r, a.g + b.g, a.b + b.b}; }
+Rgb operator*(Rgb a, Rgb b) { return {a.r * b.r, a.g * b.g, a.b * b.b}; }
+Rgb operator*(Rgb a, float s) { return {a.r * s, a.g * s, a.b * s}; }
+bool is_black(Rgb c) { return c.r == 0 && c.g == 0 && c.b == 0; }
+
+// ---------------------------------------------------------------------------------------
+// The scene: world frame z up, the default of `envmis precompute` (--axes z-up).
+
+struct Ray {
+    Vec3 origin, direction;  // direction: a unit vector
+};
+
+struct Hit {
+    Vec3 point, normal;
+    const envmis::Bsdf* bsdf = nullptr;
+};
+
+struct Sphere {
+    Vec3 centre;
+    float radius;
+    envmis::Bsdf bsdf;
+};
+
+struct Scene {
+    std::vector<Sphere> spheres;
+    envmis::Bsdf ground;  // the plane z = 0, infinite
+
+    // The nearest surface along the ray, if any.
+    std::optional<Hit> intersect(const Ray& ray) const {
+        float nearest = INFINITY;
+        std::optional<Hit> hit;
+        for (const Sphere& s : spheres) {
+            const Vec3 oc = ray.origin - s.centre;
+            const float b = envmis::dot(oc, ray.direction), c = envmis::dot(oc, oc) - s.radius * s.radius;
+            const float disc = b * b - c;
+            if (disc < 0) continue;
+            const float root = std::sqrt(disc);
+            const float t = -b - root > 0 ? -b - root : -b + root;
+            if (t <= 0 || t >= nearest) continue;
+            nearest = t;
+            const Vec3 p = ray.origin + ray.direction * t;
+            hit = Hit{p, (p - s.centre) * (1 / s.radius), &s.bsdf};
+        }
+        if (ray.direction.z < 0 && ray.origin.z > 0) {
+            const float t = -ray.origin.z / ray.direction.z;
+            if (t < nearest) hit = Hit{ray.origin + ray.direction * t, {0, 0, 1}, &ground};
+        }
+        return hit;
+    }
+    // True if light from `direction` cannot reach `hit`: some object is in the way.
+    bool occluded(const Hit& hit, Vec3 direction) const {
+        return intersect({hit.point + hit.normal * 1e-4f, direction}).has_value();
+    }
+};
+
+Scene make_scene() {
+    return {{{{-1.6f, 0, 0.7f}, 0.7f, envmis::Bsdf::lambert({0.75f, 0.25f, 0.2f})},
+             {{0, 0, 0.7f}, 0.7f, envmis::Bsdf::phong(50, {0.8f, 0.8f, 0.8f})},
+             {{1.6f, 0, 0.7f}, 0.7f, envmis::Bsdf::ggx(0.1f)}},
+            envmis::Bsdf::lambert({0.5f, 0.5f, 0.5f})};
+}
+
+// A pinhole camera; (x, y) in [0,1)^2 across the image, y down.
+struct Camera {
+    Vec3 position, forward, right, up;  // right and up scaled to the image's half extent
+
+    Camera(Vec3 from, Vec3 at, float vertical_fov_degrees, float aspect) : position(from) {
+        forward = envmis::normalize(at - from);
+        const float half = std::tan(0.5f * vertical_fov_degrees * envmis::kPiF / 180);
+        right = envmis::normalize(envmis::cross(forward, {0, 0, 1})) * (half * aspect);
+        up = envmis::cross(envmis::normalize(right), forward) * half;
+    }
+    Ray ray(float x, float y) const {
+        return {position, envmis::normalize(forward + right * (2 * x - 1) + up * (1 - 2 * y))};
+    }
+};
+
+// ---------------------------------------------------------------------------------------
+// Direct lighting: the part a renderer copies.
+
+enum class Technique { mis, env, bsdf };
+
+// Radiance leaving `hit` towards the viewer (world direction `to_viewer`): light from
+// the map, reflected once. MIS spends one environment and one BSDF sample.
+Rgb direct_lighting(const envmis::EnvMapView& env, const Scene& scene, const Hit& hit, Vec3 to_viewer,
+                    Technique technique, envmis::Pcg32& rng) {
+    // BSDFs work in the local shading frame (z = normal); the map in world directions.
+    const envmis::Frame frame = envmis::Frame::from_normal(hit.normal);
+    const Vec3 wo = frame.to_local(to_viewer);
+    const envmis::Bsdf& bsdf = *hit.bsdf;
+    Rgb result;
+
+    // 1. Sample the map; weight against the density BSDF sampling has for that direction.
+    if (technique != Technique::bsdf) {
+        const envmis::EnvSample light = env.sample(rng.uniform2());  // world direction, solid-angle pdf
+        const Vec3 wi = frame.to_local(light.direction);
+        const Rgb f = bsdf.eval(wo, wi);  // f * cos(theta_i)
+        if (light.pdf > 0 && !is_black(f) && !scene.occluded(hit, light.direction)) {
+            const float weight = technique == Technique::mis ? light.pdf / (light.pdf + bsdf.pdf(wo, wi)) : 1.0f;
+            result = result + light.radiance * f * (weight / light.pdf);
+        }
+    }
+    // 2. Sample the BSDF; weight against the density the map gives that direction. Where
+    //    a compensated map's density is 0, the weight is 1: BSDF sampling covers it alone.
+    if (technique != Technique::env) {
+        const envmis::BsdfSample s = bsdf.sample(wo, rng.uniform2());  // local direction, value = f * cos
+        const Vec3 direction = frame.to_world(s.wi);
+        if (s.pdf > 0 && !is_black(s.value) && !scene.occluded(hit, direction)) {
+            const auto [radiance, env_pdf] = env.lookup(direction);  // eval and pdf at once
+            const float weight = technique == Technique::mis ? s.pdf / (s.pdf + env_pdf) : 1.0f;
+            result = result + radiance * s.value * (weight / s.pdf);
+        }
+    }
+    return result;
+}
+
+// Radiance along a camera ray: the map where it escapes, else the lit surface.
+Rgb trace(const envmis::EnvMapView& env, const Scene& scene, const Ray& ray, Technique technique,
+          envmis::Pcg32& rng) {
+    const std::optional<Hit> hit = scene.intersect(ray);
+    if (!hit) return env.eval(ray.direction);
+    return direct_lighting(env, scene, *hit, ray.direction * -1.0f, technique, rng);
+}
+
+// ---------------------------------------------------------------------------------------
+// The image: rows shared among threads, one random stream per pixel, so the result
+// depends on the seed only.
+
+struct Options {
+    std::filesystem::path table, output;
+    uint32_t width = 480, height = 320, spp = 16, threads = std::max(1u, std::thread::hardware_concurrency());
+    uint64_t seed = 1;
+    Technique technique = Technique::mis;
+};
+
+envmis::RgbImage render(const envmis::EnvMapView& env, const Options& o) {
+    const Scene scene = make_scene();
+    const Camera camera({0, -7.5f, 2.2f}, {0, 0, 0.55f}, 30, static_cast<float>(o.width) / static_cast<float>(o.height));
+    envmis::RgbImage image{o.width, o.height, std::vector<Rgb>(size_t{o.width} * o.height)};
+    std::atomic<uint32_t> next_row{0};
+    auto work = [&] {
+        for (uint32_t y; (y = next_row.fetch_add(1)) < o.height;)
+            for (uint32_t x = 0; x < o.width; ++x) {
+                const size_t pixel = size_t{y} * o.width + x;
+                envmis::Pcg32 rng(o.seed, pixel);
+                Rgb sum;
+                for (uint32_t i = 0; i < o.spp; ++i) {
+                    const Vec2 jitter = rng.uniform2();
+                    const Ray ray = camera.ray((static_cast<float>(x) + jitter.x) / static_cast<float>(o.width),
+                                               (static_cast<float>(y) + jitter.y) / static_cast<float>(o.height));
+                    sum = sum + trace(env, scene, ray, o.technique, rng);
+                }
+                image.pixels[pixel] = sum * (1.0f / static_cast<float>(o.spp));
+            }
+    };
+    {
+        std::vector<std::jthread> pool;
+        for (uint32_t i = 1; i < o.threads; ++i) pool.emplace_back(work);
+        work();
+    }
+    return image;
+}
+
+int run_render(const Options& o) {
+    const envmis::Table table = envmis::read_table(o.table);  // checks sizes, checksums, version
+    const envmis::EnvMap& map = table.map;
+    if (map.options().axes != envmis::Axes{})
+        std::fprintf(stderr, "note: %s was built for axes %s; this scene is z up, so the map appears turned\n",
+                     o.table.string().c_str(), map.options().axes.to_string().c_str());
+    // A compensated density is 0 wherever the map is dimmer than alpha times its mean:
+    // sampled alone it would miss that light. Only MIS with BSDF sampling is unbiased.
+    if (!map.complete()) {
+        if (o.technique == Technique::env)
+            throw std::runtime_error(o.table.string() + ": compensated table (its density is 0 over " +
+                                     std::to_string(map.stats().zeroed_texels) +
+                                     " lit texels): it cannot be sampled alone; use --technique mis");
+        std::fprintf(stderr, "note: compensated table: %llu lit texels are left to BSDF sampling through MIS\n",
+                     static_cast<unsigned long long>(map.stats().zeroed_texels));
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const envmis::RgbImage image = render(map.view(), o);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+    std::filesystem::path png = o.output;
+    png.replace_extension(".png");
+    envmis::io::write_exr(o.output, image);
+    envmis::io::write_png(png, envmis::io::tonemap(image, 0, map.options().luma));
+    const char* names[] = {"1 environment + 1 BSDF sample, balance heuristic", "1 environment sample", "1 BSDF sample"};
+    std::printf("%s: %ux%u, %u spp (%s), %s density, %.2f s -> %s, %s\n", o.table.string().c_str(), o.width, o.height,
+                o.spp, names[static_cast<int>(o.technique)], map.compensated() ? "compensated" : "plain", seconds,
+                o.output.string().c_str(), png.string().c_str());
+    return 0;
+}
+
+// ---------------------------------------------------------------------------------------
+// --compare: relative MSE of renders against a reference.
+
+envmis::RgbImage read_exr(const std::filesystem::path& path) {
+    // Read as written: no colour conversion (the working space to itself).
+    return envmis::io::load_image(path, {"lin_rec709", "lin_rec709"}).image;
+}
+
+// Mean over pixels of (Y - Y_ref)^2 / (Y_ref^2 + 0.01), Y the luminance: the usual
+// relative MSE, whose 0.01 keeps nearly black pixels from dominating. It assumes a
+// display-like scale (this scene under rooitou_park_1k.hdr has mean luminance 0.33).
+double relative_mse(const envmis::RgbImage& image, const envmis::RgbImage& reference, const std::string& name) {
+    if (image.width != reference.width || image.height != reference.height)
+        throw std::runtime_error(name + ": size differs from the reference's");
+    double sum = 0;
+    for (size_t i = 0; i < image.pixels.size(); ++i) {
+        const double ref = envmis::luminance(reference.pixels[i], {});
+        const double d = envmis::luminance(image.pixels[i], {}) - ref;
+        sum += d * d / (ref * ref + 0.01);
+    }
+    return sum / static_cast<double>(image.pixels.size());
+}
+
+int run_compare(const std::vector<std::string>& files, double expect_ratio) {
+    const envmis::RgbImage reference = read_exr(files[0]);
+    std::vector<double> errors;
+    for (size_t i = 1; i < files.size(); ++i) {
+        errors.push_back(relative_mse(read_exr(files[i]), reference, files[i]));
+        std::printf("relMSE %c  %-10.4g %s\n", i == 1 ? 'A' : 'B', errors.back(), files[i].c_str());
+    }
+    if (errors.size() < 2) return 0;
+    const double ratio = errors[1] / errors[0];
+    std::printf("B / A     %.3g\n", ratio);
+    if (expect_ratio > 0) {
+        const bool ok = ratio >= expect_ratio;
+        std::printf("%s: relMSE(B) %s %g x relMSE(A)\n", ok ? "ok" : "FAIL", ok ? ">=" : "<", expect_ratio);
+        return ok ? 0 : 1;
+    }
+    return 0;
+}
+
+// ---------------------------------------------------------------------------------------
+
+// A command-line mistake: reported with the usage text, exit status 2.
+struct UsageError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+const char* const kUsage =
+    "usage: envmis_example_render TABLE -o OUT.exr [--size WxH] [--spp N] [--seed S] [--threads T]\n"
+    "                             [--technique mis|env|bsdf]\n"
+    "       envmis_example_render --compare REF A [B] [--expect-ratio R]\n";
+
+uint64_t parse_number(std::string_view flag, const std::string& text, uint64_t lo, uint64_t hi) {
+    size_t used = 0;
+    uint64_t value = 0;
+    try {
+        value = std::stoull(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used != text.size() || text.empty() || text[0] == '-' || value < lo || value > hi)
+        throw UsageError(std::string(flag) + " '" + text + "': expected an integer from " +
+                                    std::to_string(lo) + " to " + std::to_string(hi));
+    return value;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    try {
+        Options o;
+        std::vector<std::string> positional;
+        bool compare = false;
+        double expect_ratio = 0;
+        for (int i = 1; i < argc; ++i) {
+            const std::string arg = argv[i];
+            auto value = [&]() -> std::string {
+                if (i + 1 >= argc) throw UsageError(arg + ": missing value");
+                return argv[++i];
+            };
+            if (arg == "-h" || arg == "--help") {
+                std::fputs(kUsage, stdout);
+                return 0;
+            } else if (arg == "-o" || arg == "--output") {
+                o.output = value();
+            } else if (arg == "--size") {
+                const std::string text = value();
+                const size_t x = text.find('x');
+                if (x == std::string::npos) throw UsageError("--size '" + text + "': expected WxH");
+                o.width = static_cast<uint32_t>(parse_number("--size", text.substr(0, x), 1, 16384));
+                o.height = static_cast<uint32_t>(parse_number("--size", text.substr(x + 1), 1, 16384));
+            } else if (arg == "--spp") {
+                o.spp = static_cast<uint32_t>(parse_number(arg, value(), 1, 1u << 20));
+            } else if (arg == "--seed") {
+                o.seed = parse_number(arg, value(), 0, UINT64_MAX);
+            } else if (arg == "--threads") {
+                o.threads = static_cast<uint32_t>(parse_number(arg, value(), 1, 1024));
+            } else if (arg == "--technique") {
+                const std::string t = value();
+                if (t == "mis") o.technique = Technique::mis;
+                else if (t == "env") o.technique = Technique::env;
+                else if (t == "bsdf") o.technique = Technique::bsdf;
+                else throw UsageError("--technique '" + t + "': expected mis, env or bsdf");
+            } else if (arg == "--compare") {
+                compare = true;
+            } else if (arg == "--expect-ratio") {
+                const std::string text = value();
+                char* end = nullptr;
+                expect_ratio = std::strtod(text.c_str(), &end);
+                if (text.empty() || *end != 0 || !(expect_ratio > 0))
+                    throw UsageError("--expect-ratio '" + text + "': expected a positive number");
+            } else if (arg.size() > 1 && arg[0] == '-') {
+                throw UsageError(arg + ": unknown option");
+            } else {
+                positional.push_back(arg);
+            }
+        }
+        if (compare) {
+            if (positional.size() < 2 || positional.size() > 3)
+                throw UsageError("--compare takes a reference and one or two images");
+            return run_compare(positional, expect_ratio);
+        }
+        if (positional.size() != 1 || o.output.extension() != ".exr")
+            throw UsageError("expected TABLE and -o OUT.exr");
+        o.table = positional[0];
+        return run_render(o);
+    } catch (const UsageError& e) {
+        std::fprintf(stderr, "envmis_example_render: %s\n%s", e.what(), kUsage);
+        return 2;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "envmis_example_render: %s\n", e.what());
+        return 1;
+    }
+}
