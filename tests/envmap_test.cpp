@@ -143,6 +143,20 @@ TEST(EnvMap, EqualAreaMapsFollowTheirDensity) {
     EXPECT_THROW(EnvMap(test::random_map(8, 4, 1), o), std::invalid_argument);  // not square
 }
 
+// The table writer streams the density a row at a time: the rows are density()'s.
+TEST(EnvMap, DensityRowsAreTheDensity) {
+    const EnvMap map(test::random_map(13, 7, 8), options(true));
+    const std::vector<float> all = map.density();
+    std::vector<float> row(13);
+    for (uint32_t y = 0; y < 7; ++y) {
+        map.density_row(y, row);
+        for (uint32_t x = 0; x < 13; ++x) ASSERT_EQ(row[x], all[size_t{y} * 13 + x]);
+    }
+    EXPECT_THROW(map.density_row(7, row), std::invalid_argument);
+    std::vector<float> short_row(12);
+    EXPECT_THROW(map.density_row(0, short_row), std::invalid_argument);
+}
+
 TEST(EnvMap, CompensationStrengthAlphaIsHonoured) {
     const RgbImage image = test::random_map(32, 16, 3);
     for (float alpha : {0.0f, 0.5f, 2.0f}) {

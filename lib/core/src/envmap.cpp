@@ -164,7 +164,7 @@ bool scan_row(const Rgb* pixels, uint32_t w, const LumaCoefficients& luma, uint3
 
 // Pass 2: row y of the density q w_y (mapping.h: row_weight) from its luminance bits; returns the
 // number of texels with L > 0 that compensation zeroes.
-uint32_t density_row(const uint32_t* luminance, uint32_t w, float weight, float threshold, bool uniform,
+uint32_t fill_density_row(const uint32_t* luminance, uint32_t w, float weight, float threshold, bool uniform,
                      float* row) noexcept {
     if (uniform) {
         std::fill_n(row, w, weight);
@@ -219,7 +219,7 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : radiance_(std::mo
     if (options_.compensation.enabled && stats_.fallback == DensityFallback::none)
         stats_.threshold = compensation_threshold(stats_.mean_luminance, options_.compensation.alpha);
     const auto density = [&](uint32_t y, std::span<const uint32_t> cells, std::span<float> row) {
-        rows[y].zeroed = density_row(cells.data(), w, row_weight(options_.mapping, y, h), stats_.threshold,
+        rows[y].zeroed = fill_density_row(cells.data(), w, row_weight(options_.mapping, y, h), stats_.threshold,
                                      stats_.fallback == DensityFallback::uniform, row.data());
     };
     distribution_ = Distribution2D(w, h, std::move(luminance_bits), density);
@@ -237,7 +237,7 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : radiance_(std::mo
     stats_.min_positive_luminance = std::isfinite(min_positive) ? min_positive : 0.0f;
 }
 
-EnvMap::EnvMap(RgbImage radiance, std::span<const float> density, const EnvMapOptions& options,
+EnvMap::EnvMap(RgbImage radiance, LargeVector<uint32_t> density_bits, const EnvMapOptions& options,
                const EnvMapStats& stats)
     : radiance_(std::move(radiance)), options_(options), stats_(stats) {
     check_image(radiance_, options_.mapping);
@@ -250,20 +250,30 @@ EnvMap::EnvMap(RgbImage radiance, std::span<const float> density, const EnvMapOp
         bad += b.total();
     }
     if (bad) throw std::invalid_argument(std::to_string(bad) + " radiance values are negative, NaN or infinite");
-    distribution_ = Distribution2D(density, radiance_.width, radiance_.height);
+    const uint32_t w = radiance_.width;
+    distribution_ = Distribution2D(w, radiance_.height, std::move(density_bits),
+                                   [w](uint32_t, std::span<const uint32_t> bits, std::span<float> row) {
+                                       for (uint32_t x = 0; x < w; ++x) row[x] = std::bit_cast<float>(bits[x]);
+                                   });
 }
 
 std::vector<float> EnvMap::density() const {
     const uint32_t w = width(), h = height();
     std::vector<float> out(size_t{w} * h);
+    for (uint32_t y = 0; y < h; ++y) density_row(y, std::span(out).subspan(size_t{y} * w, w));
+    return out;
+}
+
+void EnvMap::density_row(uint32_t y, std::span<float> row) const {
+    const uint32_t w = width();
+    if (y >= height() || row.size() != w)
+        throw std::invalid_argument("density_row: row " + std::to_string(y) + " of " + std::to_string(row.size()) +
+                                    " values, the map is " + std::to_string(w) + "x" + std::to_string(height()));
     std::vector<uint32_t> luminance(w);
     RowStats unused;
-    for (uint32_t y = 0; y < h; ++y) {
-        scan_row(radiance_.pixels.data() + size_t{y} * w, w, options_.luma, luminance.data(), unused);
-        density_row(luminance.data(), w, row_weight(options_.mapping, y, h), stats_.threshold,
-                    stats_.fallback == DensityFallback::uniform, out.data() + size_t{y} * w);
-    }
-    return out;
+    scan_row(radiance_.pixels.data() + size_t{y} * w, w, options_.luma, luminance.data(), unused);
+    fill_density_row(luminance.data(), w, row_weight(options_.mapping, y, height()), stats_.threshold,
+                        stats_.fallback == DensityFallback::uniform, row.data());
 }
 
 }  // namespace envmis

@@ -126,9 +126,8 @@ void write_table(const std::filesystem::path& path, const EnvMap& map, const Tab
         if (s->size() > kMaxStringSize)
             throw TableError(path.string() + ": metadata string longer than " + std::to_string(kMaxStringSize) + " bytes");
     const std::vector<std::byte> metadata = metadata_block(map, source);
-    const std::vector<float> density = map.density();
     const auto& radiance = map.radiance().pixels;
-    const uint64_t payload = density.size() * sizeof(float) + radiance.size() * sizeof(Rgb);
+    const uint64_t payload = radiance.size() * (sizeof(float) + sizeof(Rgb));
     const uint64_t total = kPreambleSize + metadata.size() + 8 + payload + 8;
 
     ByteWriter head;
@@ -141,8 +140,17 @@ void write_table(const std::filesystem::path& path, const EnvMap& map, const Tab
     head.bytes.insert(head.bytes.end(), metadata.begin(), metadata.end());
     head.put(hash64(head.bytes));
 
+    // The density is computed a row at a time, twice (for the checksum, then to write):
+    // cheaper than holding a copy of the map's size.
+    std::vector<float> row(map.width());
+    const auto for_each_density_row = [&](auto&& use) {
+        for (uint32_t y = 0; y < map.height(); ++y) {
+            map.density_row(y, row);
+            use(as_bytes_of(row));
+        }
+    };
     Hasher payload_hash;
-    payload_hash.update(as_bytes_of(density));
+    for_each_density_row([&](std::span<const std::byte> bytes) { payload_hash.update(bytes); });
     payload_hash.update(as_bytes_of(radiance));
     const uint64_t payload_digest = payload_hash.digest();
 
@@ -152,7 +160,7 @@ void write_table(const std::filesystem::path& path, const EnvMap& map, const Tab
                 out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
             };
             write(head.bytes);
-            write(as_bytes_of(density));
+            for_each_density_row(write);
             write(as_bytes_of(radiance));
             write(std::as_bytes(std::span(&payload_digest, 1)));
         });
@@ -161,9 +169,22 @@ void write_table(const std::filesystem::path& path, const EnvMap& map, const Tab
     }
 }
 
-Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
-    Cursor in(bytes, name);
-    if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+namespace {
+
+// What the header (preamble, metadata, header checksum) says; the payload follows.
+struct Header {
+    uint32_t w = 0, h = 0;
+    EnvMapOptions options;
+    EnvMapStats stats;
+    TableSource source;
+    uint64_t payload_offset = 0;
+};
+
+// Parses and checks the header from `head`, the first bytes of a file of `file_size`
+// bytes (all of it, or at least the preamble, metadata and header checksum).
+Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::string_view name) {
+    Cursor in(head, name);
+    if (head.size() < sizeof kMagic || std::memcmp(head.data(), kMagic, sizeof kMagic) != 0)
         in.fail("not an envmis table (bad magic)");
     in.take_bytes(sizeof kMagic, "magic");
     const auto version = in.take<uint32_t>("version");
@@ -175,30 +196,31 @@ Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
                 std::to_string(kTableVersion) + "); upgrade envmis");
     if (version != kTableVersion && version != 1) in.fail("unknown format version " + std::to_string(version));
     const auto total = in.take<uint64_t>("file size");
-    if (total != bytes.size())
-        in.fail(total > bytes.size() ? "truncated: header says " + std::to_string(total) + " bytes, file has " +
-                                           std::to_string(bytes.size())
-                                     : "header says " + std::to_string(total) + " bytes, file has " +
-                                           std::to_string(bytes.size()) + " (trailing data)");
+    if (total != file_size)
+        in.fail(total > file_size ? "truncated: header says " + std::to_string(total) + " bytes, file has " +
+                                        std::to_string(file_size)
+                                  : "header says " + std::to_string(total) + " bytes, file has " +
+                                        std::to_string(file_size) + " (trailing data)");
     const auto metadata_size = in.take<uint32_t>("metadata size");
     in.take<uint32_t>("reserved");
     if (metadata_size > kMaxMetadataSize) in.fail("metadata block of " + std::to_string(metadata_size) + " bytes is too large");
     in.need(uint64_t{metadata_size} + 8, "metadata and header checksum");
-    const uint64_t header_digest = hash64(bytes.first(kPreambleSize + metadata_size));
+    const uint64_t header_digest = hash64(head.first(kPreambleSize + metadata_size));
 
-    Cursor meta(bytes.subspan(kPreambleSize, metadata_size), name);
-    const auto w = meta.take<uint32_t>("width");
-    const auto h = meta.take<uint32_t>("height");
+    Header out;
+    Cursor meta(head.subspan(kPreambleSize, metadata_size), name);
+    out.w = meta.take<uint32_t>("width");
+    out.h = meta.take<uint32_t>("height");
     const auto sampler = meta.take<uint32_t>("sampler kind");
     const auto flags = meta.take<uint32_t>("flags");
-    EnvMapOptions options;
+    EnvMapOptions& options = out.options;
     options.compensation.enabled = flags & kFlagCompensation;
     options.compensation.alpha = meta.take<float>("alpha");
     options.luma = meta.take<LumaCoefficients>("luma coefficients");
     options.axes = meta.take<Axes>("axes");
     // Version 1 had a reserved 0 here: every version 1 table is equirectangular.
     const auto mapping = meta.take<uint8_t>("mapping");
-    EnvMapStats stats;
+    EnvMapStats& stats = out.stats;
     stats.mean_luminance = meta.take<double>("mean luminance");
     stats.threshold = meta.take<float>("threshold");
     stats.max_luminance = meta.take<float>("max luminance");
@@ -208,7 +230,7 @@ Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
     stats.bad_pixels.nan = meta.take<uint64_t>("NaN count");
     stats.bad_pixels.infinite = meta.take<uint64_t>("Inf count");
     stats.bad_pixels.negative = meta.take<uint64_t>("negative count");
-    TableSource source;
+    TableSource& source = out.source;
     source.content_hash = meta.take<uint64_t>("source hash");
     source.name = meta.take_string("source name");
     source.input_colorspace = meta.take_string("input colour space");
@@ -217,6 +239,7 @@ Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
     in.take_bytes(metadata_size, "metadata");
     if (in.take<uint64_t>("header checksum") != header_digest) in.fail("corrupted header (checksum mismatch)");
     if (meta.position() != metadata_size) in.fail("metadata block has " + std::to_string(metadata_size - meta.position()) + " unexpected bytes");
+    const uint32_t w = out.w, h = out.h;
     if (w == 0 || h == 0 || w > kMaxCells1D || h > kMaxCells1D || uint64_t{w} * h > kMaxTexels)
         in.fail("invalid size " + std::to_string(w) + "x" + std::to_string(h));
     if (sampler != kSamplerCdf) in.fail("unknown sampler kind " + std::to_string(sampler));
@@ -228,25 +251,54 @@ Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
     if (fallback > static_cast<uint32_t>(DensityFallback::uniform)) in.fail("unknown fallback " + std::to_string(fallback));
     stats.fallback = static_cast<DensityFallback>(fallback);
 
-    const uint64_t texels = uint64_t{w} * h;
-    const auto density_bytes = in.take_bytes(texels * sizeof(float), "density");
-    const auto radiance_bytes = in.take_bytes(texels * sizeof(Rgb), "radiance");
-    Hasher payload_hash;
-    payload_hash.update(density_bytes);
-    payload_hash.update(radiance_bytes);
-    if (in.take<uint64_t>("payload checksum") != payload_hash.digest()) in.fail("corrupted payload (checksum mismatch)");
-    if (in.position() != bytes.size())
-        in.fail(std::to_string(bytes.size() - in.position()) + " bytes of trailing data after the payload");
+    // The payload's size, checked against the file before anything is allocated for it.
+    out.payload_offset = in.position();
+    const uint64_t texels = uint64_t{w} * h, payload = texels * (sizeof(float) + sizeof(Rgb)) + 8;
+    const uint64_t left = file_size - out.payload_offset;
+    if (payload > left)
+        in.fail("truncated: payload needs " + std::to_string(payload) + " bytes, " + std::to_string(left) + " left");
+    if (payload < left)
+        in.fail(std::to_string(left - payload) + " bytes of trailing data after the payload");
+    return out;
+}
 
-    std::vector<float> density(texels);
-    std::memcpy(density.data(), density_bytes.data(), density_bytes.size());
-    RgbImage radiance{w, h, std::vector<Rgb>(texels)};
-    std::memcpy(radiance.pixels.data(), radiance_bytes.data(), radiance_bytes.size());
+// Reads the payload with `read(destination, bytes)` (in file order) straight into the
+// buffers the map keeps: the density's bits become the CDF table, the radiance the
+// image; nothing else of the payload's size is held. Then checks its checksum.
+template <class Read>
+Table read_payload(Header header, Read&& read, std::string_view name) {
+    const uint64_t texels = uint64_t{header.w} * header.h;
+    LargeVector<uint32_t> density(texels);
+    RgbImage radiance{header.w, header.h, std::vector<Rgb>(texels)};
+    uint64_t digest = 0;
+    read(density.data(), texels * sizeof(float));
+    read(radiance.pixels.data(), texels * sizeof(Rgb));
+    read(&digest, sizeof digest);
+    Hasher payload_hash;
+    payload_hash.update(std::as_bytes(std::span(density.data(), density.size())));
+    payload_hash.update(std::as_bytes(std::span(radiance.pixels)));
+    const auto fail = [&](const std::string& problem) { throw TableError(std::string(name) + ": " + problem); };
+    if (digest != payload_hash.digest()) fail("corrupted payload (checksum mismatch)");
     try {
-        return {EnvMap(std::move(radiance), density, options, stats), std::move(source)};
+        return {EnvMap(std::move(radiance), std::move(density), header.options, header.stats), std::move(header.source)};
     } catch (const std::invalid_argument& e) {
-        in.fail(std::string("inconsistent contents: ") + e.what());
+        fail(std::string("inconsistent contents: ") + e.what());
     }
+    return {};
+}
+
+}  // namespace
+
+Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
+    Header header = parse_header(bytes, bytes.size(), name);
+    size_t pos = static_cast<size_t>(header.payload_offset);
+    return read_payload(
+        std::move(header),
+        [&](void* destination, uint64_t size) {
+            std::memcpy(destination, bytes.data() + pos, static_cast<size_t>(size));
+            pos += static_cast<size_t>(size);
+        },
+        name);
 }
 
 Table read_table(const std::filesystem::path& path) {
@@ -257,10 +309,20 @@ Table read_table(const std::filesystem::path& path) {
     if (!file) throw TableError(describe_errno(path, "open"));
     const std::streamoff size = file.tellg();
     if (size < 0) throw TableError(path.string() + ": cannot determine the file size");
-    std::vector<std::byte> bytes(static_cast<size_t>(size));
+    // The header is at most 32 + 64 KiB + 8 bytes; the payload goes straight to its place.
+    std::vector<std::byte> head(std::min<size_t>(static_cast<size_t>(size), kPreambleSize + kMaxMetadataSize + 8));
     file.seekg(0);
-    if (!file.read(reinterpret_cast<char*>(bytes.data()), size)) throw TableError(describe_errno(path, "read"));
-    return parse_table(bytes, path.string());
+    if (!file.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size())))
+        throw TableError(describe_errno(path, "read"));
+    Header header = parse_header(head, static_cast<uint64_t>(size), path.string());
+    file.seekg(static_cast<std::streamoff>(header.payload_offset));
+    return read_payload(
+        std::move(header),
+        [&](void* destination, uint64_t bytes) {
+            if (!file.read(static_cast<char*>(destination), static_cast<std::streamsize>(bytes)))
+                throw TableError(describe_errno(path, "read"));
+        },
+        path.string());
 }
 
 bool looks_like_table(const std::filesystem::path& path) noexcept {

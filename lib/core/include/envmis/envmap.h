@@ -123,9 +123,11 @@ public:
     explicit EnvMap(RgbImage image, const EnvMapOptions& options = {});
 
     // Rebuilds a saved sampler from its parts (the table reader's path): the image
-    // density q(x, y) w_y exactly as density() returned it. Gives bit-identical
-    // samples to the map that was saved. Throws std::invalid_argument on inconsistent parts.
-    EnvMap(RgbImage radiance, std::span<const float> density, const EnvMapOptions& options,
+    // density q(x, y) w_y exactly as density() returned it, as float bit patterns; that
+    // buffer becomes the CDF table, so a load holds nothing else of the map's size. Gives
+    // bit-identical samples to the map that was saved. Throws std::invalid_argument on
+    // inconsistent parts.
+    EnvMap(RgbImage radiance, LargeVector<uint32_t> density_bits, const EnvMapOptions& options,
            const EnvMapStats& stats);
 
     EnvMapView view() const noexcept {
@@ -145,6 +147,8 @@ public:
     // The image-space density function, q(x, y) w_y, row-major, recomputed
     // from the radiance exactly as the build computed it.
     std::vector<float> density() const;
+    // Row y of density() (w values), for writers that stream it.
+    void density_row(uint32_t y, std::span<float> row) const;
 
     // True if the density was compensated (and no fallback replaced it).
     bool compensated() const noexcept {
