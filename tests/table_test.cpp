@@ -1,6 +1,8 @@
 // Specification of table files (table.h, docs/table-format.md).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -122,6 +124,65 @@ TEST_F(TableTest, ForeignFilesAreRejected) {
     expect_rejected(path, "not an envmis table");
     expect_rejected(dir_ / "missing.envmis", "no such file");
     expect_rejected(dir_, "not a regular file");
+}
+
+// A compact table stores RGBE radiance (4 bytes a texel) and loads as the map built
+// from the RGBE-rounded radiance, bit for bit; damage is still caught.
+TEST_F(TableTest, CompactTablesHoldTheRoundedMap) {
+    EnvMapOptions o;
+    o.compensation.alpha = 0.75f;
+    RgbImage image = test::random_map(96, 48, 11, 8);
+    image.pixels[5] = {NAN, 1, 2};  // repaired and counted by the map; the count is kept
+    const EnvMap map(image, o);
+    const fs::path path = dir_ / "compact.envmis";
+    write_table(path, map, source_, TableEncoding::compact);
+    const fs::path full = dir_ / "full.envmis";
+    write_table(full, map, source_);
+    EXPECT_EQ(fs::file_size(full) - fs::file_size(path), 96u * 48 * 12);
+
+    const Table loaded = read_table(path);
+    const EnvMap rounded(rgbe_round(map.radiance()), o);
+    EXPECT_EQ(loaded.map.stats().bad_pixels.nan, 1u);
+    EXPECT_EQ(loaded.map.stats().threshold, rounded.stats().threshold);
+    test::Rng rng(12);
+    for (int i = 0; i < 10000; ++i) {
+        const Vec2 u = rng.uniform2();
+        const EnvSample a = rounded.sample(u), b = loaded.map.sample(u);
+        ASSERT_EQ(a.pdf, b.pdf);
+        ASSERT_EQ(a.direction.y, b.direction.y);
+        ASSERT_EQ(a.radiance.g, b.radiance.g);
+    }
+
+    std::vector<char> bytes = bytes_of(path);
+    bytes[bytes.size() - 20] ^= 0x10;
+    write_bytes(path, bytes);
+    expect_rejected(path, "corrupted payload");
+}
+
+// RGBE keeps each pixel's largest channel within half a step of its 8-bit mantissa
+// (0.4%), the others within half a step of the largest's scale; black stays black.
+TEST(Rgbe, RoundingErrorIsBounded) {
+    test::Rng rng(13);
+    RgbImage image{1000, 1, {}};
+    for (int i = 0; i < 1000; ++i) {
+        const float scale = std::pow(10.0f, 16 * rng.uniform() - 8);
+        image.pixels.push_back({scale * rng.uniform(), scale * rng.uniform(), scale * rng.uniform()});
+    }
+    image.pixels[0] = {0, 0, 0};
+    image.pixels[1] = {1.6e38f, 1, 0};  // the largest RGBE represents
+    const RgbImage rounded = rgbe_round(image);
+    EXPECT_EQ(rounded.pixels[0].r, 0.0f);
+    EXPECT_GT(rgbe_round({1, 1, {{3e38f, 0, 0}}}).pixels[0].r, 1.6e38f);  // saturates, never wraps to black
+    for (size_t i = 0; i < image.pixels.size(); ++i) {
+        const Rgb a = image.pixels[i], b = rounded.pixels[i];
+        const float m = std::max({a.r, a.g, a.b});
+        for (auto [x, y] : {std::pair{a.r, b.r}, std::pair{a.g, b.g}, std::pair{a.b, b.b}}) {
+            ASSERT_TRUE(std::isfinite(y)) << i;
+            ASSERT_LE(std::abs(x - y), m / 255) << i;  // half a step of 2^e / 256 with m >= 2^(e-1)
+        }
+        const float bm = std::max({b.r, b.g, b.b});
+        ASSERT_LE(std::abs(bm - m), m / 256) << i;
+    }
 }
 
 TEST_F(TableTest, EqualAreaTablesRoundTrip) {

@@ -266,14 +266,24 @@ std::vector<float> EnvMap::density() const {
 
 void EnvMap::density_row(uint32_t y, std::span<float> row) const {
     const uint32_t w = width();
-    if (y >= height() || row.size() != w)
-        throw std::invalid_argument("density_row: row " + std::to_string(y) + " of " + std::to_string(row.size()) +
-                                    " values, the map is " + std::to_string(w) + "x" + std::to_string(height()));
+    if (y >= height())
+        throw std::invalid_argument("density_row: row " + std::to_string(y) + " of a map " + std::to_string(height()) +
+                                    " high");
+    envmis::density_row(std::span(radiance_.pixels).subspan(size_t{y} * w, w), y, height(), options_, stats_, row);
+}
+
+void density_row(std::span<const Rgb> radiance_row, uint32_t y, uint32_t h, const EnvMapOptions& options,
+                 const EnvMapStats& stats, std::span<float> out) {
+    const auto w = static_cast<uint32_t>(radiance_row.size());
+    if (out.size() != w || y >= h)
+        throw std::invalid_argument("density_row: " + std::to_string(out.size()) + " outputs for a row of " +
+                                    std::to_string(w) + " (row " + std::to_string(y) + " of " + std::to_string(h) + ")");
+    // scan_row repairs nothing: a map's radiance is clean, and so is a decoded table's.
     std::vector<uint32_t> luminance(w);
     RowStats unused;
-    scan_row(radiance_.pixels.data() + size_t{y} * w, w, options_.luma, luminance.data(), unused);
-    fill_density_row(luminance.data(), w, row_weight(options_.mapping, y, height()), stats_.threshold,
-                        stats_.fallback == DensityFallback::uniform, row.data());
+    scan_row(radiance_row.data(), w, options.luma, luminance.data(), unused);
+    fill_density_row(luminance.data(), w, row_weight(options.mapping, y, h), stats.threshold,
+                     stats.fallback == DensityFallback::uniform, out.data());
 }
 
 }  // namespace envmis

@@ -23,6 +23,27 @@ constexpr uint32_t kMaxStringSize = 4096;
 constexpr uint64_t kMaxTexels = uint64_t{1} << 31;
 constexpr uint32_t kSamplerCdf = 1;
 constexpr uint32_t kFlagCompensation = 1;
+constexpr uint32_t kFlagCompact = 2;  // payload: RGBE radiance only (TableEncoding::compact)
+
+// RGBE (Ward 1991): three 8-bit mantissas sharing the exponent of the largest channel,
+// rounded to nearest. Byte 3 is the exponent + 128; 0 means black.
+uint32_t rgbe_encode(Rgb c) noexcept {
+    const float m = std::max({c.r, c.g, c.b});
+    if (!(m >= 1e-38f)) return 0;
+    int e = 0;
+    std::frexp(m, &e);  // m = f 2^e, f in [0.5, 1): the largest channel's mantissa is 128..255
+    if (std::lround(std::ldexp(m, 8 - e)) > 255) ++e;
+    e = std::min(e, 127);  // above 2^127 (1.7e38) the largest channel saturates at 255 2^119
+    const auto byte = [&](float v) { return static_cast<uint32_t>(std::min(255l, std::lround(std::ldexp(v, 8 - e)))); };
+    return byte(c.r) | byte(c.g) << 8 | byte(c.b) << 16 | static_cast<uint32_t>(e + 128) << 24;
+}
+
+Rgb rgbe_decode(uint32_t v) noexcept {
+    const int e = static_cast<int>(v >> 24);
+    if (e == 0) return {};
+    const auto channel = [&](int shift) { return std::ldexp(static_cast<float>((v >> shift) & 0xff), e - 128 - 8); };
+    return {channel(0), channel(8), channel(16)};
+}
 
 class ByteWriter {
 public:
@@ -82,14 +103,14 @@ private:
     size_t pos_ = 0;
 };
 
-std::vector<std::byte> metadata_block(const EnvMap& map, const TableSource& source) {
+std::vector<std::byte> metadata_block(const EnvMap& map, const EnvMapStats& s, const TableSource& source,
+                                      TableEncoding encoding) {
     const EnvMapOptions& o = map.options();
-    const EnvMapStats& s = map.stats();
     ByteWriter w;
     w.put(map.width());
     w.put(map.height());
     w.put(kSamplerCdf);
-    w.put(o.compensation.enabled ? kFlagCompensation : 0u);
+    w.put((o.compensation.enabled ? kFlagCompensation : 0u) | (encoding == TableEncoding::compact ? kFlagCompact : 0u));
     w.put(o.compensation.alpha);
     w.put(o.luma);
     w.put(o.axes);
@@ -121,52 +142,83 @@ std::string describe_errno(const std::filesystem::path& path, const char* action
 
 }  // namespace
 
-void write_table(const std::filesystem::path& path, const EnvMap& map, const TableSource& source) {
-    for (const std::string* s : {&source.name, &source.input_colorspace, &source.working_colorspace})
-        if (s->size() > kMaxStringSize)
-            throw TableError(path.string() + ": metadata string longer than " + std::to_string(kMaxStringSize) + " bytes");
-    const std::vector<std::byte> metadata = metadata_block(map, source);
-    const auto& radiance = map.radiance().pixels;
-    const uint64_t payload = radiance.size() * (sizeof(float) + sizeof(Rgb));
-    const uint64_t total = kPreambleSize + metadata.size() + 8 + payload + 8;
+namespace {
 
+// Writes the preamble, `metadata`, the header checksum, the payload of `payload_size`
+// bytes that for_each_chunk(use) hands to `use` in order (it is called twice: for the
+// payload checksum, then to write), and the payload checksum; atomically.
+template <class ForEachChunk>
+void write_file(const std::filesystem::path& path, const std::vector<std::byte>& metadata, uint64_t payload_size,
+                ForEachChunk&& for_each_chunk) {
     ByteWriter head;
     for (std::byte b : kMagic) head.put(b);
     head.put(kTableVersion);
     head.put(kByteOrderMark);
-    head.put(total);
+    head.put(uint64_t{kPreambleSize + metadata.size() + 8 + payload_size + 8});
     head.put(static_cast<uint32_t>(metadata.size()));
     head.put(uint32_t{0});
     head.bytes.insert(head.bytes.end(), metadata.begin(), metadata.end());
     head.put(hash64(head.bytes));
 
-    // The density is computed a row at a time, twice (for the checksum, then to write):
-    // cheaper than holding a copy of the map's size.
-    std::vector<float> row(map.width());
-    const auto for_each_density_row = [&](auto&& use) {
-        for (uint32_t y = 0; y < map.height(); ++y) {
-            map.density_row(y, row);
-            use(as_bytes_of(row));
-        }
-    };
     Hasher payload_hash;
-    for_each_density_row([&](std::span<const std::byte> bytes) { payload_hash.update(bytes); });
-    payload_hash.update(as_bytes_of(radiance));
+    for_each_chunk([&](std::span<const std::byte> bytes) { payload_hash.update(bytes); });
     const uint64_t payload_digest = payload_hash.digest();
-
     try {
         write_file_atomically(path, [&](std::ostream& out) {
             auto write = [&](std::span<const std::byte> bytes) {
                 out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
             };
             write(head.bytes);
-            for_each_density_row(write);
-            write(as_bytes_of(radiance));
+            for_each_chunk(write);
             write(std::as_bytes(std::span(&payload_digest, 1)));
         });
     } catch (const std::runtime_error& e) {
         throw TableError(e.what());
     }
+}
+
+}  // namespace
+
+RgbImage rgbe_round(const RgbImage& image) {
+    RgbImage out = image;
+    for (Rgb& p : out.pixels) {
+        BadPixels ignored;
+        sanitize_pixel(p, ignored);
+        p = rgbe_decode(rgbe_encode(p));
+    }
+    return out;
+}
+
+void write_table(const std::filesystem::path& path, const EnvMap& map, const TableSource& source,
+                 TableEncoding encoding) {
+    for (const std::string* s : {&source.name, &source.input_colorspace, &source.working_colorspace})
+        if (s->size() > kMaxStringSize)
+            throw TableError(path.string() + ": metadata string longer than " + std::to_string(kMaxStringSize) + " bytes");
+    const auto& radiance = map.radiance().pixels;
+    if (encoding == TableEncoding::compact) {
+        // The table holds the rounded map: its statistics (Lbar, threshold) are the
+        // rounded map's, which the reader's rebuild reproduces exactly; the bad-pixel
+        // counts are the source's.
+        const EnvMap rounded(rgbe_round(map.radiance()), map.options());
+        EnvMapStats stats = rounded.stats();
+        stats.bad_pixels = map.stats().bad_pixels;
+        std::vector<uint32_t> rgbe(radiance.size());
+        for (size_t i = 0; i < rgbe.size(); ++i) rgbe[i] = rgbe_encode(radiance[i]);
+        write_file(path, metadata_block(map, stats, source, encoding), rgbe.size() * sizeof(uint32_t),
+                   [&](auto&& use) { use(as_bytes_of(rgbe)); });
+        return;
+    }
+    // The density is computed a row at a time, twice (for the checksum, then to write):
+    // cheaper than holding a copy of the map's size.
+    std::vector<float> row(map.width());
+    write_file(path, metadata_block(map, map.stats(), source, encoding), radiance.size() * (sizeof(float) + sizeof(Rgb)),
+               [&](auto&& use) {
+                   for (uint32_t y = 0; y < map.height(); ++y) {
+                       map.density_row(y, row);
+                       use(as_bytes_of(row));
+                   }
+                   use(as_bytes_of(radiance));
+               });
 }
 
 namespace {
@@ -177,6 +229,7 @@ struct Header {
     EnvMapOptions options;
     EnvMapStats stats;
     TableSource source;
+    bool compact = false;  // payload: RGBE radiance only
     uint64_t payload_offset = 0;
 };
 
@@ -215,6 +268,7 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
     const auto flags = meta.take<uint32_t>("flags");
     EnvMapOptions& options = out.options;
     options.compensation.enabled = flags & kFlagCompensation;
+    out.compact = flags & kFlagCompact;
     options.compensation.alpha = meta.take<float>("alpha");
     options.luma = meta.take<LumaCoefficients>("luma coefficients");
     options.axes = meta.take<Axes>("axes");
@@ -243,6 +297,7 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
     if (w == 0 || h == 0 || w > kMaxCells1D || h > kMaxCells1D || uint64_t{w} * h > kMaxTexels)
         in.fail("invalid size " + std::to_string(w) + "x" + std::to_string(h));
     if (sampler != kSamplerCdf) in.fail("unknown sampler kind " + std::to_string(sampler));
+    if (flags & ~(kFlagCompensation | kFlagCompact)) in.fail("unknown flags " + std::to_string(flags));
     if (version == 1 ? mapping != 0 : mapping != 1 && mapping != 2)
         in.fail("unknown mapping " + std::to_string(mapping));
     options.mapping = mapping == 2 ? Mapping::equal_area : Mapping::equirect;
@@ -253,7 +308,8 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
 
     // The payload's size, checked against the file before anything is allocated for it.
     out.payload_offset = in.position();
-    const uint64_t texels = uint64_t{w} * h, payload = texels * (sizeof(float) + sizeof(Rgb)) + 8;
+    const uint64_t texels = uint64_t{w} * h;
+    const uint64_t payload = texels * (out.compact ? sizeof(uint32_t) : sizeof(float) + sizeof(Rgb)) + 8;
     const uint64_t left = file_size - out.payload_offset;
     if (payload > left)
         in.fail("truncated: payload needs " + std::to_string(payload) + " bytes, " + std::to_string(left) + " left");
@@ -264,21 +320,34 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
 
 // Reads the payload with `read(destination, bytes)` (in file order) straight into the
 // buffers the map keeps: the density's bits become the CDF table, the radiance the
-// image; nothing else of the payload's size is held. Then checks its checksum.
+// image; nothing else of the payload's size is held. Then checks its checksum. A
+// compact payload's RGBE words are decoded into the radiance, and their buffer then
+// takes the density rebuilt from it.
 template <class Read>
 Table read_payload(Header header, Read&& read, std::string_view name) {
     const uint64_t texels = uint64_t{header.w} * header.h;
     LargeVector<uint32_t> density(texels);
     RgbImage radiance{header.w, header.h, std::vector<Rgb>(texels)};
     uint64_t digest = 0;
-    read(density.data(), texels * sizeof(float));
-    read(radiance.pixels.data(), texels * sizeof(Rgb));
-    read(&digest, sizeof digest);
     Hasher payload_hash;
+    read(density.data(), texels * sizeof(uint32_t));
     payload_hash.update(std::as_bytes(std::span(density.data(), density.size())));
-    payload_hash.update(std::as_bytes(std::span(radiance.pixels)));
+    if (!header.compact) {
+        read(radiance.pixels.data(), texels * sizeof(Rgb));
+        payload_hash.update(std::as_bytes(std::span(radiance.pixels)));
+    }
+    read(&digest, sizeof digest);
     const auto fail = [&](const std::string& problem) { throw TableError(std::string(name) + ": " + problem); };
     if (digest != payload_hash.digest()) fail("corrupted payload (checksum mismatch)");
+    if (header.compact) {
+        for (size_t i = 0; i < texels; ++i) radiance.pixels[i] = rgbe_decode(density[i]);
+        std::vector<float> row(header.w);
+        for (uint32_t y = 0; y < header.h; ++y) {
+            const size_t offset = size_t{y} * header.w;
+            density_row(std::span(radiance.pixels).subspan(offset, header.w), y, header.h, header.options, header.stats, row);
+            std::memcpy(density.data() + offset, row.data(), row.size() * sizeof(float));
+        }
+    }
     try {
         return {EnvMap(std::move(radiance), std::move(density), header.options, header.stats), std::move(header.source)};
     } catch (const std::invalid_argument& e) {

@@ -114,6 +114,12 @@ struct EnvMapView {
     }
 };
 
+// Row y (of h) of the image-space density that a map with these options and stats
+// samples, q(x, y) w_y, from that row's radiance (row.size() values): what
+// EnvMap::density() holds, for code that rebuilds a map's density without the map.
+void density_row(std::span<const Rgb> radiance_row, uint32_t y, uint32_t h, const EnvMapOptions& options,
+                 const EnvMapStats& stats, std::span<float> out);
+
 class EnvMap {
 public:
     EnvMap() = default;

@@ -45,8 +45,23 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+// How the payload is stored.
+//   full:    float32 density and RGB radiance, 16 bytes a texel; loads bit-identical to
+//            the map written.
+//   compact: radiance only, in RGBE (8-bit mantissas with a shared exponent, as in
+//            Radiance .hdr files), 4 bytes a texel; the density is rebuilt from it on
+//            load. The table holds the RGBE-rounded map (rgbe_round): channels within
+//            1/255 of the pixel's largest channel, the largest within 0.4% (values
+//            above 1.7e38 saturate); it loads bit-identical to
+//            EnvMap(rgbe_round(radiance), options). Lossless for .hdr sources.
+enum class TableEncoding { full, compact };
+
 // Writes atomically (temporary file, then rename). Throws TableError on I/O failure.
-void write_table(const std::filesystem::path& path, const EnvMap& map, const TableSource& source);
+void write_table(const std::filesystem::path& path, const EnvMap& map, const TableSource& source,
+                 TableEncoding encoding = TableEncoding::full);
+
+// The radiance a compact table stores: each pixel rounded to RGBE and back.
+RgbImage rgbe_round(const RgbImage& image);
 
 // Reads and verifies a table. Throws TableError if the file is missing, truncated,
 // corrupted (checksums), of another format, or of an unsupported version.
