@@ -8,6 +8,7 @@
 
 #include "envmis/atomic_file.h"
 #include "envmis/hash.h"
+#include "parallel.h"
 
 namespace envmis {
 namespace {
@@ -27,21 +28,26 @@ constexpr uint32_t kFlagCompact = 2;  // payload: RGBE radiance only (TableEncod
 
 // RGBE (Ward 1991): three 8-bit mantissas sharing the exponent of the largest channel,
 // rounded to nearest. Byte 3 is the exponent + 128; 0 means black.
+// 2^k as a double, for |k| < 1023, from its bits (no libm call on the per-texel path).
+double power_of_two(int k) noexcept { return std::bit_cast<double>(static_cast<uint64_t>(k + 1023) << 52); }
+
 uint32_t rgbe_encode(Rgb c) noexcept {
     const float m = std::max({c.r, c.g, c.b});
     if (!(m >= 1e-38f)) return 0;
-    int e = 0;
-    std::frexp(m, &e);  // m = f 2^e, f in [0.5, 1): the largest channel's mantissa is 128..255
-    if (std::lround(std::ldexp(m, 8 - e)) > 255) ++e;
+    // m = f 2^e with f in [0.5, 1) (m is a normal float): the largest mantissa is 128..255.
+    int e = static_cast<int>((std::bit_cast<uint32_t>(m) >> 23) & 0xff) - 126;
+    if (m * power_of_two(8 - e) + 0.5 >= 256) ++e;  // rounds up to 256: one more bit of exponent
     e = std::min(e, 127);  // above 2^127 (1.7e38) the largest channel saturates at 255 2^119
-    const auto byte = [&](float v) { return static_cast<uint32_t>(std::min(255l, std::lround(std::ldexp(v, 8 - e)))); };
+    const double scale = power_of_two(8 - e);
+    const auto byte = [&](float v) { return static_cast<uint32_t>(std::min(v * scale + 0.5, 255.0)); };
     return byte(c.r) | byte(c.g) << 8 | byte(c.b) << 16 | static_cast<uint32_t>(e + 128) << 24;
 }
 
 Rgb rgbe_decode(uint32_t v) noexcept {
     const int e = static_cast<int>(v >> 24);
     if (e == 0) return {};
-    const auto channel = [&](int shift) { return std::ldexp(static_cast<float>((v >> shift) & 0xff), e - 128 - 8); };
+    const double scale = power_of_two(e - 128 - 8);
+    const auto channel = [&](int shift) { return static_cast<float>(static_cast<double>((v >> shift) & 0xff) * scale); };
     return {channel(0), channel(8), channel(16)};
 }
 
@@ -181,11 +187,13 @@ void write_file(const std::filesystem::path& path, const std::vector<std::byte>&
 
 RgbImage rgbe_round(const RgbImage& image) {
     RgbImage out = image;
-    for (Rgb& p : out.pixels) {
-        BadPixels ignored;
-        sanitize_pixel(p, ignored);
-        p = rgbe_decode(rgbe_encode(p));
-    }
+    detail::parallel_for(out.height, 16, [&](uint32_t lo, uint32_t hi) {
+        for (size_t i = size_t{lo} * out.width; i < size_t{hi} * out.width; ++i) {
+            BadPixels ignored;
+            sanitize_pixel(out.pixels[i], ignored);
+            out.pixels[i] = rgbe_decode(rgbe_encode(out.pixels[i]));
+        }
+    });
     return out;
 }
 
@@ -203,7 +211,10 @@ void write_table(const std::filesystem::path& path, const EnvMap& map, const Tab
         EnvMapStats stats = rounded.stats();
         stats.bad_pixels = map.stats().bad_pixels;
         std::vector<uint32_t> rgbe(radiance.size());
-        for (size_t i = 0; i < rgbe.size(); ++i) rgbe[i] = rgbe_encode(radiance[i]);
+        const uint32_t w = map.width();
+        detail::parallel_for(map.height(), 16, [&](uint32_t lo, uint32_t hi) {
+            for (size_t i = size_t{lo} * w; i < size_t{hi} * w; ++i) rgbe[i] = rgbe_encode(radiance[i]);
+        });
         write_file(path, metadata_block(map, stats, source, encoding), rgbe.size() * sizeof(uint32_t),
                    [&](auto&& use) { use(as_bytes_of(rgbe)); });
         return;
@@ -340,13 +351,16 @@ Table read_payload(Header header, Read&& read, std::string_view name) {
     const auto fail = [&](const std::string& problem) { throw TableError(std::string(name) + ": " + problem); };
     if (digest != payload_hash.digest()) fail("corrupted payload (checksum mismatch)");
     if (header.compact) {
-        for (size_t i = 0; i < texels; ++i) radiance.pixels[i] = rgbe_decode(density[i]);
-        std::vector<float> row(header.w);
-        for (uint32_t y = 0; y < header.h; ++y) {
-            const size_t offset = size_t{y} * header.w;
-            density_row(std::span(radiance.pixels).subspan(offset, header.w), y, header.h, header.options, header.stats, row);
-            std::memcpy(density.data() + offset, row.data(), row.size() * sizeof(float));
-        }
+        const uint32_t w = header.w;
+        detail::parallel_for(header.h, 16, [&](uint32_t lo, uint32_t hi) {
+            std::vector<float> row(w);
+            for (uint32_t y = lo; y < hi; ++y) {
+                const size_t offset = size_t{y} * w;
+                for (uint32_t x = 0; x < w; ++x) radiance.pixels[offset + x] = rgbe_decode(density[offset + x]);
+                density_row(std::span(radiance.pixels).subspan(offset, w), y, header.h, header.options, header.stats, row);
+                std::memcpy(density.data() + offset, row.data(), row.size() * sizeof(float));
+            }
+        });
     }
     try {
         return {EnvMap(std::move(radiance), std::move(density), header.options, header.stats), std::move(header.source)};
