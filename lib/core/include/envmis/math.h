@@ -11,8 +11,13 @@
 
 #if defined(__CUDACC__)
 #define ENVMIS_HD __host__ __device__
+#define ENVMIS_NOINLINE __noinline__
+#elif defined(__GNUC__)
+#define ENVMIS_HD
+#define ENVMIS_NOINLINE __attribute__((noinline))
 #else
 #define ENVMIS_HD
+#define ENVMIS_NOINLINE
 #endif
 
 namespace envmis {
