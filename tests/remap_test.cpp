@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "envmis/distribution.h"
+#include "envmis/quadrature.h"
 #include "envmis/remap.h"
 #include "maps.h"
 
@@ -98,6 +99,23 @@ TEST(Remap, SmoothMapSurvivesARoundTrip) {
     }
     EXPECT_LT(mean, 0.01);
     EXPECT_LT(worst, 0.08);
+}
+
+// The converted map lights a surface as the original does: the quadrature reference
+// (which handles both mappings) agrees within the conversion's filtering.
+TEST(Remap, ConvertedMapGivesTheSameLighting) {
+    const RgbImage sky = test::sun_sky_map(128, 64, 2e3f);
+    const EnvMap original(sky, {});
+    EnvMapOptions o;
+    o.mapping = Mapping::equal_area;
+    const EnvMap square(remap(sky, Mapping::equirect, Mapping::equal_area, 96, 96).image, o);
+    for (const Vec3 n : {Vec3{0, 0, 1}, Vec3{0.6f, 0, 0.8f}, Vec3{0, -1, 0}})
+        for (const Bsdf& bsdf : {Bsdf::lambert(), Bsdf::phong(20)}) {
+            const ShadingPoint point{n, n};
+            const double a = reflected_radiance(original, bsdf, point).luminance;
+            const double b = reflected_radiance(square, bsdf, point).luminance;
+            EXPECT_NEAR(b, a, 0.02 * a) << bsdf.name() << " normal " << n.x << "," << n.y << "," << n.z;
+        }
 }
 
 TEST(Remap, BadPixelsAreCountedAndRejectedSizesThrow) {

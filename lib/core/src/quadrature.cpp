@@ -51,26 +51,27 @@ Acc integrate(const EnvMap& map, const ShadingPoint& point, int s, Fn&& fn) {
                         }
                 }
         });
-    } else
-    detail::parallel_for(h, 1, [&](uint32_t lo, uint32_t hi) {
-        for (uint32_t y = lo; y < hi; ++y)
-            for (int b = 0; b < s; ++b) {
-                const double v = (y + (b + 0.5) / s) / h, theta = kPi * v;
-                const auto st = static_cast<float>(std::sin(theta)), ct = static_cast<float>(std::cos(theta));
-                const double solid_angle = 2 * kPi * kPi * std::sin(theta) / (static_cast<double>(ws) * h * s);
-                for (uint32_t x = 0; x < w; ++x) {
-                    const Rgb l = radiance[size_t{y} * w + x];
-                    if (!(luminance(l, luma) > 0)) continue;
-                    for (int a = 0; a < s; ++a) {
-                        const uint32_t i = x * static_cast<uint32_t>(s) + static_cast<uint32_t>(a);
-                        const Vec3 world = to_world(map.options().axes, {st * cos_phi[i], st * sin_phi[i], ct});
-                        const Vec3 wi = frame.to_local(world);
-                        if (wi.z <= 0) continue;
-                        fn(rows[y], Node{wi, solid_angle, l, {(i + 0.5f) / ws, static_cast<float>(v)}});
+    } else {
+        detail::parallel_for(h, 1, [&](uint32_t lo, uint32_t hi) {
+            for (uint32_t y = lo; y < hi; ++y)
+                for (int b = 0; b < s; ++b) {
+                    const double v = (y + (b + 0.5) / s) / h, theta = kPi * v;
+                    const auto st = static_cast<float>(std::sin(theta)), ct = static_cast<float>(std::cos(theta));
+                    const double solid_angle = 2 * kPi * kPi * std::sin(theta) / (static_cast<double>(ws) * h * s);
+                    for (uint32_t x = 0; x < w; ++x) {
+                        const Rgb l = radiance[size_t{y} * w + x];
+                        if (!(luminance(l, luma) > 0)) continue;
+                        for (int a = 0; a < s; ++a) {
+                            const uint32_t i = x * static_cast<uint32_t>(s) + static_cast<uint32_t>(a);
+                            const Vec3 world = to_world(map.options().axes, {st * cos_phi[i], st * sin_phi[i], ct});
+                            const Vec3 wi = frame.to_local(world);
+                            if (wi.z <= 0) continue;
+                            fn(rows[y], Node{wi, solid_angle, l, {(i + 0.5f) / ws, static_cast<float>(v)}});
+                        }
                     }
                 }
-            }
-    });
+        });
+    }
     Acc total{};
     for (const Acc& r : rows) total += r;
     return total;
