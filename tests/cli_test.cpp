@@ -293,7 +293,7 @@ TEST_F(Cli, InfoDescribesATableAndTheImageItCameFrom) {
     ASSERT_EQ(envmis({"precompute", (kBundled / "studio.exr").string(), "-o", "studio.envmis"}).exit_code, 0);
     const Result table = envmis({"info", "studio.envmis"});
     ASSERT_EQ(table.exit_code, 0) << table;
-    EXPECT_TRUE(contains(table.out, "studio.envmis: envmis table, format version 2")) << table;
+    EXPECT_TRUE(contains(table.out, "studio.envmis: envmis table, format version 3")) << table;
     expect_studio_summary(table);
 
     const Result image = envmis({"info", (kBundled / "studio.exr").string()});
@@ -424,10 +424,10 @@ INSTANTIATE_TEST_SUITE_P(
                      for (char& b : bytes) b = static_cast<char>((x = x * 1664525u + 1013904223u) >> 24);
                      write_file(p, bytes);
                  }},
-        BadInput{"TableOfANewerVersion", "newer.envmis", "version 3.*newer",
+        BadInput{"TableOfANewerVersion", "newer.envmis", "version 4.*newer",
                  [](Cli& t, const fs::path& p) {
                      // The format version: uint32, little-endian, at byte 8.
-                     t.damaged_table(p, [](std::string& bytes) { bytes.replace(8, 4, std::string("\x03\0\0\0", 4)); });
+                     t.damaged_table(p, [](std::string& bytes) { bytes.replace(8, 4, std::string("\x04\0\0\0", 4)); });
                  }},
         BadInput{"Folder", "folder.exr", "directory", [](Cli&, const fs::path& p) { fs::create_directory(p); }}),
     [](const testing::TestParamInfo<BadInput>& info) { return info.param.name; });

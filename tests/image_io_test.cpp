@@ -221,7 +221,7 @@ TEST_F(ImageIo, WriteExrThenLoadIsBitExact) {
 }
 
 TEST_F(ImageIo, WritesZipCompressedFloatExr) {
-    write_exr(file("out.exr"), {2, 2, std::vector<Rgb>(4, Rgb{1, 2, 3})});
+    write_exr(file("out.exr"), RgbImage{2, 2, std::vector<Rgb>(4, Rgb{1, 2, 3})});
     const auto in = OIIO::ImageInput::open(file("out.exr").string());
     ASSERT_TRUE(in) << OIIO::geterror();
     EXPECT_EQ(in->spec().format, OIIO::TypeDesc::FLOAT);
@@ -230,7 +230,7 @@ TEST_F(ImageIo, WritesZipCompressedFloatExr) {
 }
 
 TEST_F(ImageIo, KeepsNaNInfinityAndNegativeValuesAsRead) {
-    write_exr(file("bad.exr"), {2, 2, {{kNaN, 1, 2}, {kInf, -kInf, 0}, {-1, -0.004f, 3}, {1, 1, 1}}});
+    write_exr(file("bad.exr"), RgbImage{2, 2, {{kNaN, 1, 2}, {kInf, -kInf, 0}, {-1, -0.004f, 3}, {1, 1, 1}}});
     const auto& p = load_image(file("bad.exr")).image.pixels;
     EXPECT_TRUE(std::isnan(p[0].r));
     EXPECT_EQ(p[1].r, kInf);
@@ -253,7 +253,7 @@ TEST_F(ImageIo, ContentHashIsTheHashOfTheFileBytes) {
 // --- colour spaces
 
 TEST_F(ImageIo, ColorspaceOptionOverridesTheFileMetadata) {
-    write_exr(file("half.exr"), {1, 1, {{0.5f, 0.5f, 0.5f}}});
+    write_exr(file("half.exr"), RgbImage{1, 1, {{0.5f, 0.5f, 0.5f}}});
     LoadOptions options;
     options.colorspace = "srgb";
     const LoadedImage loaded = load_image(file("half.exr"), options);
@@ -335,15 +335,15 @@ TEST_F(ImageIo, LoadsAPngAsSrgbEncoded) {
 // --- atomic writes
 
 TEST_F(ImageIo, WriteReplacesAnExistingFileAndLeavesNothingElse) {
-    write_exr(file("out.exr"), {1, 1, {{1, 1, 1}}});
-    write_exr(file("out.exr"), {1, 1, {{2, 2, 2}}});
+    write_exr(file("out.exr"), RgbImage{1, 1, {{1, 1, 1}}});
+    write_exr(file("out.exr"), RgbImage{1, 1, {{2, 2, 2}}});
     EXPECT_EQ(load_image(file("out.exr")).image.pixels[0].r, 2.0f);
     EXPECT_EQ(folder_entries(dir_), std::vector<std::string>{"out.exr"});
 }
 
 TEST_F(ImageIo, WriteIntoAMissingFolderFailsNamingTheDestination) {
     const fs::path destination = file("missing") / "out.exr";
-    expect_image_error([&] { write_exr(destination, {1, 1, {{1, 1, 1}}}); }, {destination.string()});
+    expect_image_error([&] { write_exr(destination, RgbImage{1, 1, {{1, 1, 1}}}); }, {destination.string()});
     EXPECT_TRUE(folder_entries(dir_).empty());
 }
 
@@ -351,15 +351,15 @@ TEST_F(ImageIo, AFailedRenameRemovesTheTemporaryFile) {
     // A non-empty folder cannot be replaced by a file, so the rename fails after the write.
     fs::create_directories(file("taken.exr"));
     std::ofstream(file("taken.exr") / "keep") << "x";
-    EXPECT_THROW(write_exr(file("taken.exr"), {1, 1, {{1, 1, 1}}}), ImageError);
+    EXPECT_THROW(write_exr(file("taken.exr"), RgbImage{1, 1, {{1, 1, 1}}}), ImageError);
     EXPECT_THROW(write_png(file("taken.exr"), {1, 1, {1, 2, 3}}), ImageError);
     EXPECT_EQ(folder_entries(dir_), std::vector<std::string>{"taken.exr"});
     EXPECT_EQ(folder_entries(file("taken.exr")), std::vector<std::string>{"keep"});
 }
 
 TEST_F(ImageIo, WritingAnImageWhosePixelsDoNotMatchItsSizeFails) {
-    EXPECT_THROW(write_exr(file("a.exr"), {2, 2, std::vector<Rgb>(3)}), ImageError);
-    EXPECT_THROW(write_exr(file("a.exr"), {0, 0, {}}), ImageError);
+    EXPECT_THROW(write_exr(file("a.exr"), RgbImage{2, 2, std::vector<Rgb>(3)}), ImageError);
+    EXPECT_THROW(write_exr(file("a.exr"), RgbImage{0, 0, {}}), ImageError);
     EXPECT_THROW(write_png(file("a.png"), {2, 1, {1, 2, 3}}), ImageError);
     EXPECT_TRUE(folder_entries(dir_).empty());
 }

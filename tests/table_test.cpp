@@ -171,7 +171,7 @@ TEST(Rgbe, RoundingErrorIsBounded) {
     image.pixels[1] = {1.6e38f, 1, 0};  // the largest RGBE represents
     const RgbImage rounded = rgbe_round(image);
     EXPECT_EQ(rounded.pixels[0].r, 0.0f);
-    EXPECT_GT(rgbe_round({1, 1, {{3e38f, 0, 0}}}).pixels[0].r, 1.6e38f);  // saturates, never wraps to black
+    EXPECT_GT(rgbe_round(RgbImage{1, 1, {{3e38f, 0, 0}}}).pixels[0].r, 1.6e38f);  // saturates, never wraps to black
     for (size_t i = 0; i < image.pixels.size(); ++i) {
         const Rgb a = image.pixels[i], b = rounded.pixels[i];
         const float m = std::max({a.r, a.g, a.b});
@@ -195,30 +195,118 @@ TEST_F(TableTest, EqualAreaTablesRoundTrip) {
     expect_identical_samples(map, loaded.map, 9, 10000);
 }
 
+// Offsets in a table file (docs/table-format.md).
+constexpr size_t kPreamble = 32, kVersionAt = 8, kTotalSizeAt = 16, kMetadataSizeAt = 24;
+constexpr size_t kMappingByte = kPreamble + 5 * 4 + 3 * 4 + 3;  // after size, kind, flags, alpha, luma, axes
+constexpr size_t kFixedMetadata = 100;                           // the fields before the three strings
+
+uint32_t u32_at(const std::vector<char>& bytes, size_t offset) {
+    uint32_t v = 0;
+    std::memcpy(&v, bytes.data() + offset, sizeof v);
+    return v;
+}
+
+// Size of the metadata block's fields, without version 3's padding.
+size_t unpadded_metadata(const std::vector<char>& bytes) {
+    size_t end = kFixedMetadata;
+    for (int i = 0; i < 3; ++i) end += 4 + u32_at(bytes, kPreamble + end);
+    return end;
+}
+
+// Recomputes the header checksum after an edit of the header.
+void reseal(std::vector<char>& bytes) {
+    const uint32_t m = u32_at(bytes, kMetadataSizeAt);
+    const uint64_t digest = hash64(std::as_bytes(std::span(bytes.data(), kPreamble + m)));
+    std::memcpy(bytes.data() + kPreamble + m, &digest, sizeof digest);
+}
+
+// The same table as an older version writes it: no metadata padding; version 1 also
+// has a reserved 0 where later versions keep the mapping.
+std::vector<char> as_version(std::vector<char> bytes, uint32_t version) {
+    const uint32_t m = u32_at(bytes, kMetadataSizeAt), unpadded = static_cast<uint32_t>(unpadded_metadata(bytes));
+    bytes.erase(bytes.begin() + kPreamble + unpadded, bytes.begin() + kPreamble + m);
+    const uint64_t total = bytes.size();
+    std::memcpy(bytes.data() + kVersionAt, &version, sizeof version);
+    std::memcpy(bytes.data() + kTotalSizeAt, &total, sizeof total);
+    std::memcpy(bytes.data() + kMetadataSizeAt, &unpadded, sizeof unpadded);
+    if (version == 1) bytes[kMappingByte] = 0;
+    reseal(bytes);
+    return bytes;
+}
+
 // Version 1 had a reserved zero byte where version 2 keeps the mapping: such files are
 // equirectangular and still read; a version 1 file with another byte there is corrupt.
 TEST_F(TableTest, VersionOneTablesStillRead) {
     const fs::path path = saved_table();
     std::vector<char> bytes = bytes_of(path);
-    const uint32_t one = 1, preamble = 32;
-    uint32_t m = 0;  // metadata size
-    std::memcpy(&m, bytes.data() + 24, sizeof m);
-    std::memcpy(bytes.data() + 8, &one, sizeof one);
-    const size_t mapping_byte = preamble + 5 * 4 + 3 * 4 + 3;  // after size, kind, flags, alpha, luma, axes
-    ASSERT_EQ(bytes[mapping_byte], 1);                          // equirect, as version 2 writes it
-    const auto reseal = [&] {
-        const uint64_t digest = hash64(std::as_bytes(std::span(bytes.data(), preamble + m)));
-        std::memcpy(bytes.data() + preamble + m, &digest, sizeof digest);
-        write_bytes(path, bytes);
-    };
-    bytes[mapping_byte] = 0;
-    reseal();
+    ASSERT_EQ(bytes[kMappingByte], 1);  // equirect, as version 3 writes it
+    bytes = as_version(bytes, 1);
+    write_bytes(path, bytes);
     const Table loaded = read_table(path);
     EXPECT_EQ(loaded.map.options().mapping, Mapping::equirect);
-    EXPECT_EQ(loaded.map.sample({0.3f, 0.6f}).pdf, map_.sample({0.3f, 0.6f}).pdf);
-    bytes[mapping_byte] = 2;
-    reseal();
+    expect_identical_samples(map_, loaded.map, 4, 1000);
+    bytes[kMappingByte] = 2;
+    reseal(bytes);
+    write_bytes(path, bytes);
     expect_rejected(path, "unknown mapping");
+}
+
+// Version 2 is version 3 without the metadata padding; its payload may be misaligned in
+// the file, so it is read into memory rather than used from a mapping.
+TEST_F(TableTest, VersionTwoTablesStillRead) {
+    const fs::path path = saved_table();
+    write_bytes(path, as_version(bytes_of(path), 2));
+    const Table loaded = read_table(path);
+    EXPECT_FALSE(loaded.mapped);
+    expect_identical_samples(map_, loaded.map, 5, 1000);
+}
+
+// Version 3 pads the metadata block with zeros to a multiple of 8 bytes, so that the
+// payload's arrays are aligned; anything else there is an error.
+TEST_F(TableTest, MetadataPaddingIsZerosToAMultipleOfEight) {
+    const fs::path path = saved_table();
+    std::vector<char> bytes = bytes_of(path);
+    const uint32_t m = u32_at(bytes, kMetadataSizeAt);
+    EXPECT_EQ(m % 8, 0u);
+    ASSERT_GT(m, unpadded_metadata(bytes)) << "choose a source name that needs padding";
+    bytes[kPreamble + m - 1] = 1;
+    reseal(bytes);
+    write_bytes(path, bytes);
+    expect_rejected(path, "unexpected bytes");
+}
+
+// By default a full table's radiance is used in place from a mapping of the file (where
+// the platform has mmap); loading with TableLoading::copy reads it into memory. Both
+// give the saved map, bit for bit.
+TEST_F(TableTest, MappedAndCopiedLoadsAreBitIdentical) {
+    const fs::path path = saved_table();
+    const Table mapped = read_table(path), copied = read_table(path, TableLoading::copy);
+#if defined(__unix__) || defined(__APPLE__)
+    EXPECT_TRUE(mapped.mapped);
+#endif
+    EXPECT_FALSE(copied.mapped);
+    expect_identical_samples(map_, mapped.map, 6, 100000);
+    expect_identical_samples(map_, copied.map, 6, 1000);
+    ASSERT_EQ(mapped.map.radiance().pixels.size(), map_.radiance().pixels.size());
+    EXPECT_EQ(std::memcmp(mapped.map.radiance().pixels.data(), map_.radiance().pixels.data(),
+                          map_.radiance().pixels.size_bytes()),
+              0);
+    // Compact tables decode their radiance: nothing to map.
+    write_table(path, map_, source_, TableEncoding::compact);
+    EXPECT_FALSE(read_table(path).mapped);
+}
+
+// write_table replaces a file by renaming a new one over it: a map loaded from the old
+// file, and copies of that map, keep sampling it after the loaded Table is gone.
+TEST_F(TableTest, AMappedMapOutlivesItsTableAndTheFilesReplacement) {
+    const fs::path path = saved_table();
+    EnvMap kept;
+    {
+        const Table t = read_table(path);
+        kept = t.map;
+    }
+    write_table(path, EnvMap(test::constant_map(8, 4, {1, 2, 3})), source_);
+    expect_identical_samples(map_, kept, 7, 10000);
 }
 
 TEST_F(TableTest, NewerVersionsAreRejectedWithAnUpgradeHint) {

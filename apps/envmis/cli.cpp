@@ -7,8 +7,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
+#include <sstream>
 
 #include "envmis/io/image_io.h"
 
@@ -71,11 +74,28 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+std::string resident_memory() {
+    std::ifstream status("/proc/self/status");
+    std::map<std::string, double> kib;
+    for (std::string line; std::getline(status, line);) {
+        std::istringstream fields(line);
+        std::string key;
+        double value = 0;
+        if (fields >> key >> value) kib[key] = value;
+    }
+    if (!kib.count("VmRSS:") || !kib.count("VmHWM:")) return {};
+    const auto mb = [&](const char* key) { return std::to_string(static_cast<long>(kib[key] / 1024 + 0.5)) + " MB"; };
+    return "resident " + mb("VmRSS:") + " (anonymous " + mb("RssAnon:") + ", mapped files " + mb("RssFile:") +
+           "), peak " + mb("VmHWM:");
+}
+
 LoadedMap load_map(const std::string& path, const MapFlags& flags) {
     const auto start = std::chrono::steady_clock::now();
     if (looks_like_table(path)) {
         Table table = read_table(path);
         LoadedMap loaded{std::move(table.map), std::move(table.source), true, "envmis table"};
+        loaded.table_version = table.version;
+        loaded.mapped = table.mapped;
         loaded.load_ms = milliseconds_since(start);
         return loaded;
     }

@@ -36,6 +36,8 @@ struct LoadedMap {
     TableSource source;
     bool from_table = false;
     std::string format;  // "envmis table", "openexr", "hdr", ...
+    uint32_t table_version = 0;  // the table file's format version
+    bool mapped = false;         // the map borrows its radiance from a mapping of the table file
     uint32_t channels = 3;
     double load_ms = 0, build_ms = 0;
     std::optional<AlphaChoice> alpha_choice = {};  // with --alpha auto, for an image
@@ -48,6 +50,10 @@ LoadedMap load_map(const std::string& path, const MapFlags& flags);
 void print_summary(std::ostream& out, const LoadedMap& loaded);
 
 double milliseconds_since(std::chrono::steady_clock::time_point start);
+
+// This process's resident memory, now and at its peak, with the share of anonymous
+// memory and of mapped files' pages; empty where the system does not say (not Linux).
+std::string resident_memory();
 
 // Ctrl-C (SIGINT) and SIGTERM set a flag that long loops check, so that they stop
 // cleanly: `compare` reports what is done, writers throw and remove their temporary

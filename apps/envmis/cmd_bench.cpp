@@ -87,7 +87,7 @@ Subcommand add_bench(CLI::App& app) {
                 } else {
                     MapFlags flags;
                     flags.no_compensate = true;
-                    image = load_map(args->input, flags).map.radiance();
+                    image = to_image(load_map(args->input, flags).map.radiance());
                     map_name = args->input;
                 }
                 EnvMapOptions options;

@@ -175,7 +175,7 @@ Subcommand add_compare(CLI::App& app) {
                                                                      : 0.0f;
                 EnvMapOptions plain_options = loaded.map.options();
                 plain_options.compensation.enabled = false;
-                const EnvMap plain = loaded.from_table ? EnvMap(loaded.map.radiance(), plain_options) : std::move(loaded.map);
+                const EnvMap plain = loaded.from_table ? EnvMap(to_image(loaded.map.radiance()), plain_options) : std::move(loaded.map);
 
                 std::vector<ShadingPoint> points;
                 if (!args->normal.empty()) {

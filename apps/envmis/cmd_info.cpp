@@ -18,13 +18,18 @@ Subcommand add_info(CLI::App& app) {
     add_map_flags(*sub, args->map);
     return {sub, [args] {
                 const LoadedMap loaded = load_map(args->input, args->map);
-                std::cout << args->input << ": " << (loaded.from_table ? "envmis table, format version " : "image, ")
-                          << (loaded.from_table ? std::to_string(kTableVersion) : std::to_string(loaded.channels) + " channels")
-                          << "\n";
+                std::cout << args->input << ": ";
+                if (loaded.from_table)
+                    std::cout << "envmis table, format version " << loaded.table_version
+                              << (loaded.mapped ? ", radiance used in place from a mapping of the file" : "") << "\n";
+                else
+                    std::cout << "image, " << loaded.channels << " channels\n";
                 print_summary(std::cout, loaded);
                 std::cout << std::fixed << std::setprecision(1) << "  time          load " << loaded.load_ms
                           << " ms" << (loaded.from_table ? " (includes rebuilding the sampler)" : "") << ", build "
                           << loaded.build_ms << " ms\n";
+                if (const std::string memory = resident_memory(); !memory.empty())
+                    std::cout << "  process       " << memory << "\n";
             }};
 }
 

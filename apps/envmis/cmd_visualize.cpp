@@ -45,7 +45,7 @@ Subcommand add_visualize(CLI::App& app) {
                 const bool loaded_compensated = loaded.map.options().compensation.enabled;
                 EnvMapOptions other_options = loaded.map.options();
                 other_options.compensation.enabled = !loaded_compensated;
-                const EnvMap other(loaded.map.radiance(), other_options);
+                const EnvMap other(to_image(loaded.map.radiance()), other_options);
                 const EnvMap* maps[2] = {loaded_compensated ? &other : &loaded.map, loaded_compensated ? &loaded.map : &other};
                 const EnvMapOptions& plain = maps[0]->options();
                 const EnvMapOptions& compensated = maps[1]->options();

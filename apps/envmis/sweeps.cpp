@@ -51,7 +51,7 @@ std::function<void(size_t, size_t)> run_progress(Progress& progress, size_t run,
 EnvMap compensated_map(const EnvMap& plain, float alpha) {
     EnvMapOptions options = plain.options();
     options.compensation = {true, alpha};
-    return EnvMap(plain.radiance(), options);
+    return EnvMap(to_image(plain.radiance()), options);
 }
 
 CompensatedMaps compensated_maps(const EnvMap& plain, std::span<const float> bsdf_alphas) {

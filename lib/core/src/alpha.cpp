@@ -13,7 +13,7 @@ namespace envmis {
 namespace {
 
 // One halving step of downsample().
-RgbImage halve(const RgbImage& in, Mapping mapping) {
+RgbImage halve(RgbImageView in, Mapping mapping) {
     const uint32_t w = in.width / 2, h = in.height / 2;
     std::vector<double> sin_theta(in.height, 1.0);
     if (mapping == Mapping::equirect)
@@ -44,7 +44,7 @@ RgbImage halve(const RgbImage& in, Mapping mapping) {
 // Relative difference of criteria below which candidates tie.
 constexpr double kTie = 1e-6;
 
-bool can_halve(const RgbImage& image, uint32_t max_width) {
+bool can_halve(RgbImageView image, uint32_t max_width) {
     return image.width > max_width && image.width >= 2 && image.height >= 2;
 }
 
@@ -70,8 +70,8 @@ std::vector<LogRatios> log_ratios(std::span<const double> variances, std::span<c
 
 }  // namespace
 
-RgbImage downsample(const RgbImage& image, uint32_t max_width, Mapping mapping) {
-    if (!can_halve(image, max_width)) return image;
+RgbImage downsample(RgbImageView image, uint32_t max_width, Mapping mapping) {
+    if (!can_halve(image, max_width)) return to_image(image);
     RgbImage small = halve(image, mapping);
     while (can_halve(small, max_width)) small = halve(small, mapping);
     return small;
@@ -95,7 +95,7 @@ std::vector<double> geometric_mean_ratios(std::span<const double> variances, std
     return means;
 }
 
-AlphaChoice choose_alpha(const RgbImage& radiance, const EnvMapOptions& map, const AlphaOptions& options) {
+AlphaChoice choose_alpha(RgbImageView radiance, const EnvMapOptions& map, const AlphaOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     if (radiance.width == 0 || radiance.height == 0 || options.bsdfs.empty() || options.points.empty())
         throw std::invalid_argument("choose_alpha: needs a non-empty map, a BSDF and a shading point");

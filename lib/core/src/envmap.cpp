@@ -30,7 +30,7 @@ constexpr size_t kMaxTexels = size_t{1} << 31;
 // Rows per task of the parallel passes.
 constexpr uint32_t kRowsPerChunk = 8;
 
-void check_image(const RgbImage& image, Mapping mapping) {
+void check_image(RgbImageView image, Mapping mapping) {
     const size_t n = size_t{image.width} * image.height;
     if (image.width == 0 || image.height == 0 || image.width > kMaxCells1D || image.height > kMaxCells1D || n > kMaxTexels)
         throw std::invalid_argument("environment map size " + std::to_string(image.width) + "x" +
@@ -182,11 +182,14 @@ uint32_t fill_density_row(const uint32_t* luminance, uint32_t w, float weight, f
 
 }  // namespace
 
-EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : radiance_(std::move(image)), options_(options) {
-    check_image(radiance_, options_.mapping);
+EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : options_(options) {
+    check_image(image, options_.mapping);
     check_options(options_);
-    const uint32_t w = radiance_.width, h = radiance_.height;
-    Rgb* pixels = radiance_.pixels.data();
+    const uint32_t w = image.width, h = image.height;
+    auto owned = std::make_shared<std::vector<Rgb>>(std::move(image.pixels));
+    Rgb* pixels = owned->data();
+    radiance_ = {w, h, *owned};
+    radiance_owner_ = std::move(owned);
 
     // Pass 1 gives Lbar, and keeps each texel's luminance in the memory that the start
     // table will occupy: pass 2 then reads 4 bytes a texel instead of the 12 of RGB.
@@ -239,7 +242,20 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : radiance_(std::mo
 
 EnvMap::EnvMap(RgbImage radiance, LargeVector<uint32_t> density_bits, const EnvMapOptions& options,
                const EnvMapStats& stats)
-    : radiance_(std::move(radiance)), options_(options), stats_(stats) {
+    : options_(options), stats_(stats) {
+    auto owned = std::make_shared<const std::vector<Rgb>>(std::move(radiance.pixels));
+    radiance_ = {radiance.width, radiance.height, *owned};
+    radiance_owner_ = std::move(owned);
+    rebuild(std::move(density_bits));
+}
+
+EnvMap::EnvMap(RgbImageView radiance, std::shared_ptr<const void> owner, LargeVector<uint32_t> density_bits,
+               const EnvMapOptions& options, const EnvMapStats& stats)
+    : radiance_owner_(std::move(owner)), radiance_(radiance), options_(options), stats_(stats) {
+    rebuild(std::move(density_bits));
+}
+
+void EnvMap::rebuild(LargeVector<uint32_t> density_bits) {
     check_image(radiance_, options_.mapping);
     check_options(options_);
     size_t bad = 0;

@@ -1,13 +1,16 @@
 #include "envmis/table.h"
 
+#include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <vector>
 
 #include "envmis/atomic_file.h"
 #include "envmis/hash.h"
+#include "mapped_file.h"
 #include "parallel.h"
 
 namespace envmis {
@@ -25,6 +28,9 @@ constexpr uint64_t kMaxTexels = uint64_t{1} << 31;
 constexpr uint32_t kSamplerCdf = 1;
 constexpr uint32_t kFlagCompensation = 1;
 constexpr uint32_t kFlagCompact = 2;  // payload: RGBE radiance only (TableEncoding::compact)
+// Version 3 pads the metadata block with zeros to a multiple of this, so that the payload's
+// arrays are aligned in the file and a mapping of it can be used in place.
+constexpr uint32_t kMetadataAlignment = 8;
 
 // RGBE (Ward 1991): three 8-bit mantissas sharing the exponent of the largest channel,
 // rounded to nearest. Byte 3 is the exponent + 128; 0 means black.
@@ -134,12 +140,13 @@ std::vector<std::byte> metadata_block(const EnvMap& map, const EnvMapStats& s, c
     w.put_string(source.name);
     w.put_string(source.input_colorspace);
     w.put_string(source.working_colorspace);
+    w.bytes.resize((w.bytes.size() + kMetadataAlignment - 1) / kMetadataAlignment * kMetadataAlignment);
     return std::move(w.bytes);
 }
 
 template <class T>
-std::span<const std::byte> as_bytes_of(const std::vector<T>& v) {
-    return std::as_bytes(std::span<const T>(v));
+std::span<const std::byte> as_bytes_of(std::span<const T> v) {
+    return std::as_bytes(v);
 }
 
 std::string describe_errno(const std::filesystem::path& path, const char* action) {
@@ -185,8 +192,8 @@ void write_file(const std::filesystem::path& path, const std::vector<std::byte>&
 
 }  // namespace
 
-RgbImage rgbe_round(const RgbImage& image) {
-    RgbImage out = image;
+RgbImage rgbe_round(RgbImageView image) {
+    RgbImage out = to_image(image);
     detail::parallel_for(out.height, 16, [&](uint32_t lo, uint32_t hi) {
         for (size_t i = size_t{lo} * out.width; i < size_t{hi} * out.width; ++i) {
             BadPixels ignored;
@@ -216,7 +223,7 @@ void write_table(const std::filesystem::path& path, const EnvMap& map, const Tab
             for (size_t i = size_t{lo} * w; i < size_t{hi} * w; ++i) rgbe[i] = rgbe_encode(radiance[i]);
         });
         write_file(path, metadata_block(map, stats, source, encoding), rgbe.size() * sizeof(uint32_t),
-                   [&](auto&& use) { use(as_bytes_of(rgbe)); });
+                   [&](auto&& use) { use(as_bytes_of<uint32_t>(rgbe)); });
         return;
     }
     // The density is computed a row at a time, twice (for the checksum, then to write):
@@ -226,9 +233,9 @@ void write_table(const std::filesystem::path& path, const EnvMap& map, const Tab
                [&](auto&& use) {
                    for (uint32_t y = 0; y < map.height(); ++y) {
                        map.density_row(y, row);
-                       use(as_bytes_of(row));
+                       use(as_bytes_of<float>(row));
                    }
-                   use(as_bytes_of(radiance));
+                   use(as_bytes_of<Rgb>(radiance));
                });
 }
 
@@ -241,6 +248,7 @@ struct Header {
     EnvMapStats stats;
     TableSource source;
     bool compact = false;  // payload: RGBE radiance only
+    uint32_t version = 0;
     uint64_t payload_offset = 0;
 };
 
@@ -258,7 +266,7 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
     if (version > kTableVersion)
         in.fail("format version " + std::to_string(version) + " is newer than this envmis reads (version " +
                 std::to_string(kTableVersion) + "); upgrade envmis");
-    if (version != kTableVersion && version != 1) in.fail("unknown format version " + std::to_string(version));
+    if (version == 0) in.fail("unknown format version 0");
     const auto total = in.take<uint64_t>("file size");
     if (total != file_size)
         in.fail(total > file_size ? "truncated: header says " + std::to_string(total) + " bytes, file has " +
@@ -272,6 +280,7 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
     const uint64_t header_digest = hash64(head.first(kPreambleSize + metadata_size));
 
     Header out;
+    out.version = version;
     Cursor meta(head.subspan(kPreambleSize, metadata_size), name);
     out.w = meta.take<uint32_t>("width");
     out.h = meta.take<uint32_t>("height");
@@ -303,7 +312,12 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
 
     in.take_bytes(metadata_size, "metadata");
     if (in.take<uint64_t>("header checksum") != header_digest) in.fail("corrupted header (checksum mismatch)");
-    if (meta.position() != metadata_size) in.fail("metadata block has " + std::to_string(metadata_size - meta.position()) + " unexpected bytes");
+    // Version 3 pads the block to a multiple of kMetadataAlignment with zeros; older
+    // versions have no padding.
+    const std::span<const std::byte> rest = head.subspan(kPreambleSize + meta.position(), metadata_size - meta.position());
+    const bool padded = version >= 3 && metadata_size % kMetadataAlignment == 0 && rest.size() < kMetadataAlignment &&
+                        std::all_of(rest.begin(), rest.end(), [](std::byte b) { return b == std::byte{0}; });
+    if (!rest.empty() && !padded) in.fail("metadata block has " + std::to_string(rest.size()) + " unexpected bytes");
     const uint32_t w = out.w, h = out.h;
     if (w == 0 || h == 0 || w > kMaxCells1D || h > kMaxCells1D || uint64_t{w} * h > kMaxTexels)
         in.fail("invalid size " + std::to_string(w) + "x" + std::to_string(h));
@@ -329,6 +343,20 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
     return out;
 }
 
+[[noreturn]] void fail(std::string_view name, const std::string& problem) {
+    throw TableError(std::string(name) + ": " + problem);
+}
+
+// The table of the map that `build` makes, its errors reported as the file's.
+template <class Build>
+Table checked_table(std::string_view name, uint32_t version, TableSource source, Build&& build) {
+    try {
+        return {build(), std::move(source), version};
+    } catch (const std::invalid_argument& e) {
+        fail(name, std::string("inconsistent contents: ") + e.what());
+    }
+}
+
 // Reads the payload with `read(destination, bytes)` (in file order) straight into the
 // buffers the map keeps: the density's bits become the CDF table, the radiance the
 // image; nothing else of the payload's size is held. Then checks its checksum. A
@@ -348,8 +376,7 @@ Table read_payload(Header header, Read&& read, std::string_view name) {
         payload_hash.update(std::as_bytes(std::span(radiance.pixels)));
     }
     read(&digest, sizeof digest);
-    const auto fail = [&](const std::string& problem) { throw TableError(std::string(name) + ": " + problem); };
-    if (digest != payload_hash.digest()) fail("corrupted payload (checksum mismatch)");
+    if (digest != payload_hash.digest()) fail(name, "corrupted payload (checksum mismatch)");
     if (header.compact) {
         const uint32_t w = header.w;
         detail::parallel_for(header.h, 16, [&](uint32_t lo, uint32_t hi) {
@@ -362,12 +389,37 @@ Table read_payload(Header header, Read&& read, std::string_view name) {
             }
         });
     }
-    try {
-        return {EnvMap(std::move(radiance), std::move(density), header.options, header.stats), std::move(header.source)};
-    } catch (const std::invalid_argument& e) {
-        fail(std::string("inconsistent contents: ") + e.what());
-    }
-    return {};
+    return checked_table(name, header.version, std::move(header.source),
+                         [&] { return EnvMap(std::move(radiance), std::move(density), header.options, header.stats); });
+}
+
+// A full version 3 payload in a file mapping, used in place: the map borrows the
+// radiance from the mapping, which it keeps alive; only the density is copied, into the
+// buffer that becomes the CDF table. Null if the payload cannot be used in place (compact,
+// or an older version whose arrays may be misaligned).
+std::optional<Table> read_mapped_payload(Header header, std::shared_ptr<const detail::MappedFile> file,
+                                         std::string_view name) {
+    const uint64_t texels = uint64_t{header.w} * header.h;
+    const std::span<const std::byte> payload = file->bytes().subspan(static_cast<size_t>(header.payload_offset));
+    const auto density_bytes = payload.first(texels * sizeof(uint32_t));
+    const auto radiance_bytes = payload.subspan(density_bytes.size(), texels * sizeof(Rgb));
+    if (header.compact || header.version < 3 || reinterpret_cast<uintptr_t>(radiance_bytes.data()) % alignof(Rgb) != 0)
+        return std::nullopt;
+    Hasher payload_hash;
+    payload_hash.update(density_bytes);
+    payload_hash.update(radiance_bytes);
+    uint64_t digest = 0;
+    std::memcpy(&digest, payload.data() + density_bytes.size() + radiance_bytes.size(), sizeof digest);
+    if (digest != payload_hash.digest()) fail(name, "corrupted payload (checksum mismatch)");
+    LargeVector<uint32_t> density(texels);
+    std::memcpy(density.data(), density_bytes.data(), density_bytes.size());
+    const RgbImageView radiance{header.w, header.h,
+                                std::span(reinterpret_cast<const Rgb*>(radiance_bytes.data()), static_cast<size_t>(texels))};
+    Table table = checked_table(name, header.version, std::move(header.source), [&] {
+        return EnvMap(radiance, std::move(file), std::move(density), header.options, header.stats);
+    });
+    table.mapped = true;
+    return table;
 }
 
 }  // namespace
@@ -384,10 +436,17 @@ Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
         name);
 }
 
-Table read_table(const std::filesystem::path& path) {
+Table read_table(const std::filesystem::path& path, TableLoading loading) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw TableError(path.string() + ": no such file");
     if (!std::filesystem::is_regular_file(path, ec)) throw TableError(path.string() + ": not a regular file");
+    if (loading == TableLoading::map)
+        if (std::shared_ptr<const detail::MappedFile> file = detail::MappedFile::map(path)) {
+            const std::span<const std::byte> bytes = file->bytes();
+            Header header = parse_header(bytes, bytes.size(), path.string());
+            if (std::optional<Table> table = read_mapped_payload(header, std::move(file), path.string()))
+                return std::move(*table);
+        }
     std::ifstream file(path, std::ios::binary | std::ios::ate);
     if (!file) throw TableError(describe_errno(path, "open"));
     const std::streamoff size = file.tellg();

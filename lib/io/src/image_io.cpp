@@ -144,7 +144,7 @@ LoadedImage load_image(const fs::path& path, const LoadOptions& options) {
     return loaded;
 }
 
-void write_exr(const fs::path& path, const RgbImage& image) {
+void write_exr(const fs::path& path, RgbImageView image) {
     check_writable(path, image.width, image.height, image.pixels.size(), 1);
     OIIO::ImageSpec spec(static_cast<int>(image.width), static_cast<int>(image.height), 3, OIIO::TypeDesc::FLOAT);
     spec.attribute("compression", "zip");

@@ -164,7 +164,7 @@ void blit(Image8& dst, const Image8& src, int x, int y) {
                     at(dst, x + col0, y + row));
 }
 
-RgbImage resize(const RgbImage& image, uint32_t new_width, uint32_t new_height) {
+RgbImage resize(RgbImageView image, uint32_t new_width, uint32_t new_height) {
     const auto values = resample(reinterpret_cast<const float*>(image.pixels.data()), image.width, image.height, 3,
                                  new_width, new_height);
     RgbImage out{new_width, new_height, std::vector<Rgb>(values.size() / 3)};
@@ -188,7 +188,7 @@ Image8 resize(const Image8& image, uint32_t new_width, uint32_t new_height) {
     return out;
 }
 
-Image8 tonemap(const RgbImage& image, float exposure_stops, LumaCoefficients luma) {
+Image8 tonemap(RgbImageView image, float exposure_stops, LumaCoefficients luma) {
     constexpr float kMidGrey = 0.18f, kWhite = 8;
     double log_sum = 0;
     size_t lit = 0;

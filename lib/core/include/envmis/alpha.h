@@ -44,7 +44,7 @@ namespace envmis {
 // NaN, infinite and negative channel values count as 0, as EnvMap's build treats them.
 // An equal-area map's texels all weigh the same.
 // Cost: O(W H), one pass per halving.
-RgbImage downsample(const RgbImage& image, uint32_t max_width, Mapping mapping = Mapping::equirect);
+RgbImage downsample(RgbImageView image, uint32_t max_width, Mapping mapping = Mapping::equirect);
 
 // The exact variance (exact_variance, at `subdivisions`) of `technique` sampling `env`,
 // at every (BSDF, point): element b * points.size() + p.
@@ -96,6 +96,6 @@ struct AlphaChoice {
 // Chooses alpha for `radiance` as AlphaOptions says. `map` gives the luma coefficients
 // and axes (its compensation settings are ignored). Throws std::invalid_argument for an
 // empty image, no BSDF or point, or a negative or non-finite candidate.
-AlphaChoice choose_alpha(const RgbImage& radiance, const EnvMapOptions& map, const AlphaOptions& options = {});
+AlphaChoice choose_alpha(RgbImageView radiance, const EnvMapOptions& map, const AlphaOptions& options = {});
 
 }  // namespace envmis

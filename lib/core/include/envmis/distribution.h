@@ -45,6 +45,11 @@ struct CellHit {
     float offset = 0;
 };
 
+// The hint of CdfView::invert that does nothing.
+struct NoHint {
+    ENVMIS_HD void operator()(uint32_t) const noexcept {}
+};
+
 // Non-owning view of one fixed-point CDF over n cells.
 struct CdfView {
     const uint32_t* start = nullptr;  // n: first unit of each cell; zero-width cells are empty
@@ -56,10 +61,19 @@ struct CdfView {
     // The cell holding unit u * 2^31, and the position inside it.
     // Single precision throughout: x is exact (a power-of-two scale of u), and so are
     // its integer part t and the fraction x - t; only the offset's division rounds.
-    ENVMIS_HD CellHit invert(float u) const noexcept {
+    //
+    // Memory: a map beyond the cache misses on the guide entry, then on the CDF entry it
+    // names, then on the caller's data for the cell found. The answer is usually near
+    // cell k of the guide bucket (for a smooth function, within a cache line of it), so
+    // the CDF around k is prefetched and `near_answer(k)` lets the caller prefetch its
+    // own: the three loads overlap instead of waiting for each other.
+    template <class Hint = NoHint>
+    ENVMIS_HD CellHit invert(float u, Hint near_answer = {}) const noexcept {
         const float x = u * static_cast<float>(kCdfUnits);
         const auto t = static_cast<uint32_t>(x);
         const auto k = static_cast<uint32_t>((static_cast<uint64_t>(t) * n) >> 31);
+        ENVMIS_PREFETCH(start + k);
+        near_answer(k);
         uint32_t lo = guide[k], hi = k + 1 < n ? guide[k + 1] : n - 1;
         while (lo < hi) {  // last cell whose start is <= t
             const uint32_t mid = (lo + hi + 1) / 2;
@@ -205,11 +219,15 @@ struct Distribution2DView {
         const size_t offset = static_cast<size_t>(y) * w;
         return {start + offset, guide + offset, w};
     }
-    // u.y picks the row, u.x the column within it.
-    ENVMIS_HD Sample sample(Vec2 u) const noexcept {
+    // u.y picks the row, u.x the column within it. `near_answer(i)` is told the
+    // row-major index i = y w + x of a cell usually near the one sampled (see
+    // CdfView::invert), for the caller to prefetch its data.
+    template <class Hint = NoHint>
+    ENVMIS_HD Sample sample(Vec2 u, Hint near_answer = {}) const noexcept {
         const CellHit r = marginal.invert(u.y);
         const CdfView cdf = row(r.index);
-        const CellHit c = cdf.invert(u.x);
+        const size_t row_start = static_cast<size_t>(r.index) * w;
+        const CellHit c = cdf.invert(u.x, [&](uint32_t x) { near_answer(row_start + x); });
         const Vec2 p{detail::point_in_cell(c.index, c.offset, w), detail::point_in_cell(r.index, r.offset, h)};
         return {p, pdf_of(marginal.width(r.index), cdf.width(c.index)), c.index, r.index};
     }

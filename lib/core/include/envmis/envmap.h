@@ -13,10 +13,12 @@
 //
 // Cost: build O(w h), parallel over rows (see `envmis bench` for figures); sample, pdf
 // and eval O(1), noexcept and allocation-free. Memory: 6 bytes per texel for the
-// distribution plus 12 for the RGB radiance.
+// distribution plus 12 for the RGB radiance (not the map's own when it borrows a
+// memory-mapped table's).
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -75,7 +77,8 @@ struct EnvMapView {
     Mapping mapping = Mapping::equirect;
 
     ENVMIS_HD EnvSample sample(Vec2 u) const noexcept {
-        const auto s = distribution.sample(u);
+        // Prefetching the radiance near the answer overlaps its load with the search's.
+        const auto s = distribution.sample(u, [this](size_t i) { ENVMIS_PREFETCH(radiance + i); });
         if (mapping == Mapping::equal_area) [[unlikely]]
             return sample_equal_area(s);
         const SinCos theta = sincos_turns(turns, 0.5f * s.p.y), phi = sincos_turns(turns, s.p.x);
@@ -150,6 +153,11 @@ public:
     // inconsistent parts.
     EnvMap(RgbImage radiance, LargeVector<uint32_t> density_bits, const EnvMapOptions& options,
            const EnvMapStats& stats);
+    // The same with radiance the map borrows instead of holding (a memory-mapped table
+    // file): `owner` keeps the pixels alive and unchanged for as long as the map or a
+    // copy of it lives.
+    EnvMap(RgbImageView radiance, std::shared_ptr<const void> owner, LargeVector<uint32_t> density_bits,
+           const EnvMapOptions& options, const EnvMapStats& stats);
 
     EnvMapView view() const noexcept {
         return {distribution_.view(), radiance_.pixels.data(), options_.axes, turns_.data(), options_.mapping};
@@ -163,7 +171,8 @@ public:
     uint32_t height() const noexcept { return radiance_.height; }
     const EnvMapOptions& options() const noexcept { return options_; }
     const EnvMapStats& stats() const noexcept { return stats_; }
-    const RgbImage& radiance() const noexcept { return radiance_; }
+    // The repaired radiance, as built (owned) or loaded (possibly a file mapping).
+    RgbImageView radiance() const noexcept { return radiance_; }
     const Distribution2D& distribution() const noexcept { return distribution_; }
     // The image-space density function, q(x, y) w_y, row-major, recomputed
     // from the radiance exactly as the build computed it.
@@ -181,8 +190,12 @@ public:
     bool complete() const noexcept { return stats_.zeroed_texels == 0; }
 
 private:
+    // The table constructors' common part: checks the radiance, builds the distribution.
+    void rebuild(LargeVector<uint32_t> density_bits);
 
-    RgbImage radiance_;
+    // The pixels are immutable once built, so copies of a map share them.
+    std::shared_ptr<const void> radiance_owner_;
+    RgbImageView radiance_;
     Distribution2D distribution_;
     std::vector<SinCos> turns_ = make_turn_table();
     EnvMapOptions options_;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "envmis/math.h"
@@ -16,13 +17,28 @@ namespace envmis {
 
 static_assert(sizeof(Rgb) == 3 * sizeof(float), "Rgb must be three packed floats");
 
+// Read-only view of linear RGB pixels, row-major, row 0 at the top: an RgbImage, or
+// pixels that live elsewhere (a memory-mapped table file).
+struct RgbImageView {
+    uint32_t width = 0, height = 0;
+    std::span<const Rgb> pixels;  // width * height
+
+    const Rgb& at(uint32_t x, uint32_t y) const { return pixels[static_cast<size_t>(y) * width + x]; }
+};
+
 // Linear RGB pixels, row-major, row 0 at the top.
 struct RgbImage {
     uint32_t width = 0, height = 0;
     std::vector<Rgb> pixels;  // width * height
 
     const Rgb& at(uint32_t x, uint32_t y) const { return pixels[static_cast<size_t>(y) * width + x]; }
+    operator RgbImageView() const noexcept { return {width, height, pixels}; }
 };
+
+// A copy that owns its pixels.
+inline RgbImage to_image(RgbImageView view) {
+    return {view.width, view.height, std::vector<Rgb>(view.pixels.begin(), view.pixels.end())};
+}
 
 // Counts of channel values replaced by 0.
 struct BadPixels {

@@ -20,6 +20,14 @@
 #define ENVMIS_NOINLINE
 #endif
 
+// A hint to start loading the cache line at address p; nothing where unsupported
+// (device code, other compilers).
+#if defined(__GNUC__) && !defined(__CUDA_ARCH__)
+#define ENVMIS_PREFETCH(p) __builtin_prefetch(p)
+#else
+#define ENVMIS_PREFETCH(p) ((void)(p))
+#endif
+
 namespace envmis {
 
 inline constexpr double kPi = 3.14159265358979323846;

@@ -1,6 +1,6 @@
 // Table files: a built EnvMap saved to disk, readable with envmis::core alone.
 //
-// The format (version 2; version 1 files are read too) is specified in docs/table-format.md: a fixed preamble (magic,
+// The format (version 3; versions 1 and 2 are read too) is specified in docs/table-format.md: a fixed preamble (magic,
 // version, byte order, total size), a metadata block with the build options and the
 // source's name and content hash, a header checksum, then the payload (the image
 // density q sin(theta) and the RGB radiance, both float32) and a payload checksum.
@@ -24,7 +24,7 @@
 
 namespace envmis {
 
-inline constexpr uint32_t kTableVersion = 2;
+inline constexpr uint32_t kTableVersion = 3;
 
 // Where a table's map came from.
 struct TableSource {
@@ -37,6 +37,8 @@ struct TableSource {
 struct Table {
     EnvMap map;
     TableSource source;
+    uint32_t version = 0;  // the file's format version
+    bool mapped = false;   // the map borrows its radiance from a mapping of the file
 };
 
 // A table file that cannot be read; what() names the file and the problem.
@@ -61,11 +63,23 @@ void write_table(const std::filesystem::path& path, const EnvMap& map, const Tab
                  TableEncoding encoding = TableEncoding::full);
 
 // The radiance a compact table stores: each pixel rounded to RGBE and back.
-RgbImage rgbe_round(const RgbImage& image);
+RgbImage rgbe_round(RgbImageView image);
+
+// How read_table gets a full table's radiance (12 bytes a texel).
+//   map:  borrowed from a read-only mapping of the file (POSIX mmap), which the map keeps
+//         alive: no copy, pages shared with the page cache and with other processes
+//         mapping the same table. Compact and version 1-2 tables, and platforms without
+//         mmap, are read as with `copy`. write_table replaces a file by renaming, which
+//         leaves a mapping of the old one intact; a program that truncates a mapped
+//         table in place makes the next access to it fault (SIGBUS): read such files
+//         with `copy`.
+//   copy: read into memory the map owns.
+// Either way the density is read into the buffer that becomes the CDF table.
+enum class TableLoading { map, copy };
 
 // Reads and verifies a table. Throws TableError if the file is missing, truncated,
 // corrupted (checksums), of another format, or of an unsupported version.
-Table read_table(const std::filesystem::path& path);
+Table read_table(const std::filesystem::path& path, TableLoading loading = TableLoading::map);
 
 // The same checks on bytes already in memory; `name` appears in error messages.
 Table parse_table(std::span<const std::byte> bytes, std::string_view name);

@@ -53,7 +53,7 @@ struct Image8 {
 };
 
 // Writes linear float RGB as a 32-bit float OpenEXR file.
-void write_exr(const std::filesystem::path& path, const RgbImage& image);
+void write_exr(const std::filesystem::path& path, RgbImageView image);
 // Writes a PNG file.
 void write_png(const std::filesystem::path& path, const Image8& image);
 

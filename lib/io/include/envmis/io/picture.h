@@ -50,7 +50,7 @@ void blit(Image8& dst, const Image8& src, int x, int y);
 // Area-weighted box resampling to new_width x new_height: each output pixel is the mean of
 // the input area it covers, so downsizing an 8192x4096 map to 512x256 averages 16x16
 // blocks and keeps the image's mean. NaN and Inf count as 0.
-RgbImage resize(const RgbImage& image, uint32_t new_width, uint32_t new_height);
+RgbImage resize(RgbImageView image, uint32_t new_width, uint32_t new_height);
 // The same for one float per pixel (densities, errors), row-major, width x height values.
 std::vector<float> resize(std::span<const float> values, uint32_t width, uint32_t height,
                           uint32_t new_width, uint32_t new_height);
@@ -67,7 +67,7 @@ Image8 resize(const Image8& image, uint32_t new_width, uint32_t new_height);
 // a hue; the result is sRGB-encoded. Black maps to black and the mapping is monotone in
 // each channel. NaN, Inf and negative channel values are treated as 0. Downsize first:
 // it is faster, and the exposure is then measured on what is shown.
-Image8 tonemap(const RgbImage& image, float exposure_stops = 0, LumaCoefficients luma = {});
+Image8 tonemap(RgbImageView image, float exposure_stops = 0, LumaCoefficients luma = {});
 
 // ---------------------------------------------------------------------------------------
 // False colour
