@@ -1,5 +1,7 @@
 #include "mapped_file.h"
 
+#include <cstdint>
+
 #if defined(__unix__) || defined(__APPLE__)
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -32,10 +34,18 @@ std::shared_ptr<const MappedFile> MappedFile::map(const std::filesystem::path& p
 
 MappedFile::~MappedFile() { ::munmap(const_cast<std::byte*>(data_), size_); }
 
+void MappedFile::release(std::span<const std::byte> range) const noexcept {
+    const auto page = static_cast<uintptr_t>(::sysconf(_SC_PAGESIZE));
+    const auto first = (reinterpret_cast<uintptr_t>(range.data()) + page - 1) / page * page;
+    const auto last = (reinterpret_cast<uintptr_t>(range.data()) + range.size()) / page * page;
+    if (last > first) ::madvise(reinterpret_cast<void*>(first), last - first, MADV_DONTNEED);
+}
+
 #else
 
 std::shared_ptr<const MappedFile> MappedFile::map(const std::filesystem::path&) noexcept { return nullptr; }
 MappedFile::~MappedFile() = default;
+void MappedFile::release(std::span<const std::byte>) const noexcept {}
 
 #endif
 

@@ -21,6 +21,10 @@ public:
     ~MappedFile();
 
     std::span<const std::byte> bytes() const noexcept { return {data_, size_}; }
+    // Tells the system that the whole pages inside `range` (part of bytes()) will not be
+    // read again: they leave this process's resident set (the page cache keeps them, so
+    // a later read still works, from the cache or the file).
+    void release(std::span<const std::byte> range) const noexcept;
 
 private:
     MappedFile(const std::byte* data, size_t size) noexcept : data_(data), size_(size) {}

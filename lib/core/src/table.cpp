@@ -413,6 +413,7 @@ std::optional<Table> read_mapped_payload(Header header, std::shared_ptr<const de
     if (digest != payload_hash.digest()) fail(name, "corrupted payload (checksum mismatch)");
     LargeVector<uint32_t> density(texels);
     std::memcpy(density.data(), density_bytes.data(), density_bytes.size());
+    file->release(density_bytes);
     const RgbImageView radiance{header.w, header.h,
                                 std::span(reinterpret_cast<const Rgb*>(radiance_bytes.data()), static_cast<size_t>(texels))};
     Table table = checked_table(name, header.version, std::move(header.source), [&] {
