@@ -405,15 +405,21 @@ std::optional<Table> read_mapped_payload(Header header, std::shared_ptr<const de
     const auto radiance_bytes = payload.subspan(density_bytes.size(), texels * sizeof(Rgb));
     if (header.compact || header.version < 3 || reinterpret_cast<uintptr_t>(radiance_bytes.data()) % alignof(Rgb) != 0)
         return std::nullopt;
+    // The density a chunk at a time: hashed, copied, and its mapped pages released at
+    // once, so that they and the copy are never both resident (the load's peak memory).
+    constexpr size_t kChunk = size_t{32} << 20;
+    LargeVector<uint32_t> density(texels);
     Hasher payload_hash;
-    payload_hash.update(density_bytes);
+    for (size_t at = 0; at < density_bytes.size(); at += kChunk) {
+        const auto chunk = density_bytes.subspan(at, std::min(kChunk, density_bytes.size() - at));
+        payload_hash.update(chunk);
+        std::memcpy(reinterpret_cast<std::byte*>(density.data()) + at, chunk.data(), chunk.size());
+        file->release(chunk);
+    }
     payload_hash.update(radiance_bytes);
     uint64_t digest = 0;
     std::memcpy(&digest, payload.data() + density_bytes.size() + radiance_bytes.size(), sizeof digest);
     if (digest != payload_hash.digest()) fail(name, "corrupted payload (checksum mismatch)");
-    LargeVector<uint32_t> density(texels);
-    std::memcpy(density.data(), density_bytes.data(), density_bytes.size());
-    file->release(density_bytes);
     const RgbImageView radiance{header.w, header.h,
                                 std::span(reinterpret_cast<const Rgb*>(radiance_bytes.data()), static_cast<size_t>(texels))};
     Table table = checked_table(name, header.version, std::move(header.source), [&] {
