@@ -186,10 +186,7 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : options_(options)
     check_image(image, options_.mapping);
     check_options(options_);
     const uint32_t w = image.width, h = image.height;
-    auto owned = std::make_shared<std::vector<Rgb>>(std::move(image.pixels));
-    Rgb* pixels = owned->data();
-    radiance_ = {w, h, *owned};
-    radiance_owner_ = std::move(owned);
+    Rgb* pixels = adopt(std::move(image)).data();
 
     // Pass 1 gives Lbar, and keeps each texel's luminance in the memory that the start
     // table will occupy: pass 2 then reads 4 bytes a texel instead of the 12 of RGB.
@@ -243,9 +240,7 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : options_(options)
 EnvMap::EnvMap(RgbImage radiance, LargeVector<uint32_t> density_bits, const EnvMapOptions& options,
                const EnvMapStats& stats)
     : options_(options), stats_(stats) {
-    auto owned = std::make_shared<const std::vector<Rgb>>(std::move(radiance.pixels));
-    radiance_ = {radiance.width, radiance.height, *owned};
-    radiance_owner_ = std::move(owned);
+    adopt(std::move(radiance));
     rebuild(std::move(density_bits));
 }
 
@@ -253,6 +248,13 @@ EnvMap::EnvMap(RgbImageView radiance, std::shared_ptr<const void> owner, LargeVe
                const EnvMapOptions& options, const EnvMapStats& stats)
     : radiance_owner_(std::move(owner)), radiance_(radiance), options_(options), stats_(stats) {
     rebuild(std::move(density_bits));
+}
+
+std::vector<Rgb>& EnvMap::adopt(RgbImage image) {
+    auto owned = std::make_shared<std::vector<Rgb>>(std::move(image.pixels));
+    radiance_ = {image.width, image.height, *owned};
+    radiance_owner_ = owned;
+    return *owned;
 }
 
 void EnvMap::rebuild(LargeVector<uint32_t> density_bits) {

@@ -397,7 +397,7 @@ Table read_payload(Header header, Read&& read, std::string_view name) {
 // radiance from the mapping, which it keeps alive; only the density is copied, into the
 // buffer that becomes the CDF table. Null if the payload cannot be used in place (compact,
 // or an older version whose arrays may be misaligned).
-std::optional<Table> read_mapped_payload(Header header, std::shared_ptr<const detail::MappedFile> file,
+std::optional<Table> read_mapped_payload(Header header, const std::shared_ptr<const detail::MappedFile>& file,
                                          std::string_view name) {
     const uint64_t texels = uint64_t{header.w} * header.h;
     const std::span<const std::byte> payload = file->bytes().subspan(static_cast<size_t>(header.payload_offset));
@@ -423,16 +423,14 @@ std::optional<Table> read_mapped_payload(Header header, std::shared_ptr<const de
     const RgbImageView radiance{header.w, header.h,
                                 std::span(reinterpret_cast<const Rgb*>(radiance_bytes.data()), static_cast<size_t>(texels))};
     Table table = checked_table(name, header.version, std::move(header.source), [&] {
-        return EnvMap(radiance, std::move(file), std::move(density), header.options, header.stats);
+        return EnvMap(radiance, file, std::move(density), header.options, header.stats);
     });
     table.mapped = true;
     return table;
 }
 
-}  // namespace
-
-Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
-    Header header = parse_header(bytes, bytes.size(), name);
+// The payload of `bytes`, a whole table file in memory, copied out of it.
+Table copy_payload(Header header, std::span<const std::byte> bytes, std::string_view name) {
     size_t pos = static_cast<size_t>(header.payload_offset);
     return read_payload(
         std::move(header),
@@ -443,16 +441,22 @@ Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
         name);
 }
 
+}  // namespace
+
+Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
+    return copy_payload(parse_header(bytes, bytes.size(), name), bytes, name);
+}
+
 Table read_table(const std::filesystem::path& path, TableLoading loading) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw TableError(path.string() + ": no such file");
     if (!std::filesystem::is_regular_file(path, ec)) throw TableError(path.string() + ": not a regular file");
     if (loading == TableLoading::map)
-        if (std::shared_ptr<const detail::MappedFile> file = detail::MappedFile::map(path)) {
+        if (const std::shared_ptr<const detail::MappedFile> file = detail::MappedFile::map(path)) {
             const std::span<const std::byte> bytes = file->bytes();
             Header header = parse_header(bytes, bytes.size(), path.string());
-            if (std::optional<Table> table = read_mapped_payload(header, std::move(file), path.string()))
-                return std::move(*table);
+            if (std::optional<Table> table = read_mapped_payload(header, file, path.string())) return std::move(*table);
+            return copy_payload(std::move(header), bytes, path.string());
         }
     std::ifstream file(path, std::ios::binary | std::ios::ate);
     if (!file) throw TableError(describe_errno(path, "open"));

@@ -190,6 +190,9 @@ public:
     bool complete() const noexcept { return stats_.zeroed_texels == 0; }
 
 private:
+    // Makes the image's pixels the map's own radiance; returns them, still writable for
+    // the build's repair of bad values.
+    std::vector<Rgb>& adopt(RgbImage image);
     // The table constructors' common part: checks the radiance, builds the distribution.
     void rebuild(LargeVector<uint32_t> density_bits);
 

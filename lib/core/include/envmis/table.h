@@ -68,11 +68,11 @@ RgbImage rgbe_round(RgbImageView image);
 // How read_table gets a full table's radiance (12 bytes a texel).
 //   map:  borrowed from a read-only mapping of the file (POSIX mmap), which the map keeps
 //         alive: no copy, pages shared with the page cache and with other processes
-//         mapping the same table. Compact and version 1-2 tables, and platforms without
-//         mmap, are read as with `copy`. write_table replaces a file by renaming, which
-//         leaves a mapping of the old one intact; a program that truncates a mapped
-//         table in place makes the next access to it fault (SIGBUS): read such files
-//         with `copy`.
+//         mapping the same table. Compact and version 1-2 tables are copied out of the
+//         mapping into memory the map owns; without mmap, `map` reads as `copy` does.
+//         write_table replaces a file by renaming, which leaves a mapping of the old one
+//         intact; a program that truncates a mapped table in place makes the next
+//         access to it fault (SIGBUS): read such files with `copy`.
 //   copy: read into memory the map owns.
 // Either way the density is read into the buffer that becomes the CDF table.
 enum class TableLoading { map, copy };
