@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 
 #include "envmis/comparison.h"
@@ -244,6 +245,31 @@ TEST(Estimator, BalanceMisUsesTheRandomNumbersInTheirDocumentedOrder) {
                             << name << " " << a.env << "+" << a.bsdf << " seed " << seed << " channel " << c;
                     ASSERT_EQ(rng.uniform(), mine.uniform()) << name << ": the generator is not exactly past the numbers used";
                 }
+            }
+}
+
+// Many estimates asked at once are the estimates one at a time would give, bit for
+// bit, from the same random numbers: for every technique (those that run side by side
+// and those that do not), for allocations within and beyond what runs side by side, and
+// across the groups of 32 a request is split into. Adaptive techniques learn the same.
+TEST(Estimator, ManyEstimatesAtOnceEqualTheSameEstimatesOneAtATime) {
+    const Maps maps = make_maps("sun", test::sun_sky_map(128, 64));
+    const ShadingPoint point{normalize(Vec3{0.3f, -0.2f, 1}), normalize(Vec3{-0.5f, 0.4f, 1})};
+    for (const Bsdf& bsdf : {Bsdf::lambert(), Bsdf::phong(20), Bsdf::ggx(0.2f)})
+        for (const Allocation a : {Allocation{1, 1}, Allocation{2, 3}, Allocation{5, 4}})
+            for (const Technique& t : valid_techniques()) {
+                const DirectLightingEstimator estimator(maps.plain, maps.compensated, t, a);
+                Pcg32 rng(7), mine(7);
+                PointState state, my_state;
+                std::vector<Rgb> got(100);
+                estimator.estimate(point, bsdf, rng, state, got);
+                for (size_t i = 0; i < got.size(); ++i) {
+                    const Rgb expected = estimator.estimate(point, bsdf, mine, my_state);
+                    ASSERT_EQ(std::memcmp(&got[i], &expected, sizeof(Rgb)), 0)
+                        << t.name() << " " << bsdf.name() << " " << a.env << "+" << a.bsdf << " estimate " << i;
+                }
+                EXPECT_EQ(rng.uniform(), mine.uniform()) << t.name() << ": not the same random numbers";
+                EXPECT_EQ(state.estimates, my_state.estimates) << t.name();
             }
 }
 

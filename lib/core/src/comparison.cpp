@@ -1,5 +1,6 @@
 #include "envmis/comparison.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -13,6 +14,8 @@ namespace {
 // Interleaved batches per cell: the spread of their variances is the noise of the
 // cell's variance estimate, whatever the estimates' distribution.
 constexpr uint32_t kBatches = 8;
+// Estimates asked of an estimator at a time: enough for it to run them side by side.
+constexpr uint32_t kChunk = 64;
 
 // What one (point, BSDF, technique) cell of the study measured.
 struct Cell {
@@ -64,9 +67,11 @@ Rgb average_estimate(const DirectLightingEstimator& estimator, const ShadingPoin
     Pcg32 rng(seed, stream);
     PointState state;
     double r = 0, g = 0, b = 0;
-    for (uint32_t i = 0; i < spp; ++i) {
-        const Rgb e = estimator.estimate(point, bsdf, rng, state);
-        r += e.r, g += e.g, b += e.b;
+    Rgb chunk[kChunk];
+    for (uint32_t first = 0; first < spp; first += kChunk) {
+        const std::span<Rgb> estimates(chunk, std::min(kChunk, spp - first));
+        estimator.estimate(point, bsdf, rng, state, estimates);
+        for (const Rgb& e : estimates) r += e.r, g += e.g, b += e.b;
     }
     return {static_cast<float>(r / spp), static_cast<float>(g / spp), static_cast<float>(b / spp)};
 }
@@ -102,11 +107,16 @@ Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<con
                 Pcg32 rng(options.seed, (done * nb + b) * nt + t);
                 PointState state;
                 const auto start = std::chrono::steady_clock::now();
-                for (uint32_t i = 0; i < options.spp; ++i) {
-                    const double x = luminance(estimators[t].estimate(point, options.bsdfs[b], rng, state), luma);
-                    cell.estimates.add(x);
-                    cell.batches[i % kBatches].add(x);
-                    if (reference > 0) cell.squared_relative_error.add((x - reference) * (x - reference) / (reference * reference));
+                Rgb chunk[kChunk];
+                for (uint32_t first = 0; first < options.spp; first += kChunk) {
+                    const uint32_t count = std::min(kChunk, options.spp - first);
+                    estimators[t].estimate(point, options.bsdfs[b], rng, state, {chunk, count});
+                    for (uint32_t i = first; i < first + count; ++i) {
+                        const double x = luminance(chunk[i - first], luma);
+                        cell.estimates.add(x);
+                        cell.batches[i % kBatches].add(x);
+                        if (reference > 0) cell.squared_relative_error.add((x - reference) * (x - reference) / (reference * reference));
+                    }
                 }
                 cell.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
                 cell.ill_conditioned = options.techniques[t].heuristic == Heuristic::optimal && state.estimates >= 8 &&

@@ -1,5 +1,6 @@
 #include "envmis/estimator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -71,6 +72,81 @@ void update(PointState& s, Heuristic h, int m) noexcept {
     }
 }
 
+// Sample counts of the environment (0) and BSDF (1) techniques in one estimate.
+struct Counts {
+    float n[2];
+};
+Counts sample_counts(const Technique& t, const Allocation& a) noexcept {
+    const Strategy s = t.strategy;
+    const bool both = s == Strategy::mis || s == Strategy::one_sample;
+    return {{static_cast<float>(s == Strategy::env ? a.total() : (both ? a.env : 0)),
+             static_cast<float>(s == Strategy::bsdf ? a.total() : (both ? a.bsdf : 0))}};
+}
+
+// The weight of a sample of technique k (0: environment, 1: BSDF), q = n p of both, for
+// the techniques whose weights depend on the densities alone: 1 for a single technique,
+// the balance or power heuristic for MIS. One-sample MIS picks technique k with
+// probability n_k / total: its estimate, averaged over total draws, is f / sum q as for
+// multi-sample balance.
+float fixed_weight(const Technique& t, const float* q, int k) noexcept {
+    if (t.strategy == Strategy::env || t.strategy == Strategy::bsdf) return 1;
+    return t.strategy == Strategy::mis && t.heuristic == Heuristic::power ? power_weight(q, 2, k)
+                                                                           : balance_weight(q, 2, k);
+}
+
+// Estimates side by side, for the fixed-weight techniques over one density.
+constexpr uint32_t kLanes = 32;
+constexpr uint32_t kMaxLaneSamples = 8;  // per estimate; estimates that spend more go one at a time
+
+bool runs_in_lanes(const Technique& t, const Allocation& a) noexcept {
+    return !t.adaptive() && !t.mixture && t.strategy != Strategy::one_sample && a.total() <= kMaxLaneSamples;
+}
+
+// Up to `lanes` (<= kMaxLanes) estimates at once, each step over all of them: the random
+// numbers (drawn in the order one estimate at a time would draw them: each estimate's
+// environment samples, then its BSDF samples, two numbers each), then each environment
+// sample, then each BSDF sample, whose radiance and density are prefetched a whole step
+// ahead. kMaxLanes sizes the working arrays, which one estimate alone must not pay for.
+template <uint32_t kMaxLanes>
+void estimate_lanes(const EnvMapView& env, const Technique& t, const Allocation& a, const Frame& frame, Vec3 wo,
+                    const Bsdf& bsdf, Pcg32& rng, std::span<Rgb> out) noexcept {
+    const Counts counts = sample_counts(t, a);
+    const auto n_env = static_cast<uint32_t>(counts.n[0]), n_bsdf = static_cast<uint32_t>(counts.n[1]);
+    const uint32_t lanes = static_cast<uint32_t>(out.size());
+    Vec2 u[kMaxLaneSamples][kMaxLanes];
+    for (uint32_t l = 0; l < lanes; ++l)
+        for (uint32_t j = 0; j < n_env + n_bsdf; ++j) u[j][l] = rng.uniform2();
+    std::fill(out.begin(), out.end(), Rgb{});
+    auto contribute = [&](Rgb& sum, int k, Rgb f, const float* p) {
+        const float q[2] = {counts.n[0] * p[0], counts.n[1] * p[1]};
+        add(sum, f, fixed_weight(t, q, k) / q[k]);
+    };
+    for (uint32_t j = 0; j < n_env; ++j) {
+        EnvSample e[kMaxLanes];
+        for (uint32_t l = 0; l < lanes; ++l) e[l] = env.sample(u[j][l]);
+        for (uint32_t l = 0; l < lanes; ++l) {
+            if (!(e[l].pdf > 0)) continue;
+            const Vec3 wi = frame.to_local(e[l].direction);
+            const float p[2] = {e[l].pdf, bsdf.pdf(wo, wi)};
+            contribute(out[l], 0, e[l].radiance * bsdf.eval(wo, wi), p);
+        }
+    }
+    for (uint32_t j = n_env; j < n_env + n_bsdf; ++j) {
+        BsdfSample b[kMaxLanes];
+        Vec2 uv[kMaxLanes];
+        for (uint32_t l = 0; l < lanes; ++l) {
+            b[l] = bsdf.sample(wo, u[j][l]);
+            uv[l] = env.uv_of(frame.to_world(b[l].wi));
+            env.prefetch_uv(uv[l]);
+        }
+        for (uint32_t l = 0; l < lanes; ++l) {
+            if (!(b[l].pdf > 0)) continue;
+            const float p[2] = {env.pdf_uv(uv[l]), b[l].pdf};
+            contribute(out[l], 1, env.eval_uv(uv[l]) * b[l].value, p);
+        }
+    }
+}
+
 }  // namespace
 
 Technique Technique::parse(std::string_view name) {
@@ -128,12 +204,15 @@ Rgb DirectLightingEstimator::estimate(const ShadingPoint& point, const Bsdf& bsd
     const Frame frame = Frame::from_normal(point.normal);
     const Vec3 wo = frame.to_local(point.wo);
     const Technique t = technique_;
+    if (runs_in_lanes(t, allocation_)) {
+        Rgb sum;
+        estimate_lanes<1>(env_, t, allocation_, frame, wo, bsdf, rng, {&sum, 1});
+        return sum;
+    }
     const Strategy s = t.strategy;
     const uint32_t total = allocation_.total();
-    const bool both = s == Strategy::mis || s == Strategy::one_sample;
-    // Sample counts of the environment (0) and BSDF (1) techniques.
-    const float n[2] = {static_cast<float>(s == Strategy::env ? total : (both ? allocation_.env : 0)),
-                        static_cast<float>(s == Strategy::bsdf ? total : (both ? allocation_.bsdf : 0))};
+    const Counts counts = sample_counts(t, allocation_);
+    const float* n = counts.n;
     const bool optimal = s == Strategy::mis && t.heuristic == Heuristic::optimal;
     const bool variance_aware = s == Strategy::mis && t.heuristic == Heuristic::variance_aware;
     const int m = t.mixture ? 3 : 2;  // optimal MIS's control variates
@@ -164,14 +243,7 @@ Rgb DirectLightingEstimator::estimate(const ShadingPoint& point, const Bsdf& bsd
             }
             return;
         }
-        float weight = 1;
-        if (s == Strategy::mis || s == Strategy::one_sample) {
-            // One-sample MIS picks technique k with probability n_k / total: its estimate,
-            // averaged over total draws, is f / sum q as for multi-sample balance.
-            if (s == Strategy::one_sample || t.heuristic == Heuristic::balance) weight = balance_weight(q, 2, k);
-            else if (t.heuristic == Heuristic::power) weight = power_weight(q, 2, k);
-            else weight = variance_aware_weight(q, state.nu, 2, k);
-        }
+        const float weight = variance_aware ? variance_aware_weight(q, state.nu, 2, k) : fixed_weight(t, q, k);
         add(sum, f, weight / q[k]);
         if (variance_aware) {
             const double y = luminance(f, luma_) / p[k];
@@ -217,6 +289,19 @@ Rgb DirectLightingEstimator::estimate(const ShadingPoint& point, const Bsdf& bsd
         state.next_update *= 2;
     }
     return sum;
+}
+
+void DirectLightingEstimator::estimate(const ShadingPoint& point, const Bsdf& bsdf, Pcg32& rng, PointState& state,
+                                       std::span<Rgb> out) const noexcept {
+    if (!runs_in_lanes(technique_, allocation_) || out.size() == 1) {
+        for (Rgb& e : out) e = estimate(point, bsdf, rng, state);
+        return;
+    }
+    const Frame frame = Frame::from_normal(point.normal);
+    const Vec3 wo = frame.to_local(point.wo);
+    for (size_t first = 0; first < out.size(); first += kLanes)
+        estimate_lanes<kLanes>(env_, technique_, allocation_, frame, wo, bsdf, rng,
+                               out.subspan(first, std::min<size_t>(kLanes, out.size() - first)));
 }
 
 }  // namespace envmis

@@ -117,6 +117,15 @@ struct EnvMapView {
         const uint32_t x = detail::cell_of(uv.x, distribution.w), y = detail::cell_of(uv.y, distribution.h);
         return radiance[static_cast<size_t>(y) * distribution.w + x];
     }
+    // Starts loading what eval_uv and pdf_uv read at uv, so that code with several
+    // lookups to make (a batch of shading samples) overlaps their cache misses.
+    ENVMIS_HD void prefetch_uv(Vec2 uv) const noexcept {
+        const uint32_t x = detail::cell_of(uv.x, distribution.w), y = detail::cell_of(uv.y, distribution.h);
+        const size_t i = static_cast<size_t>(y) * distribution.w + x;
+        ENVMIS_PREFETCH(radiance + i);
+        ENVMIS_PREFETCH(distribution.start + i);
+        ENVMIS_PREFETCH(distribution.marginal.start + y);
+    }
     // Both at once, mapping the direction to the image once (MIS needs both).
     struct Lookup {
         Rgb radiance;

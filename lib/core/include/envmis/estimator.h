@@ -25,6 +25,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -118,6 +119,15 @@ public:
         PointState state;
         return estimate(point, bsdf, rng, state);
     }
+
+    // out.size() estimates at one point, the same as that many calls of the above in
+    // a row (bit-identical, the same random numbers). The techniques with fixed weights
+    // (env, bsdf, mis-balance, mis-power, compensated or not) run up to 32 estimates
+    // side by side: the shading frame is built once, and each step runs over all of
+    // them before the next, so their cache misses overlap instead of following one
+    // another (see README, Performance). noexcept and allocation-free.
+    void estimate(const ShadingPoint& point, const Bsdf& bsdf, Pcg32& rng, PointState& state,
+                  std::span<Rgb> out) const noexcept;
 
     Technique technique() const noexcept { return technique_; }
     Allocation allocation() const noexcept { return allocation_; }
