@@ -106,19 +106,19 @@ Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<con
                 Cell& cell = cells[first + job];
                 Pcg32 rng(options.seed, (done * nb + b) * nt + t);
                 PointState state;
-                const auto start = std::chrono::steady_clock::now();
                 Rgb chunk[kChunk];
-                for (uint32_t first = 0; first < options.spp; first += kChunk) {
-                    const uint32_t count = std::min(kChunk, options.spp - first);
+                for (uint32_t begin = 0; begin < options.spp; begin += kChunk) {
+                    const uint32_t count = std::min(kChunk, options.spp - begin);
+                    const auto start = std::chrono::steady_clock::now();
                     estimators[t].estimate(point, options.bsdfs[b], rng, state, {chunk, count});
-                    for (uint32_t i = first; i < first + count; ++i) {
-                        const double x = luminance(chunk[i - first], luma);
+                    cell.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+                    for (uint32_t i = begin; i < begin + count; ++i) {
+                        const double x = luminance(chunk[i - begin], luma);
                         cell.estimates.add(x);
                         cell.batches[i % kBatches].add(x);
                         if (reference > 0) cell.squared_relative_error.add((x - reference) * (x - reference) / (reference * reference));
                     }
                 }
-                cell.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
                 cell.ill_conditioned = options.techniques[t].heuristic == Heuristic::optimal && state.estimates >= 8 &&
                                        !state.optimal.solved;
             }

@@ -8,6 +8,7 @@
 //   std_error                   standard error of the aggregated mean
 //   rel_mse                     mean over points and estimates of ((F - ref) / ref)^2
 //   ns_per_estimate             wall time per estimate, all estimates of the technique
+//                               (the estimator's own time, without the statistics kept)
 //   efficiency                  1 / (variance * seconds per estimate)
 //   variance_ratio_vs_mis       geometric mean over points of variance / variance of
 //                               mis-balance (each point counts equally, bright or dim)
