@@ -110,6 +110,9 @@ TEST(Estimator, RefusesEnvironmentSamplingAloneOverACompensatedDensity) {
     }
     EXPECT_NO_THROW(DirectLightingEstimator(maps.compensated, Technique::parse("mis-balance-comp")));
     EXPECT_THROW(DirectLightingEstimator(maps.plain, Technique::parse("mis-balance"), {0, 2}), std::invalid_argument);
+    // A sample count that wraps around 32 bits.
+    EXPECT_THROW(DirectLightingEstimator(maps.plain, Technique::parse("mis-balance"), {0xFFFFFF00u, 0x105u}),
+                 std::invalid_argument);
 }
 
 TEST(Estimator, OptimalMisLowersLambertVarianceUnderASunnyMap) {
@@ -193,19 +196,24 @@ TEST(Estimator, MixtureNeedsBothMaps) {
 // The random numbers' order is part of the estimator's contract (results are
 // reproducible from a seed): the environment samples take theirs first (the mixture one
 // more each, for its choice of density), then the BSDF samples, two each. An estimate
-// equals the balance heuristic's sum computed here by hand from those numbers, and
-// leaves the generator exactly past them.
-TEST(Estimator, BalanceMisUsesTheRandomNumbersInTheirDocumentedOrder) {
+// equals the sum computed here by hand from those numbers, with the weights of its
+// technique (balance: f / sum q; power: f q_k / sum q^2; a single technique: f / (n p),
+// n its whole sample count), and leaves the generator exactly past them.
+TEST(Estimator, FixedWeightEstimatesUseTheRandomNumbersInTheirDocumentedOrder) {
     const Maps maps = make_maps("sun", test::sun_sky_map(128, 64));
     const ShadingPoint point{normalize(Vec3{0.3f, -0.2f, 1}), normalize(Vec3{-0.5f, 0.4f, 1})};
     const Frame frame = Frame::from_normal(point.normal);
     const Vec3 wo = frame.to_local(point.wo);
     for (const Bsdf& bsdf : {Bsdf::lambert(), Bsdf::ggx(0.2f)})
         for (const Allocation a : {Allocation{1, 1}, Allocation{2, 3}})
-            for (const char* name : {"mis-balance", "mis-balance-comp", "mis-balance-all"}) {
+            for (const char* name :
+                 {"mis-balance", "mis-balance-comp", "mis-balance-all", "mis-power", "mis-power-comp", "env", "bsdf"}) {
                 const Technique t = Technique::parse(name);
                 const DirectLightingEstimator estimator(maps.plain, maps.compensated, t, a);
                 const EnvMap& sampled = t.compensated && !t.mixture ? maps.compensated : maps.plain;
+                const bool power = t.strategy == Strategy::mis && t.heuristic == Heuristic::power;
+                const uint32_t n_env = t.strategy == Strategy::env ? a.total() : (t.strategy == Strategy::bsdf ? 0 : a.env);
+                const uint32_t n_bsdf = t.strategy == Strategy::bsdf ? a.total() : (t.strategy == Strategy::env ? 0 : a.bsdf);
                 // Density of the environment technique at a direction: the mixture's is
                 // the mean of both maps'.
                 const auto env_pdf = [&](Vec3 w) {
@@ -215,11 +223,13 @@ TEST(Estimator, BalanceMisUsesTheRandomNumbersInTheirDocumentedOrder) {
                     Pcg32 rng(seed), mine(seed);
                     const Rgb got = estimator.estimate(point, bsdf, rng);
                     double sum[3] = {};
-                    const auto add = [&](Rgb f, float p_env, float p_bsdf) {
-                        const double q = a.env * double(p_env) + a.bsdf * double(p_bsdf);
-                        sum[0] += f.r / q, sum[1] += f.g / q, sum[2] += f.b / q;
+                    // A sample of technique k (0: environment, 1: BSDF) with value f.
+                    const auto add = [&](int k, Rgb f, float p_env, float p_bsdf) {
+                        const double q[2] = {n_env * double(p_env), n_bsdf * double(p_bsdf)};
+                        const double s = power ? q[k] / (q[0] * q[0] + q[1] * q[1]) : 1 / (q[0] + q[1]);
+                        sum[0] += f.r * s, sum[1] += f.g * s, sum[2] += f.b * s;
                     };
-                    for (uint32_t i = 0; i < a.env; ++i) {
+                    for (uint32_t i = 0; i < n_env; ++i) {
                         const bool from_plain = t.mixture && mine.uniform() < 0.5f;
                         const EnvMap& map = t.mixture ? (from_plain ? maps.plain : maps.compensated) : sampled;
                         const EnvSample e = map.sample(mine.uniform2());
@@ -229,14 +239,14 @@ TEST(Estimator, BalanceMisUsesTheRandomNumbersInTheirDocumentedOrder) {
                         // The sampled density's pdf is the one the sample returned.
                         const float p_env = !t.mixture ? e.pdf
                                             : 0.5f * (e.pdf + (from_plain ? maps.compensated : maps.plain).pdf(e.direction));
-                        add({e.radiance.r * f.r, e.radiance.g * f.g, e.radiance.b * f.b}, p_env, bsdf.pdf(wo, wi));
+                        add(0, {e.radiance.r * f.r, e.radiance.g * f.g, e.radiance.b * f.b}, p_env, bsdf.pdf(wo, wi));
                     }
-                    for (uint32_t i = 0; i < a.bsdf; ++i) {
+                    for (uint32_t i = 0; i < n_bsdf; ++i) {
                         const BsdfSample b = bsdf.sample(wo, mine.uniform2());
                         if (!(b.pdf > 0)) continue;
                         const Vec3 wi = frame.to_world(b.wi);
                         const Rgb l = sampled.eval(wi);
-                        add({l.r * b.value.r, l.g * b.value.g, l.b * b.value.b}, env_pdf(wi), b.pdf);
+                        add(1, {l.r * b.value.r, l.g * b.value.g, l.b * b.value.b}, env_pdf(wi), b.pdf);
                     }
                     const float expected[3] = {static_cast<float>(sum[0]), static_cast<float>(sum[1]), static_cast<float>(sum[2])};
                     const float actual[3] = {got.r, got.g, got.b};

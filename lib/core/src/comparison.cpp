@@ -68,8 +68,8 @@ Rgb average_estimate(const DirectLightingEstimator& estimator, const ShadingPoin
     PointState state;
     double r = 0, g = 0, b = 0;
     Rgb chunk[kChunk];
-    for (uint32_t first = 0; first < spp; first += kChunk) {
-        const std::span<Rgb> estimates(chunk, std::min(kChunk, spp - first));
+    for (uint64_t first = 0; first < spp; first += kChunk) {
+        const std::span<Rgb> estimates(chunk, std::min<uint64_t>(kChunk, spp - first));
         estimator.estimate(point, bsdf, rng, state, estimates);
         for (const Rgb& e : estimates) r += e.r, g += e.g, b += e.b;
     }
@@ -107,12 +107,12 @@ Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<con
                 Pcg32 rng(options.seed, (done * nb + b) * nt + t);
                 PointState state;
                 Rgb chunk[kChunk];
-                for (uint32_t begin = 0; begin < options.spp; begin += kChunk) {
-                    const uint32_t count = std::min(kChunk, options.spp - begin);
+                for (uint64_t begin = 0; begin < options.spp; begin += kChunk) {
+                    const uint64_t count = std::min<uint64_t>(kChunk, options.spp - begin);
                     const auto start = std::chrono::steady_clock::now();
                     estimators[t].estimate(point, options.bsdfs[b], rng, state, {chunk, count});
                     cell.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-                    for (uint32_t i = begin; i < begin + count; ++i) {
+                    for (uint64_t i = begin; i < begin + count; ++i) {
                         const double x = luminance(chunk[i - begin], luma);
                         cell.estimates.add(x);
                         cell.batches[i % kBatches].add(x);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "envmis/frame.h"
@@ -182,6 +183,9 @@ DirectLightingEstimator::DirectLightingEstimator(const EnvMap& plain, const EnvM
       technique_(technique),
       allocation_(allocation) {
     if (allocation.total() == 0) throw std::invalid_argument("an estimate needs at least one sample");
+    if (allocation.env > std::numeric_limits<uint32_t>::max() - allocation.bsdf)
+        throw std::invalid_argument("too many samples per estimate: " + std::to_string(allocation.env) + " + " +
+                                    std::to_string(allocation.bsdf) + " does not fit in 32 bits");
     const bool both = technique.strategy == Strategy::mis || technique.strategy == Strategy::one_sample;
     if (both && (allocation.env == 0 || allocation.bsdf == 0))
         throw std::invalid_argument(technique.name() + " needs at least one environment and one BSDF sample per estimate");

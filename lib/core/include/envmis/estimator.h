@@ -102,8 +102,8 @@ public:
     // `plain` and `compensated` are the same map without and with compensation; the
     // technique samples the one it names (both for the mixture). Throws
     // std::invalid_argument if the technique samples only the environment over an
-    // incomplete (compensated) density, if the allocation spends no sample, or if MIS
-    // is given a zero count for one of its techniques.
+    // incomplete (compensated) density, if the allocation spends no sample or more than
+    // 2^32 - 1, or if MIS is given a zero count for one of its techniques.
     DirectLightingEstimator(const EnvMap& plain, const EnvMap& compensated, Technique technique,
                             Allocation allocation = {});
     // The same for a technique that needs one map (not the mixture): `env` is the map
@@ -122,10 +122,11 @@ public:
 
     // out.size() estimates at one point, the same as that many calls of the above in
     // a row (bit-identical, the same random numbers). The techniques with fixed weights
-    // (env, bsdf, mis-balance, mis-power, compensated or not) run up to 32 estimates
-    // side by side: the shading frame is built once, and each step runs over all of
-    // them before the next, so their cache misses overlap instead of following one
-    // another (see README, Performance). noexcept and allocation-free.
+    // (env, bsdf, mis-balance, mis-power, compensated or not) with at most 8 samples
+    // per estimate run up to 32 estimates side by side: the shading frame is built
+    // once, and each step runs over all of them before the next, so their cache misses
+    // overlap instead of following one another (see README, Performance). noexcept and
+    // allocation-free.
     void estimate(const ShadingPoint& point, const Bsdf& bsdf, Pcg32& rng, PointState& state,
                   std::span<Rgb> out) const noexcept;
 
