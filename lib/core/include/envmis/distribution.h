@@ -81,7 +81,9 @@ struct CdfView {
         }
         const float offset = (static_cast<float>(t - start[lo]) + (x - static_cast<float>(t))) /
                              static_cast<float>(width(lo));
-        return {lo, clamp(offset, 0.0f, kOneMinusEpsilon)};
+        // Both terms are >= 0 (t >= start[lo], t <= x) and the found cell is not empty,
+        // so only the rounding up to 1 needs a clamp.
+        return {lo, min(offset, kOneMinusEpsilon)};
     }
 
     // The u that `invert` maps to (index, offset).

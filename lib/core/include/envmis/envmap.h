@@ -82,7 +82,7 @@ struct EnvMapView {
         if (mapping == Mapping::equal_area) [[unlikely]]
             return sample_equal_area(s);
         const SinCos theta = sincos_half_turns(turns, s.p.y), phi = sincos_turns(turns, s.p.x);
-        const float sin_theta = max(theta.sin, 0.0f);
+        const float sin_theta = theta.sin;  // >= 0 on [0, 1): see fast_math_test
         const Vec3 canonical{sin_theta * phi.cos, sin_theta * phi.sin, theta.cos};
         return {to_world(axes, canonical), solid_angle_pdf(s.pdf, sin_theta),
                 radiance[static_cast<size_t>(s.y) * distribution.w + s.x], s.p};
@@ -98,7 +98,7 @@ struct EnvMapView {
     // Solid-angle pdf at image point uv; bit-identical to sample(u).pdf when uv = sample(u).uv.
     ENVMIS_HD float pdf_uv(Vec2 uv) const noexcept {
         if (mapping == Mapping::equal_area) return distribution.pdf(uv) * (1 / kFourPi);
-        return solid_angle_pdf(distribution.pdf(uv), max(sincos_half_turns(turns, uv.y).sin, 0.0f));
+        return solid_angle_pdf(distribution.pdf(uv), sincos_half_turns(turns, uv.y).sin);
     }
     // Image point of a world direction.
     ENVMIS_HD Vec2 uv_of(Vec3 direction) const noexcept {
