@@ -55,7 +55,7 @@ ENVMIS_HD inline float fast_atan2(float y, float x) noexcept {
 // sin and cos of a whole turn's fraction, 2 pi t, from a table of kTurnSteps entries and
 // the angle-sum identity: the remainder d is at most half a step, pi / 1024 = 0.0031,
 // where sin d = d - d^3/6 and cos d = 1 - d^2/2 are exact to 4e-12, so the result is
-// within two float ulps of sin and cos. Ten flops and two L1 loads, without
+// within two float ulps of sin and cos. About fifteen flops and two L1 loads, without
 // fast_sincos's range reduction: the samplers, which need two angles per sample, use it.
 inline constexpr int32_t kTurnSteps = 1024;
 

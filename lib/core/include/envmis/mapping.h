@@ -50,7 +50,7 @@ ENVMIS_HD inline float axis_component(Vec3 v, int8_t code) noexcept {
 }
 
 // Both return early for the default frame, which most renderers use: the general
-// permutation takes some thirty instructions, an eighth of EnvMapView::sample.
+// permutation takes some thirty instructions and three branches per call.
 ENVMIS_HD inline Vec3 to_world(const Axes& a, Vec3 canonical) noexcept {
     if (a.identity()) return canonical;
     return {axis_component(canonical, a.code[0]), axis_component(canonical, a.code[1]),
