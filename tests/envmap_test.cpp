@@ -323,6 +323,48 @@ TEST(EnvMap, AxesRotateDirectionsWithoutChangingPdfs) {
     }
 }
 
+// lookup_many takes a SIMD path (AVX2, equirect, default axes) that repeats lookup's
+// arithmetic: every lane must give lookup's exact bits, on every path.
+TEST(EnvMap, LookupManyIsBitIdenticalToLookup) {
+    std::vector<Vec3> directions = {{0, 0, 1},  {0, 0, -1}, {1, 0, 0},     {-1, 0, 0},        {0, 1, 0},
+                                    {0, -1, 0}, {1, -0.0f, 0}, {-1, -0.0f, 0}, {1e-20f, 0, 1}, {0, -1e-20f, -1},
+                                    {0.6f, -0.8f, 0}, {0, 0, 0}};
+    Rng rng(17);
+    while (directions.size() < 1003) {  // not a multiple of the SIMD width
+        const Vec2 u = rng.uniform2();
+        const float z = 1 - 2 * u.x, r = std::sqrt(std::max(0.0f, 1 - z * z)), phi = 2 * kPiF * u.y;
+        directions.push_back({r * std::cos(phi), r * std::sin(phi), z});
+    }
+    EnvMapOptions y_up = options(true), equal_area = options(true);
+    y_up.axes = Axes::parse("y-up");
+    equal_area.mapping = Mapping::equal_area;
+    const std::vector<EnvMap> maps = {EnvMap(test::sun_sky_map(1024, 512), options(true)),
+                                      EnvMap(test::sun_sky_map(1024, 512), options(false)),
+                                      EnvMap(test::random_map(37, 19, 3), options(false)),
+                                      EnvMap(test::random_map(2, 1, 4), options(true)),
+                                      EnvMap(test::constant_map(1, 1, {1, 2, 3}), options(false)),
+                                      EnvMap(test::sun_sky_map(64, 32), y_up),
+                                      EnvMap(test::random_map(32, 32, 5), equal_area)};
+    for (const EnvMap& map : maps) {
+        // Add directions that the map itself samples: the sun, the seam, the last column.
+        std::vector<Vec3> d = directions;
+        for (int i = 0; i < 500; ++i) d.push_back(map.sample(rng.uniform2()).direction);
+        std::vector<float> x, y, z, r(d.size()), g(d.size()), b(d.size()), pdf(d.size());
+        for (const Vec3 v : d) x.push_back(v.x), y.push_back(v.y), z.push_back(v.z);
+        const EnvMapView view = map.view();
+        lookup_many(view, {x.data(), y.data(), z.data()}, {r.data(), g.data(), b.data(), pdf.data()},
+                    static_cast<uint32_t>(d.size()));
+        for (size_t i = 0; i < d.size(); ++i) {
+            const EnvMapView::Lookup e = view.lookup(d[i]);
+            const auto bits = [](float f) { return bit_cast<uint32_t>(f); };
+            ASSERT_EQ(bits(pdf[i]), bits(e.pdf)) << map.width() << "x" << map.height() << " direction " << i;
+            ASSERT_EQ(bits(r[i]), bits(e.radiance.r)) << map.width() << "x" << map.height() << " direction " << i;
+            ASSERT_EQ(bits(g[i]), bits(e.radiance.g));
+            ASSERT_EQ(bits(b[i]), bits(e.radiance.b));
+        }
+    }
+}
+
 TEST(EnvMap, RejectsInvalidConstruction) {
     EXPECT_THROW(EnvMap(RgbImage{}), std::invalid_argument);
     EXPECT_THROW(EnvMap(RgbImage{4, 4, std::vector<Rgb>(15)}), std::invalid_argument);

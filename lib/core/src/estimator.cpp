@@ -106,13 +106,13 @@ bool runs_in_lanes(const Technique& t, const Allocation& a) noexcept {
 // Up to `lanes` (<= kMaxLanes) estimates at once, each step over all of them: the random
 // numbers (drawn in the order one estimate at a time would draw them: each estimate's
 // environment samples, then its BSDF samples, two numbers each), then each environment
-// sample, then each BSDF sample (all of them drawn before any is mapped to the image),
-// whose radiance and density are prefetched a whole step ahead. Compiled once per BSDF
-// kind K and flattened (everything it calls inlined), so that the kind's own code runs
-// with no branch on the kind and no call: the generic Bsdf::sample, eval and pdf are
-// too large for GCC to inline into the loops by itself (measured: 1.3-1.4x faster MIS
-// estimates; see README, Performance). kMaxLanes sizes the working arrays, which one
-// estimate alone must not pay for.
+// sample, then each BSDF sample (all of them drawn before any is looked up), whose
+// radiance and density lookup_many finds for all lanes at once (SIMD where it can; see
+// envmap.h). Compiled once per BSDF kind K and flattened (everything it calls inlined),
+// so that the kind's own code runs with no branch on the kind and no call: the generic
+// Bsdf::sample, eval and pdf are too large for GCC to inline into the loops by itself.
+// See README, Performance, for what each step gained. kMaxLanes sizes the working
+// arrays, which one estimate alone must not pay for.
 template <uint32_t kMaxLanes, BsdfKind K>
 [[gnu::flatten]] void estimate_lanes_of(const EnvMapView& env, const Technique& t, const Allocation& a,
                                         const Frame& frame, Vec3 wo, Bsdf bsdf, Pcg32& rng,
@@ -141,16 +141,22 @@ template <uint32_t kMaxLanes, BsdfKind K>
     }
     for (uint32_t j = n_env; j < n_env + n_bsdf; ++j) {
         BsdfSample b[kMaxLanes];
-        Vec2 uv[kMaxLanes];
-        for (uint32_t l = 0; l < lanes; ++l) b[l] = bsdf.sample(wo, u[j][l]);
+        float x[kMaxLanes], y[kMaxLanes], z[kMaxLanes], r[kMaxLanes], g[kMaxLanes], bl[kMaxLanes], pdf[kMaxLanes];
         for (uint32_t l = 0; l < lanes; ++l) {
-            uv[l] = env.uv_of(frame.to_world(b[l].wi));
-            env.prefetch_uv(uv[l]);
+            b[l] = bsdf.sample(wo, u[j][l]);
+            const Vec3 wi = frame.to_world(b[l].wi);
+            x[l] = wi.x, y[l] = wi.y, z[l] = wi.z;
+        }
+        if constexpr (kMaxLanes == 1) {  // one estimate: inline, without the batch's set-up
+            const EnvMapView::Lookup e = env.lookup({x[0], y[0], z[0]});
+            r[0] = e.radiance.r, g[0] = e.radiance.g, bl[0] = e.radiance.b, pdf[0] = e.pdf;
+        } else {
+            lookup_many(env, {x, y, z}, {r, g, bl, pdf}, lanes);
         }
         for (uint32_t l = 0; l < lanes; ++l) {
             if (!(b[l].pdf > 0)) continue;
-            const float p[2] = {env.pdf_uv(uv[l]), b[l].pdf};
-            contribute(out[l], 1, env.eval_uv(uv[l]) * b[l].value, p);
+            const float p[2] = {pdf[l], b[l].pdf};
+            contribute(out[l], 1, Rgb{r[l], g[l], bl[l]} * b[l].value, p);
         }
     }
 }

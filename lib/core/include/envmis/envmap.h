@@ -141,6 +141,20 @@ struct EnvMapView {
     }
 };
 
+// EnvMapView::lookup for n directions at once, for code that holds many (an estimator's
+// or a wavefront renderer's BSDF samples): directions in, one array per world
+// coordinate; radiance and solid-angle pdf out, likewise. Bit-identical to n calls of
+// lookup. On x86-64 CPUs with AVX2, an equirectangular map in the default axes is looked
+// up eight directions at a time with SIMD instructions (envmap_lookup.cpp); other maps
+// and CPUs take one direction at a time. Host only; noexcept and allocation-free.
+struct DirectionArrays {
+    const float *x, *y, *z;
+};
+struct LookupArrays {
+    float *r, *g, *b, *pdf;
+};
+void lookup_many(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept;
+
 // Row y (of h) of the image-space density that a map with these options and stats
 // samples, q(x, y) w_y, from that row's radiance (row.size() values): what
 // EnvMap::density() holds, for code that rebuilds a map's density without the map.
