@@ -123,9 +123,10 @@ ENVMIS_AVX2 F8 sin_half_turns8(const SinCos* turns, F8 t) noexcept {
     return _mm256_add_ps(_mm256_mul_ps(s, cos_d), _mm256_mul_ps(co, sin_d));
 }
 
-// Where eight directions fall: their cells and the image v (for sin theta).
+// Where eight directions fall: their cells, the first texel of their rows (y w) and
+// the image v (for sin theta).
 struct Cells8 {
-    I8 x, y;
+    I8 x, y, row;
     F8 v;
 };
 
@@ -141,10 +142,10 @@ ENVMIS_AVX2 Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l
     const F8 turn = select(less(phi, splat(0.0f)), _mm256_add_ps(phi, splat(2 * kPiF)), phi);
     const F8 u = clamp8(_mm256_mul_ps(splat(0.5f * kInvPi), turn), 0.0f, kOneMinusEpsilon);
     const F8 v = clamp8(_mm256_mul_ps(theta, splat(kInvPi)), 0.0f, kOneMinusEpsilon);
-    const Cells8 c{cell8(u, env.distribution.w), cell8(v, env.distribution.h), v};
+    const I8 x = cell8(u, env.distribution.w), y = cell8(v, env.distribution.h);
+    const Cells8 c{x, y, _mm256_mullo_epi32(y, _mm256_set1_epi32(static_cast<int>(env.distribution.w))), v};
     alignas(32) uint32_t texel[8];
-    _mm256_store_si256(reinterpret_cast<I8*>(texel),
-                       _mm256_add_epi32(_mm256_mullo_epi32(c.y, _mm256_set1_epi32(static_cast<int>(env.distribution.w))), c.x));
+    _mm256_store_si256(reinterpret_cast<I8*>(texel), _mm256_add_epi32(c.row, c.x));
     for (const uint32_t i : texel) {
         ENVMIS_PREFETCH(env.radiance + i);
         ENVMIS_PREFETCH(env.distribution.start + i);
@@ -155,14 +156,13 @@ ENVMIS_AVX2 Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l
 // Radiance and solid-angle pdf at eight located directions, stored from lane l on.
 ENVMIS_AVX2 void fetch8(const EnvMapView& env, const Cells8& c, LookupArrays out, uint32_t l) noexcept {
     const Distribution2DView& d = env.distribution;
-    const I8 row = _mm256_mullo_epi32(c.y, _mm256_set1_epi32(static_cast<int>(d.w)));
-    const I8 texel = _mm256_add_epi32(row, c.x), three = _mm256_add_epi32(texel, _mm256_add_epi32(texel, texel));
+    const I8 texel = _mm256_add_epi32(c.row, c.x), three = _mm256_add_epi32(texel, _mm256_add_epi32(texel, texel));
     const float* rgb = &env.radiance->r;
     _mm256_storeu_ps(out.r + l, _mm256_i32gather_ps(rgb, three, 4));
     _mm256_storeu_ps(out.g + l, _mm256_i32gather_ps(rgb + 1, three, 4));
     _mm256_storeu_ps(out.b + l, _mm256_i32gather_ps(rgb + 2, three, 4));
     const F8 row_width = width_to_float(width8(d.marginal.start, _mm256_setzero_si256(), c.y, d.h));
-    const F8 cell_width = width_to_float(width8(d.start, row, c.x, d.w));
+    const F8 cell_width = width_to_float(width8(d.start, c.row, c.x, d.w));
     const F8 image_pdf = _mm256_mul_ps(_mm256_mul_ps(row_width, cell_width), splat(d.pdf_scale));
     const F8 sin_v = sin_half_turns8(env.turns, c.v);
     const F8 pdf = _mm256_div_ps(image_pdf, _mm256_mul_ps(splat(kTwoPiSquared), sin_v));
