@@ -344,11 +344,12 @@ TEST_F(Cli, BenchPrintsOneLinePerSamplerWithTheDocumentedFields) {
     ASSERT_EQ(r.exit_code, 0) << r;
     EXPECT_TRUE(contains(r.out, R"((^|\n)map=synthetic-sky size=256x128 compensated=1 repeats=1 samples=10000)")) << r;
     const std::string number = "[0-9]+(\\.[0-9]+)?";
-    for (const char* sampler : {"guided", "textbook"})
+    for (const char* sampler : {"guided", "guided-batch", "textbook"})
         EXPECT_TRUE(contains(r.out, std::string("(^|\\n)sampler=") + sampler + " build_ms=" + number + " ns_per_sample=" +
                                         number + " ns_per_pdf=" + number + " bytes_per_texel=" + number + "\\n"))
             << sampler << r;
-    EXPECT_TRUE(contains(r.out, "\\nspeedup_vs_textbook build=" + number + "x sample=" + number + "x pdf=" + number + "x ")) << r;
+    EXPECT_TRUE(contains(r.out, "\\nspeedup_vs_textbook build=" + number + "x sample=" + number + "x pdf=" + number +
+                                    "x batch_sample=" + number + "x batch_pdf=" + number + "x ")) << r;
 }
 
 TEST_F(Cli, BenchJsonIsOneObjectWithTheSameFields) {
@@ -361,13 +362,15 @@ TEST_F(Cli, BenchJsonIsOneObjectWithTheSameFields) {
     EXPECT_EQ(j.at("samples"), 10000);
     EXPECT_EQ(j.at("repeats"), 1);
     EXPECT_EQ(j.at("compensated"), true);
-    ASSERT_EQ(j.at("samplers").size(), 2u);
+    ASSERT_EQ(j.at("samplers").size(), 3u);
     EXPECT_EQ(j["samplers"][0].at("sampler"), "guided");
-    EXPECT_EQ(j["samplers"][1].at("sampler"), "textbook");
+    EXPECT_EQ(j["samplers"][1].at("sampler"), "guided-batch");
+    EXPECT_EQ(j["samplers"][2].at("sampler"), "textbook");
     for (const auto& s : j["samplers"])
         for (const char* field : {"build_ms", "ns_per_sample", "ns_per_pdf", "bytes_per_texel"})
             EXPECT_TRUE(s.at(field).is_number() && s[field].get<double>() > 0) << field << r;
-    for (const char* field : {"build", "sample", "pdf"}) EXPECT_TRUE(j.at("speedup_vs_textbook").at(field).is_number()) << field;
+    for (const char* field : {"build", "sample", "pdf", "batch_sample", "batch_pdf"})
+        EXPECT_TRUE(j.at("speedup_vs_textbook").at(field).is_number()) << field;
 }
 
 // ---------------------------------------------------------------------------------

@@ -323,8 +323,30 @@ TEST(EnvMap, AxesRotateDirectionsWithoutChangingPdfs) {
     }
 }
 
-// lookup_many takes a SIMD path (AVX2, equirect, default axes) that repeats lookup's
-// arithmetic: every lane must give lookup's exact bits, on every path.
+// Maps for the batch functions' SIMD path (AVX2, equirect, default axes) and for each
+// way around it: power-of-two and odd sizes, compensated or not, 2x1 and 1x1 (whose
+// full-width cell, 2^31 units, breaks a signed conversion), y up, equal-area.
+std::vector<EnvMap> batch_maps() {
+    EnvMapOptions y_up = options(true), equal_area = options(true);
+    y_up.axes = Axes::parse("y-up");
+    equal_area.mapping = Mapping::equal_area;
+    std::vector<EnvMap> maps;
+    maps.emplace_back(test::sun_sky_map(1024, 512), options(true));
+    maps.emplace_back(test::sun_sky_map(1024, 512), options(false));
+    maps.emplace_back(test::random_map(37, 19, 3), options(false));
+    maps.emplace_back(test::random_map(37, 19, 3), options(true));
+    maps.emplace_back(test::random_map(2, 1, 4), options(true));
+    maps.emplace_back(test::random_map(2, 2, 6), options(false));
+    maps.emplace_back(test::constant_map(1, 1, {1, 2, 3}), options(false));
+    maps.emplace_back(test::sun_sky_map(64, 32), y_up);
+    maps.emplace_back(test::random_map(32, 32, 5), equal_area);
+    return maps;
+}
+
+uint32_t bits(float f) { return bit_cast<uint32_t>(f); }
+
+// lookup_many's SIMD path repeats lookup's arithmetic: every lane must give lookup's
+// exact bits, on every path.
 TEST(EnvMap, LookupManyIsBitIdenticalToLookup) {
     std::vector<Vec3> directions = {{0, 0, 1},  {0, 0, -1}, {1, 0, 0},     {-1, 0, 0},        {0, 1, 0},
                                     {0, -1, 0}, {1, -0.0f, 0}, {-1, -0.0f, 0}, {1e-20f, 0, 1}, {0, -1e-20f, -1},
@@ -335,17 +357,7 @@ TEST(EnvMap, LookupManyIsBitIdenticalToLookup) {
         const float z = 1 - 2 * u.x, r = std::sqrt(std::max(0.0f, 1 - z * z)), phi = 2 * kPiF * u.y;
         directions.push_back({r * std::cos(phi), r * std::sin(phi), z});
     }
-    EnvMapOptions y_up = options(true), equal_area = options(true);
-    y_up.axes = Axes::parse("y-up");
-    equal_area.mapping = Mapping::equal_area;
-    const std::vector<EnvMap> maps = {EnvMap(test::sun_sky_map(1024, 512), options(true)),
-                                      EnvMap(test::sun_sky_map(1024, 512), options(false)),
-                                      EnvMap(test::random_map(37, 19, 3), options(false)),
-                                      EnvMap(test::random_map(2, 1, 4), options(true)),
-                                      EnvMap(test::constant_map(1, 1, {1, 2, 3}), options(false)),
-                                      EnvMap(test::sun_sky_map(64, 32), y_up),
-                                      EnvMap(test::random_map(32, 32, 5), equal_area)};
-    for (const EnvMap& map : maps) {
+    for (const EnvMap& map : batch_maps()) {
         // Add directions that the map itself samples: the sun, the seam, the last column.
         std::vector<Vec3> d = directions;
         for (int i = 0; i < 500; ++i) d.push_back(map.sample(rng.uniform2()).direction);
@@ -356,11 +368,44 @@ TEST(EnvMap, LookupManyIsBitIdenticalToLookup) {
                     static_cast<uint32_t>(d.size()));
         for (size_t i = 0; i < d.size(); ++i) {
             const EnvMapView::Lookup e = view.lookup(d[i]);
-            const auto bits = [](float f) { return bit_cast<uint32_t>(f); };
             ASSERT_EQ(bits(pdf[i]), bits(e.pdf)) << map.width() << "x" << map.height() << " direction " << i;
             ASSERT_EQ(bits(r[i]), bits(e.radiance.r)) << map.width() << "x" << map.height() << " direction " << i;
             ASSERT_EQ(bits(g[i]), bits(e.radiance.g));
             ASSERT_EQ(bits(b[i]), bits(e.radiance.b));
+        }
+    }
+}
+
+// sample_many's SIMD path repeats sample's search and arithmetic likewise, for points
+// at the ends of [0,1), on the random generator's grid and off it.
+TEST(EnvMap, SampleManyIsBitIdenticalToSample) {
+    const float edges[] = {0.0f, 0x1p-24f, 0.5f, 0.25f, 1 - 0x1p-24f, kOneMinusEpsilon};
+    std::vector<Vec2> points;
+    for (const float a : edges)
+        for (const float b : edges) points.push_back({a, b});
+    Rng rng(19);
+    while (points.size() < 1500) points.push_back(rng.uniform2());
+    while (points.size() < 2005) {  // finer than 2^-31 (the CDF's unit) near 0; not a multiple of 8
+        const Vec2 u = rng.uniform2();
+        points.push_back({u.x * 0x1p-9f, u.y * 0x1p-9f});
+    }
+    std::vector<float> ux, uy;
+    for (const Vec2 p : points) ux.push_back(p.x), uy.push_back(p.y);
+    for (const EnvMap& map : batch_maps()) {
+        const size_t n = points.size();
+        std::vector<float> x(n), y(n), z(n), pdf(n), r(n), g(n), b(n);
+        const EnvMapView view = map.view();
+        sample_many(view, {ux.data(), uy.data()}, {x.data(), y.data(), z.data(), pdf.data(), r.data(), g.data(), b.data()},
+                    static_cast<uint32_t>(n));
+        for (size_t i = 0; i < n; ++i) {
+            const EnvSample e = view.sample(points[i]);
+            const float expected[] = {e.direction.x, e.direction.y, e.direction.z, e.pdf,
+                                      e.radiance.r, e.radiance.g,  e.radiance.b};
+            const float got[] = {x[i], y[i], z[i], pdf[i], r[i], g[i], b[i]};
+            for (int k = 0; k < 7; ++k)
+                ASSERT_EQ(bits(got[k]), bits(expected[k]))
+                    << map.width() << "x" << map.height() << " point " << i << " (" << points[i].x << ", "
+                    << points[i].y << ") output " << k;
         }
     }
 }

@@ -67,6 +67,37 @@ void sample(benchmark::State& state) {
     }
 }
 
+// The guided sampler through sample_many, kBatch points a call (as the estimator's lanes
+// or a wavefront renderer ask): the points are the same as sample's, stored as the
+// batch call reads them; the counter is the time per sample.
+void sample_batch(benchmark::State& state) {
+    constexpr size_t kBatch = 64;
+    const EnvMap map(sky(static_cast<uint32_t>(state.range(0))), envmis::EnvMapOptions{});
+    const EnvMapView view = map.view();
+    static const std::vector<float> ux = [] {
+        std::vector<float> v;
+        for (const envmis::Vec2 u : uniforms()) v.push_back(u.x);
+        return v;
+    }();
+    static const std::vector<float> uy = [] {
+        std::vector<float> v;
+        for (const envmis::Vec2 u : uniforms()) v.push_back(u.y);
+        return v;
+    }();
+    std::vector<float> out(7 * kBatch);
+    float* o = out.data();
+    const envmis::SampleArrays arrays{o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch, o + 4 * kBatch, o + 5 * kBatch,
+                                      o + 6 * kBatch};
+    size_t first = 0;
+    for (auto _ : state) {
+        envmis::sample_many(view, {ux.data() + first, uy.data() + first}, arrays, kBatch);
+        benchmark::DoNotOptimize(o);
+        first = (first + kBatch) & (ux.size() - 1);
+    }
+    state.counters["per_sample"] = benchmark::Counter(static_cast<double>(kBatch),
+                                                      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
 // Uniformly distributed directions, made before timing: the pdf benchmark times the
 // lookup, not the sines and cosines that make its argument.
 const std::vector<envmis::Vec3>& directions() {
@@ -120,6 +151,7 @@ BENCHMARK(build<EnvMap>)->Name("build/guided")->Apply(sizes);
 BENCHMARK(build<TextbookEnvMap>)->Name("build/textbook")->Apply(sizes);
 BENCHMARK(sample<EnvMap>)->Name("sample/guided")->Apply(sizes_ns);
 BENCHMARK(sample<TextbookEnvMap>)->Name("sample/textbook")->Apply(sizes_ns);
+BENCHMARK(sample_batch)->Name("sample/guided-many")->Apply(sizes_ns);
 BENCHMARK(pdf<EnvMap>)->Name("pdf/guided")->Apply(sizes_ns);
 BENCHMARK(pdf<TextbookEnvMap>)->Name("pdf/textbook")->Apply(sizes_ns);
 BENCHMARK_CAPTURE(estimate, mis_balance_lambert, "mis-balance", envmis::Bsdf::lambert())->Name("estimate/mis-balance/lambert")->Args({1024, 1})->Args({1024, 64});

@@ -38,6 +38,43 @@ double ns_per_call(const std::vector<Input>& inputs, Call&& call) {
     return milliseconds_since(start) * 1e6 / static_cast<double>(inputs.size());
 }
 
+// The inputs of sample_many and lookup_many: one array per coordinate, and outputs for
+// a batch of kBatch.
+constexpr uint32_t kBatch = 64;
+struct BatchInputs {
+    std::vector<float> ux, uy, x, y, z;
+    std::vector<float> out = std::vector<float>(7 * kBatch);
+
+    BatchInputs(const std::vector<Vec2>& us, const std::vector<Vec3>& directions) {
+        for (const Vec2 u : us) ux.push_back(u.x), uy.push_back(u.y);
+        for (const Vec3 d : directions) x.push_back(d.x), y.push_back(d.y), z.push_back(d.z);
+    }
+    // ns per sample (per lookup) over all inputs, kBatch at a time (the rest, fewer).
+    template <class Call>
+    double ns_per_item(size_t n, Call&& call) {
+        volatile float sink = 0;
+        float* o = out.data();
+        const auto start = std::chrono::steady_clock::now();
+        for (size_t first = 0; first < n; first += kBatch) {
+            call(first, static_cast<uint32_t>(std::min<size_t>(kBatch, n - first)), o);
+            sink = sink + o[0];
+        }
+        return milliseconds_since(start) * 1e6 / static_cast<double>(n);
+    }
+    double sample_cost(const EnvMapView& view) {
+        return ns_per_item(ux.size(), [&](size_t first, uint32_t n, float* o) {
+            sample_many(view, {ux.data() + first, uy.data() + first},
+                        {o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch, o + 4 * kBatch, o + 5 * kBatch, o + 6 * kBatch}, n);
+        });
+    }
+    double lookup_cost(const EnvMapView& view) {
+        return ns_per_item(x.size(), [&](size_t first, uint32_t n, float* o) {
+            lookup_many(view, {x.data() + first, y.data() + first, z.data() + first},
+                        {o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch}, n);
+        });
+    }
+};
+
 // A sampler built `repeats` times (the last one kept) and the median build time.
 template <class Sampler>
 std::pair<std::unique_ptr<Sampler>, double> build_repeatedly(const RgbImage& image, int repeats,
@@ -112,7 +149,6 @@ Subcommand add_bench(CLI::App& app) {
                     step);
                 // Sampling and pdf times: the two samplers back to back in each repeat, so
                 // that the ratios compare like with like on a machine whose speed drifts.
-                std::vector<double> times[4], ratios[2];
                 const auto sample_cost = [&](const auto& sampler) {
                     return ns_per_call(us, [&](Vec2 u) {
                         const EnvSample s = sampler.sample(u);
@@ -124,20 +160,30 @@ Subcommand add_bench(CLI::App& app) {
                 };
                 // The guided sampler through its view, as a renderer's hot loop uses it: the
                 // view's flat arrays are read once, not rebuilt from the map at every call.
+                // guided-batch is the same sampler through sample_many and lookup_many (the
+                // latter finds the radiance too), as a wavefront renderer would call it.
                 const EnvMapView view = guided->view();
+                BatchInputs batch(us, directions);
+                std::vector<double> times[6], ratios[4];
                 for (int r = 0; r < args->repeats; ++r) {
-                    const double t[4] = {sample_cost(view), sample_cost(*textbook), pdf_cost(view), pdf_cost(*textbook)};
-                    for (int k = 0; k < 4; ++k) times[k].push_back(t[k]);
+                    const double t[6] = {sample_cost(view),        sample_cost(*textbook),   pdf_cost(view),
+                                         pdf_cost(*textbook),      batch.sample_cost(view), batch.lookup_cost(view)};
+                    for (int k = 0; k < 6; ++k) times[k].push_back(t[k]);
                     ratios[0].push_back(t[1] / t[0]);
                     ratios[1].push_back(t[3] / t[2]);
+                    ratios[2].push_back(t[1] / t[4]);
+                    ratios[3].push_back(t[3] / t[5]);
                     progress.update(++step);
                 }
                 const double texels = static_cast<double>(image.width) * image.height;
+                const double guided_bytes = guided->distribution().bytes() / texels;
                 const std::vector<Timing> timings = {
-                    {"guided", guided_build, median(times[0]), median(times[2]), guided->distribution().bytes() / texels},
+                    {"guided", guided_build, median(times[0]), median(times[2]), guided_bytes},
+                    {"guided-batch", guided_build, median(times[4]), median(times[5]), guided_bytes},
                     {"textbook", textbook_build, median(times[1]), median(times[3]), textbook->distribution_bytes() / texels}};
                 const double build_speedup = textbook_build / guided_build, sample_speedup = median(ratios[0]),
-                             pdf_speedup = median(ratios[1]);
+                             pdf_speedup = median(ratios[1]), batch_sample_speedup = median(ratios[2]),
+                             batch_pdf_speedup = median(ratios[3]);
                 if (args->json) {
                     nlohmann::json j = {{"map", map_name},
                                         {"width", image.width},
@@ -151,8 +197,11 @@ Subcommand add_bench(CLI::App& app) {
                                                  {"ns_per_sample", t.ns_per_sample},
                                                  {"ns_per_pdf", t.ns_per_pdf},
                                                  {"bytes_per_texel", t.bytes_per_texel}});
-                    j["speedup_vs_textbook"] = {
-                        {"build", build_speedup}, {"sample", sample_speedup}, {"pdf", pdf_speedup}};
+                    j["speedup_vs_textbook"] = {{"build", build_speedup},
+                                                {"sample", sample_speedup},
+                                                {"pdf", pdf_speedup},
+                                                {"batch_sample", batch_sample_speedup},
+                                                {"batch_pdf", batch_pdf_speedup}};
                     std::cout << j.dump(2) << "\n";
                     return;
                 }
@@ -161,9 +210,9 @@ Subcommand add_bench(CLI::App& app) {
                 for (const Timing& t : timings)
                     std::printf("sampler=%s build_ms=%.1f ns_per_sample=%.1f ns_per_pdf=%.1f bytes_per_texel=%.2f\n",
                                 t.sampler.c_str(), t.build_ms, t.ns_per_sample, t.ns_per_pdf, t.bytes_per_texel);
-                std::printf("speedup_vs_textbook build=%.2fx sample=%.2fx pdf=%.2fx (sample, pdf: median of the "
-                            "ratios within each repeat)\n",
-                            build_speedup, sample_speedup, pdf_speedup);
+                std::printf("speedup_vs_textbook build=%.2fx sample=%.2fx pdf=%.2fx batch_sample=%.2fx "
+                            "batch_pdf=%.2fx (sample, pdf: median of the ratios within each repeat)\n",
+                            build_speedup, sample_speedup, pdf_speedup, batch_sample_speedup, batch_pdf_speedup);
             }};
 }
 

@@ -121,29 +121,34 @@ template <uint32_t kMaxLanes, BsdfKind K>
     const Counts counts = sample_counts(t, a);
     const auto n_env = static_cast<uint32_t>(counts.n[0]), n_bsdf = static_cast<uint32_t>(counts.n[1]);
     const uint32_t lanes = static_cast<uint32_t>(out.size());
-    Vec2 u[kMaxLaneSamples][kMaxLanes];
+    float u_x[kMaxLaneSamples][kMaxLanes], u_y[kMaxLaneSamples][kMaxLanes];
     for (uint32_t l = 0; l < lanes; ++l)
-        for (uint32_t j = 0; j < n_env + n_bsdf; ++j) u[j][l] = rng.uniform2();
+        for (uint32_t j = 0; j < n_env + n_bsdf; ++j) u_x[j][l] = rng.uniform(), u_y[j][l] = rng.uniform();
     std::fill(out.begin(), out.end(), Rgb{});
     auto contribute = [&](Rgb& sum, int k, Rgb f, const float* p) {
         const float q[2] = {counts.n[0] * p[0], counts.n[1] * p[1]};
         add(sum, f, fixed_weight(t, q, k) / q[k]);
     };
+    float x[kMaxLanes], y[kMaxLanes], z[kMaxLanes], r[kMaxLanes], g[kMaxLanes], bl[kMaxLanes], pdf[kMaxLanes];
     for (uint32_t j = 0; j < n_env; ++j) {
-        EnvSample e[kMaxLanes];
-        for (uint32_t l = 0; l < lanes; ++l) e[l] = env.sample(u[j][l]);
+        if constexpr (kMaxLanes == 1) {
+            const EnvSample e = env.sample({u_x[j][0], u_y[j][0]});
+            x[0] = e.direction.x, y[0] = e.direction.y, z[0] = e.direction.z, pdf[0] = e.pdf;
+            r[0] = e.radiance.r, g[0] = e.radiance.g, bl[0] = e.radiance.b;
+        } else {
+            sample_many(env, {u_x[j], u_y[j]}, {x, y, z, pdf, r, g, bl}, lanes);
+        }
         for (uint32_t l = 0; l < lanes; ++l) {
-            if (!(e[l].pdf > 0)) continue;
-            const Vec3 wi = frame.to_local(e[l].direction);
-            const float p[2] = {e[l].pdf, bsdf.pdf(wo, wi)};
-            contribute(out[l], 0, e[l].radiance * bsdf.eval(wo, wi), p);
+            if (!(pdf[l] > 0)) continue;
+            const Vec3 wi = frame.to_local({x[l], y[l], z[l]});
+            const float p[2] = {pdf[l], bsdf.pdf(wo, wi)};
+            contribute(out[l], 0, Rgb{r[l], g[l], bl[l]} * bsdf.eval(wo, wi), p);
         }
     }
     for (uint32_t j = n_env; j < n_env + n_bsdf; ++j) {
         BsdfSample b[kMaxLanes];
-        float x[kMaxLanes], y[kMaxLanes], z[kMaxLanes], r[kMaxLanes], g[kMaxLanes], bl[kMaxLanes], pdf[kMaxLanes];
         for (uint32_t l = 0; l < lanes; ++l) {
-            b[l] = bsdf.sample(wo, u[j][l]);
+            b[l] = bsdf.sample(wo, {u_x[j][l], u_y[j][l]});
             const Vec3 wi = frame.to_world(b[l].wi);
             x[l] = wi.x, y[l] = wi.y, z[l] = wi.z;
         }

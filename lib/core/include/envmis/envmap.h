@@ -145,7 +145,7 @@ struct EnvMapView {
 // or a wavefront renderer's BSDF samples): directions in, one array per world
 // coordinate; radiance and solid-angle pdf out, likewise. Bit-identical to n calls of
 // lookup. On x86-64 CPUs with AVX2, an equirectangular map in the default axes is looked
-// up eight directions at a time with SIMD instructions (envmap_lookup.cpp); other maps
+// up eight directions at a time with SIMD instructions (envmap_many.cpp); other maps
 // and CPUs take one direction at a time. Host only; noexcept and allocation-free.
 struct DirectionArrays {
     const float *x, *y, *z;
@@ -154,6 +154,18 @@ struct LookupArrays {
     float *r, *g, *b, *pdf;
 };
 void lookup_many(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept;
+
+// EnvMapView::sample for n random points at once, likewise: the points' two coordinates
+// in [0,1) in, one array each; direction, solid-angle pdf and radiance out (not the
+// image point). Bit-identical to n calls of sample; SIMD on the same maps and CPUs as
+// lookup_many, when the map is at least 2x2.
+struct PointArrays {
+    const float *x, *y;
+};
+struct SampleArrays {
+    float *x, *y, *z, *pdf, *r, *g, *b;
+};
+void sample_many(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t n) noexcept;
 
 // Row y (of h) of the image-space density that a map with these options and stats
 // samples, q(x, y) w_y, from that row's radiance (row.size() values): what
