@@ -14,10 +14,7 @@
 
 #include <algorithm>
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define ENVMIS_AVX2_BATCHES 1
-#include <immintrin.h>
-#endif
+#include "simd.h"
 
 namespace envmis {
 namespace {
@@ -42,7 +39,7 @@ void lookup_one_by_one(const EnvMapView& env, DirectionArrays in, LookupArrays o
 }
 
 #ifdef ENVMIS_AVX2_BATCHES
-#define ENVMIS_AVX2 __attribute__((target("avx2")))
+using namespace simd;
 
 // The SIMD path's preconditions: the equirectangular mapping in the default axes, and
 // 32-bit gather indices for the three floats of every texel.
@@ -50,19 +47,6 @@ bool avx2_applies(const EnvMapView& env) noexcept {
     return env.mapping == Mapping::equirect && env.axes.identity() &&
            uint64_t{env.distribution.w} * env.distribution.h * 3 < (uint64_t{1} << 31);
 }
-
-using F8 = __m256;
-using I8 = __m256i;
-
-ENVMIS_AVX2 inline F8 splat(float v) noexcept { return _mm256_set1_ps(v); }
-// c ? a : b, lane by lane, for a comparison mask c.
-ENVMIS_AVX2 inline F8 select(F8 c, F8 a, F8 b) noexcept { return _mm256_blendv_ps(b, a, c); }
-ENVMIS_AVX2 inline F8 less(F8 a, F8 b) noexcept { return _mm256_cmp_ps(a, b, _CMP_LT_OQ); }
-// clamp() of math.h: v < lo ? lo : (hi < v ? hi : v), NaN passing through.
-ENVMIS_AVX2 inline F8 clamp8(F8 v, float lo, float hi) noexcept {
-    return select(less(v, splat(lo)), splat(lo), select(less(splat(hi), v), splat(hi), v));
-}
-ENVMIS_AVX2 inline F8 abs8(F8 v) noexcept { return _mm256_andnot_ps(splat(-0.0f), v); }
 
 // fast_atan2 (fast_math.h).
 ENVMIS_AVX2 F8 atan2_8(F8 y, F8 x) noexcept {
@@ -301,7 +285,7 @@ ENVMIS_AVX2 uint32_t sample_avx2(const EnvMapView& env, PointArrays in, SampleAr
 void lookup_many(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
     uint32_t done = 0;
 #ifdef ENVMIS_AVX2_BATCHES
-    if (avx2_applies(env) && __builtin_cpu_supports("avx2")) done = lookup_avx2(env, in, out, n);
+    if (avx2_applies(env) && simd::avx2_available()) done = lookup_avx2(env, in, out, n);
 #endif
     lookup_one_by_one(env, in, out, done, n);
 }
@@ -310,7 +294,7 @@ void sample_many(const EnvMapView& env, PointArrays in, SampleArrays out, uint32
     uint32_t done = 0;
 #ifdef ENVMIS_AVX2_BATCHES
     // The guide pairs of invert8 need two cells in each dimension.
-    if (avx2_applies(env) && env.distribution.w > 1 && env.distribution.h > 1 && __builtin_cpu_supports("avx2"))
+    if (avx2_applies(env) && env.distribution.w > 1 && env.distribution.h > 1 && simd::avx2_available())
         done = sample_avx2(env, in, out, n);
 #endif
     for (uint32_t l = done; l < n; ++l) {

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "envmis/frame.h"
+#include "estimator_simd.h"
 
 namespace envmis {
 namespace {
@@ -103,16 +104,27 @@ bool runs_in_lanes(const Technique& t, const Allocation& a) noexcept {
     return !t.adaptive() && !t.mixture && t.strategy != Strategy::one_sample && a.total() <= kMaxLaneSamples;
 }
 
+#ifdef ENVMIS_AVX2_BATCHES
+detail::Weighting weighting_of(const Technique& t) noexcept {
+    if (t.strategy == Strategy::env || t.strategy == Strategy::bsdf) return detail::Weighting::one;
+    return t.strategy == Strategy::mis && t.heuristic == Heuristic::power ? detail::Weighting::power
+                                                                          : detail::Weighting::balance;
+}
+#endif
+
 // Up to `lanes` (<= kMaxLanes) estimates at once, each step over all of them: the random
 // numbers (drawn in the order one estimate at a time would draw them: each estimate's
 // environment samples, then its BSDF samples, two numbers each), then each environment
 // sample, then each BSDF sample (all of them drawn before any is looked up), whose
-// radiance and density lookup_many finds for all lanes at once (SIMD where it can; see
-// envmap.h). Compiled once per BSDF kind K and flattened (everything it calls inlined),
-// so that the kind's own code runs with no branch on the kind and no call: the generic
-// Bsdf::sample, eval and pdf are too large for GCC to inline into the loops by itself.
-// See README, Performance, for what each step gained. kMaxLanes sizes the working
-// arrays, which one estimate alone must not pay for.
+// radiance and density lookup_many finds for all lanes at once. Compiled once per BSDF
+// kind K and flattened (everything it calls inlined), so that the kind's own code runs
+// with no branch on the kind and no call: the generic Bsdf::sample, eval and pdf are
+// too large for GCC to inline into the loops by itself. With AVX2, the batch functions
+// sample and look up eight lanes at a time, and for a Lambertian surface (seen from
+// above) so do the BSDF's sampling, pdf, value and the weighted sums
+// (estimator_simd.h): the lanes are then padded to a multiple of eight with valid
+// points, whose results are dropped. See README, Performance, for what each step
+// gained. kMaxLanes sizes the working arrays, which one estimate alone must not pay for.
 template <uint32_t kMaxLanes, BsdfKind K>
 [[gnu::flatten]] void estimate_lanes_of(const EnvMapView& env, const Technique& t, const Allocation& a,
                                         const Frame& frame, Vec3 wo, Bsdf bsdf, Pcg32& rng,
@@ -121,49 +133,83 @@ template <uint32_t kMaxLanes, BsdfKind K>
     const Counts counts = sample_counts(t, a);
     const auto n_env = static_cast<uint32_t>(counts.n[0]), n_bsdf = static_cast<uint32_t>(counts.n[1]);
     const uint32_t lanes = static_cast<uint32_t>(out.size());
+#ifdef ENVMIS_AVX2_BATCHES
+    constexpr uint32_t kWidth = detail::kSimdWidth;
+    const bool simd = kMaxLanes % kWidth == 0 && simd::avx2_available();
+    const bool simd_lambert = simd && K == BsdfKind::lambert && wo.z > 0;
+    const uint32_t padded = simd ? (lanes + kWidth - 1) / kWidth * kWidth : lanes;
+#else
+    const bool simd = false, simd_lambert = false;
+    const uint32_t padded = lanes;
+#endif
     float u_x[kMaxLaneSamples][kMaxLanes], u_y[kMaxLaneSamples][kMaxLanes];
     for (uint32_t l = 0; l < lanes; ++l)
         for (uint32_t j = 0; j < n_env + n_bsdf; ++j) u_x[j][l] = rng.uniform(), u_y[j][l] = rng.uniform();
-    std::fill(out.begin(), out.end(), Rgb{});
-    auto contribute = [&](Rgb& sum, int k, Rgb f, const float* p) {
-        const float q[2] = {counts.n[0] * p[0], counts.n[1] * p[1]};
-        add(sum, f, fixed_weight(t, q, k) / q[k]);
+    for (uint32_t j = 0; j < n_env + n_bsdf; ++j)
+        for (uint32_t l = lanes; l < padded; ++l) u_x[j][l] = u_y[j][l] = 0.5f;
+    // The environment technique's directions (world frame), densities and radiance; the
+    // BSDF's densities and values (f cos) at the same directions.
+    float x[kMaxLanes], y[kMaxLanes], z[kMaxLanes], pdf[kMaxLanes], r[kMaxLanes], g[kMaxLanes], bl[kMaxLanes];
+    float b_pdf[kMaxLanes], v_r[kMaxLanes], v_g[kMaxLanes], v_b[kMaxLanes];
+    float sum_r[kMaxLanes] = {}, sum_g[kMaxLanes] = {}, sum_b[kMaxLanes] = {};
+    // Adds each lane's sample of technique k (0: environment, 1: BSDF) to its sum.
+    auto add_lanes = [&](int k) {
+#ifdef ENVMIS_AVX2_BATCHES
+        if (simd)
+            return detail::add_samples(weighting_of(t), counts.n, k, {r, g, bl, v_r, v_g, v_b, pdf, b_pdf},
+                                       {sum_r, sum_g, sum_b}, padded);
+#endif
+        for (uint32_t l = 0; l < lanes; ++l) {
+            const float q[2] = {counts.n[0] * pdf[l], counts.n[1] * b_pdf[l]};
+            if (!(k == 0 ? pdf[l] > 0 : b_pdf[l] > 0)) continue;
+            const Rgb f = Rgb{r[l], g[l], bl[l]} * Rgb{v_r[l], v_g[l], v_b[l]};
+            const float s = fixed_weight(t, q, k) / q[k];
+            sum_r[l] += f.r * s, sum_g[l] += f.g * s, sum_b[l] += f.b * s;
+        }
     };
-    float x[kMaxLanes], y[kMaxLanes], z[kMaxLanes], r[kMaxLanes], g[kMaxLanes], bl[kMaxLanes], pdf[kMaxLanes];
     for (uint32_t j = 0; j < n_env; ++j) {
         if constexpr (kMaxLanes == 1) {
             const EnvSample e = env.sample({u_x[j][0], u_y[j][0]});
             x[0] = e.direction.x, y[0] = e.direction.y, z[0] = e.direction.z, pdf[0] = e.pdf;
             r[0] = e.radiance.r, g[0] = e.radiance.g, bl[0] = e.radiance.b;
         } else {
-            sample_many(env, {u_x[j], u_y[j]}, {x, y, z, pdf, r, g, bl}, lanes);
+            sample_many(env, {u_x[j], u_y[j]}, {x, y, z, pdf, r, g, bl}, padded);
         }
-        for (uint32_t l = 0; l < lanes; ++l) {
-            if (!(pdf[l] > 0)) continue;
-            const Vec3 wi = frame.to_local({x[l], y[l], z[l]});
-            const float p[2] = {pdf[l], bsdf.pdf(wo, wi)};
-            contribute(out[l], 0, Rgb{r[l], g[l], bl[l]} * bsdf.eval(wo, wi), p);
+        if (simd_lambert) {
+#ifdef ENVMIS_AVX2_BATCHES
+            detail::eval_lambert(frame, bsdf.reflectance, {x, y, z}, {b_pdf, v_r, v_g, v_b}, padded);
+#endif
+        } else {
+            for (uint32_t l = 0; l < padded; ++l) {
+                const Vec3 wi = frame.to_local({x[l], y[l], z[l]});
+                const Rgb v = bsdf.eval(wo, wi);
+                b_pdf[l] = bsdf.pdf(wo, wi), v_r[l] = v.r, v_g[l] = v.g, v_b[l] = v.b;
+            }
         }
+        add_lanes(0);
     }
     for (uint32_t j = n_env; j < n_env + n_bsdf; ++j) {
-        BsdfSample b[kMaxLanes];
-        for (uint32_t l = 0; l < lanes; ++l) {
-            b[l] = bsdf.sample(wo, {u_x[j][l], u_y[j][l]});
-            const Vec3 wi = frame.to_world(b[l].wi);
-            x[l] = wi.x, y[l] = wi.y, z[l] = wi.z;
+        if (simd_lambert) {
+#ifdef ENVMIS_AVX2_BATCHES
+            detail::sample_lambert(frame, bsdf.reflectance, {u_x[j], u_y[j]}, {x, y, z, b_pdf, v_r, v_g, v_b}, padded);
+#endif
+        } else {
+            for (uint32_t l = 0; l < padded; ++l) {
+                const BsdfSample b = bsdf.sample(wo, {u_x[j][l], u_y[j][l]});
+                const Vec3 wi = frame.to_world(b.wi);
+                x[l] = wi.x, y[l] = wi.y, z[l] = wi.z;
+                b_pdf[l] = b.pdf, v_r[l] = b.value.r, v_g[l] = b.value.g, v_b[l] = b.value.b;
+            }
         }
         if constexpr (kMaxLanes == 1) {  // one estimate: inline, without the batch's set-up
             const EnvMapView::Lookup e = env.lookup({x[0], y[0], z[0]});
             r[0] = e.radiance.r, g[0] = e.radiance.g, bl[0] = e.radiance.b, pdf[0] = e.pdf;
         } else {
-            lookup_many(env, {x, y, z}, {r, g, bl, pdf}, lanes);
+            lookup_many(env, {x, y, z}, {r, g, bl, pdf}, padded);
         }
-        for (uint32_t l = 0; l < lanes; ++l) {
-            if (!(b[l].pdf > 0)) continue;
-            const float p[2] = {pdf[l], b[l].pdf};
-            contribute(out[l], 1, Rgb{r[l], g[l], bl[l]} * b[l].value, p);
-        }
+        add_lanes(1);
     }
+    for (uint32_t l = 0; l < lanes; ++l) out[l] = {sum_r[l], sum_g[l], sum_b[l]};
 }
 
 template <uint32_t kMaxLanes>
