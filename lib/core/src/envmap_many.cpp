@@ -188,20 +188,30 @@ ENVMIS_AVX2 I8 gather(const uint32_t* a, I8 i) noexcept {
     return _mm256_i32gather_epi32(reinterpret_cast<const int*>(a), i, 4);
 }
 
-// CdfView::invert for eight units u, lane i searching the CDF of n >= 2 cells at
-// start + base_i (guide likewise): the cell index and the offset in it.
+// Eight units u of CdfView::invert over n cells: u in CDF units (x), its integer part t
+// and its guide bucket k = t n / 2^31 (from 64-bit products of the even and odd lanes).
+struct Unit8 {
+    F8 x;
+    I8 t, k;
+};
+ENVMIS_AVX2 Unit8 unit8(F8 u, uint32_t n) noexcept {
+    const F8 x = _mm256_mul_ps(u, splat(static_cast<float>(kCdfUnits)));
+    const I8 t = _mm256_cvttps_epi32(x);  // x < 2^31
+    const I8 nn = _mm256_set1_epi32(static_cast<int>(n));
+    const I8 even = _mm256_srli_epi64(_mm256_mul_epu32(t, nn), 31);
+    const I8 odd = _mm256_slli_epi64(_mm256_srli_epi64(_mm256_mul_epu32(_mm256_srli_epi64(t, 32), nn), 31), 32);
+    return {x, t, _mm256_min_epu32(_mm256_blend_epi32(even, odd, 0xAA), _mm256_set1_epi32(static_cast<int>(n - 1)))};
+}
+
+// The rest of CdfView::invert for eight units, lane i searching the CDF of n >= 2 cells
+// at start + base_i (guide likewise): the cell index and the offset in it.
 struct Hit8 {
     I8 index;
     F8 offset;
 };
-ENVMIS_AVX2 Hit8 invert8(const uint32_t* start, const uint16_t* guide, I8 base, uint32_t n, F8 u) noexcept {
-    const F8 x = _mm256_mul_ps(u, splat(static_cast<float>(kCdfUnits)));
-    const I8 t = _mm256_cvttps_epi32(x);  // x < 2^31
-    // The guide bucket k = t n / 2^31, from 64-bit products of the even and odd lanes.
-    const I8 nn = _mm256_set1_epi32(static_cast<int>(n)), last = _mm256_set1_epi32(static_cast<int>(n - 1));
-    const I8 even = _mm256_srli_epi64(_mm256_mul_epu32(t, nn), 31);
-    const I8 odd = _mm256_slli_epi64(_mm256_srli_epi64(_mm256_mul_epu32(_mm256_srli_epi64(t, 32), nn), 31), 32);
-    const I8 k = _mm256_min_epu32(_mm256_blend_epi32(even, odd, 0xAA), last);
+ENVMIS_AVX2 Hit8 search8(const uint32_t* start, const uint16_t* guide, I8 base, uint32_t n, const Unit8& unit) noexcept {
+    const F8 x = unit.x;
+    const I8 t = unit.t, k = unit.k, last = _mm256_set1_epi32(static_cast<int>(n - 1));
     // guide[k] and guide[k + 1] (or n - 1 after the last bucket) from one 32-bit gather of
     // the pair at j = min(k, n - 2), which stays inside the guide's n entries.
     const I8 j = _mm256_min_epu32(k, _mm256_set1_epi32(static_cast<int>(n - 2)));
@@ -252,12 +262,38 @@ ENVMIS_AVX2 F8 point_in_cell8(I8 index, F8 offset, uint32_t n) noexcept {
     return clamp8(_mm256_castsi256_ps(_mm256_sub_epi32(_mm256_castps_si256(x), step)), 0.0f, kOneMinusEpsilon);
 }
 
-// EnvMapView::sample for the eight points from lane l on.
-ENVMIS_AVX2 void sample8(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t l) noexcept {
+// Eight points of EnvMapView::sample with their rows found (the marginal is small and
+// stays in cache) and their columns' guide bucket.
+struct Rows8 {
+    Hit8 r;
+    I8 row;  // r.index w: the row's first cell
+    Unit8 column;
+};
+
+// The rows of the eight points from lane l on; starts loading what the column search
+// reads first (the guide entry and CDF around the bucket) and the radiance near it.
+ENVMIS_AVX2 Rows8 rows8(const EnvMapView& env, PointArrays in, uint32_t l) noexcept {
     const Distribution2DView& d = env.distribution;
-    const Hit8 r = invert8(d.marginal.start, d.marginal.guide, _mm256_setzero_si256(), d.h, _mm256_loadu_ps(in.y + l));
-    const I8 row = _mm256_mullo_epi32(r.index, _mm256_set1_epi32(static_cast<int>(d.w)));
-    const Hit8 c = invert8(d.start, d.guide, row, d.w, _mm256_loadu_ps(in.x + l));
+    const I8 zero = _mm256_setzero_si256();
+    const Hit8 r = search8(d.marginal.start, d.marginal.guide, zero, d.h, unit8(_mm256_loadu_ps(in.y + l), d.h));
+    const Rows8 rows{r, _mm256_mullo_epi32(r.index, _mm256_set1_epi32(static_cast<int>(d.w))),
+                     unit8(_mm256_loadu_ps(in.x + l), d.w)};
+    alignas(32) uint32_t near[8];
+    _mm256_store_si256(reinterpret_cast<I8*>(near), _mm256_add_epi32(rows.row, rows.column.k));
+    for (const uint32_t i : near) {
+        ENVMIS_PREFETCH(d.guide + i);
+        ENVMIS_PREFETCH(d.start + i);
+        ENVMIS_PREFETCH(env.radiance + i);
+    }
+    return rows;
+}
+
+// EnvMapView::sample for the eight points from lane l on, their rows found.
+ENVMIS_AVX2 void sample8(const EnvMapView& env, const Rows8& rows, SampleArrays out, uint32_t l) noexcept {
+    const Distribution2DView& d = env.distribution;
+    const Hit8& r = rows.r;
+    const I8 row = rows.row;
+    const Hit8 c = search8(d.start, d.guide, row, d.w, rows.column);
     const SinCos8 theta = sincos_half_turns8(env.turns, point_in_cell8(r.index, r.offset, d.h));
     const SinCos8 phi = sincos_turns8(env.turns, point_in_cell8(c.index, c.offset, d.w));
     _mm256_storeu_ps(out.x + l, _mm256_mul_ps(theta.sin, phi.cos));
@@ -272,10 +308,18 @@ ENVMIS_AVX2 void sample8(const EnvMapView& env, PointArrays in, SampleArrays out
     _mm256_storeu_ps(out.b + l, _mm256_i32gather_ps(rgb + 2, three, 4));
 }
 
-// Lanes [0, n - n % 8).
+// Lanes [0, n - n % 8): up to four groups of eight with their rows found, and their
+// columns' data prefetched, before the first group's column search, so that the cache
+// misses of all of them overlap (as in lookup_avx2).
 ENVMIS_AVX2 uint32_t sample_avx2(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t n) noexcept {
+    constexpr uint32_t kGroups = 4;
     const uint32_t whole = n - n % 8;
-    for (uint32_t first = 0; first < whole; first += 8) sample8(env, in, out, first);
+    for (uint32_t first = 0; first < whole; first += 8 * kGroups) {
+        const uint32_t groups = std::min(kGroups, (whole - first) / 8);
+        Rows8 rows[kGroups];
+        for (uint32_t k = 0; k < groups; ++k) rows[k] = rows8(env, in, first + 8 * k);
+        for (uint32_t k = 0; k < groups; ++k) sample8(env, rows[k], out, first + 8 * k);
+    }
     return whole;
 }
 #endif
@@ -293,7 +337,7 @@ void lookup_many(const EnvMapView& env, DirectionArrays in, LookupArrays out, ui
 void sample_many(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t n) noexcept {
     uint32_t done = 0;
 #ifdef ENVMIS_AVX2_BATCHES
-    // The guide pairs of invert8 need two cells in each dimension.
+    // The guide pairs of search8 need two cells in each dimension.
     if (avx2_applies(env) && env.distribution.w > 1 && env.distribution.h > 1 && simd::avx2_available())
         done = sample_avx2(env, in, out, n);
 #endif
