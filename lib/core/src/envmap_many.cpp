@@ -170,18 +170,28 @@ ENVMIS_AVX2 void fetch8(const EnvMapView& env, const Cells8& c, LookupArrays out
     _mm256_storeu_ps(out.pdf + l, solid_angle_pdf8(d, row_width, cell_width, sincos_half_turns8(env.turns, c.v).sin));
 }
 
-// Lanes [0, n - n % 8): up to four groups of eight located, and their texels
-// prefetched, before the first is fetched, so that their cache misses overlap.
-ENVMIS_AVX2 uint32_t lookup_avx2(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
+// Lanes [0, n - n % 8) in groups of eight, up to four groups at a time: start(first)
+// for each of them (it finds what its group will read, prefetches it and returns where
+// it is), then finish(started, first) for each, so that the cache misses of all four
+// overlap. Without the staging, three quarters of lookup_avx2's time went waiting on
+// its first radiance gather. Returns n - n % 8.
+template <class Start, class Finish>
+ENVMIS_AVX2 uint32_t in_staged_groups(uint32_t n, Start&& start, Finish&& finish) noexcept {
     constexpr uint32_t kGroups = 4;
     const uint32_t whole = n - n % 8;
     for (uint32_t first = 0; first < whole; first += 8 * kGroups) {
         const uint32_t groups = std::min(kGroups, (whole - first) / 8);
-        Cells8 cells[kGroups];
-        for (uint32_t k = 0; k < groups; ++k) cells[k] = locate8(env, in, first + 8 * k);
-        for (uint32_t k = 0; k < groups; ++k) fetch8(env, cells[k], out, first + 8 * k);
+        decltype(start(first)) started[kGroups];
+        for (uint32_t k = 0; k < groups; ++k) started[k] = start(first + 8 * k);
+        for (uint32_t k = 0; k < groups; ++k) finish(started[k], first + 8 * k);
     }
     return whole;
+}
+
+ENVMIS_AVX2 uint32_t lookup_avx2(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
+    return in_staged_groups(
+        n, [&](uint32_t first) ENVMIS_AVX2 { return locate8(env, in, first); },
+        [&](const Cells8& cells, uint32_t first) ENVMIS_AVX2 { fetch8(env, cells, out, first); });
 }
 
 ENVMIS_AVX2 I8 gather(const uint32_t* a, I8 i) noexcept {
@@ -308,19 +318,12 @@ ENVMIS_AVX2 void sample8(const EnvMapView& env, const Rows8& rows, SampleArrays 
     _mm256_storeu_ps(out.b + l, _mm256_i32gather_ps(rgb + 2, three, 4));
 }
 
-// Lanes [0, n - n % 8): up to four groups of eight with their rows found, and their
-// columns' data prefetched, before the first group's column search, so that the cache
-// misses of all of them overlap (as in lookup_avx2).
+// Rows found and columns' data prefetched for up to four groups before the first
+// group's column search.
 ENVMIS_AVX2 uint32_t sample_avx2(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t n) noexcept {
-    constexpr uint32_t kGroups = 4;
-    const uint32_t whole = n - n % 8;
-    for (uint32_t first = 0; first < whole; first += 8 * kGroups) {
-        const uint32_t groups = std::min(kGroups, (whole - first) / 8);
-        Rows8 rows[kGroups];
-        for (uint32_t k = 0; k < groups; ++k) rows[k] = rows8(env, in, first + 8 * k);
-        for (uint32_t k = 0; k < groups; ++k) sample8(env, rows[k], out, first + 8 * k);
-    }
-    return whole;
+    return in_staged_groups(
+        n, [&](uint32_t first) ENVMIS_AVX2 { return rows8(env, in, first); },
+        [&](const Rows8& rows, uint32_t first) ENVMIS_AVX2 { sample8(env, rows, out, first); });
 }
 #endif
 

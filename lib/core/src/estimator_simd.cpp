@@ -1,9 +1,9 @@
 // The estimator's lanes in AVX2; see estimator_simd.h. The scalar code each function
 // repeats: sample_disk, fast_sincos, sample_cosine_hemisphere, Frame::to_world and
 // to_local, Bsdf::sample, pdf and eval for BsdfKind::lambert (frame.h, fast_math.h,
-// bsdf.h), and contribute, fixed_weight, balance_weight and power_weight (estimator.cpp,
-// mis_weights.h). If one of them changes, this file must change with it; the test that
-// compares estimates made together and alone fails until it does.
+// bsdf.h), and the lanes' add_lanes, fixed_weight, balance_weight and power_weight
+// (estimator.cpp, mis_weights.h). If one of them changes, this file must change with
+// it; the test that compares estimates made together and alone fails until it does.
 #include "estimator_simd.h"
 
 #ifdef ENVMIS_AVX2_BATCHES

@@ -34,8 +34,8 @@ void eval_lambert(const Frame& frame, Rgb albedo, DirectionArrays wi, BsdfValueA
 enum class Weighting { one, balance, power };
 
 // One sample per lane of technique k (0: environment, 1: BSDF), added to the lanes'
-// sums as the scalar contribute() adds it: value L v per channel, weight from
-// q = n p of both techniques, divided by q_k; nothing where p_k is not > 0.
+// sums as the scalar add_lanes (estimator.cpp) adds it: value L v per channel, weight
+// from q = n p of both techniques, divided by q_k; nothing where p_k is not > 0.
 struct LaneSamples {
     const float *radiance_r, *radiance_g, *radiance_b;  // L
     const float *value_r, *value_g, *value_b;           // v: the BSDF's f cos
