@@ -90,10 +90,18 @@ Counts sample_counts(const Technique& t, const Allocation& a) noexcept {
 // the balance or power heuristic for MIS. One-sample MIS picks technique k with
 // probability n_k / total: its estimate, averaged over total draws, is f / sum q as for
 // multi-sample balance.
+detail::Weighting weighting_of(const Technique& t) noexcept {
+    if (t.strategy == Strategy::env || t.strategy == Strategy::bsdf) return detail::Weighting::one;
+    return t.strategy == Strategy::mis && t.heuristic == Heuristic::power ? detail::Weighting::power
+                                                                          : detail::Weighting::balance;
+}
 float fixed_weight(const Technique& t, const float* q, int k) noexcept {
-    if (t.strategy == Strategy::env || t.strategy == Strategy::bsdf) return 1;
-    return t.strategy == Strategy::mis && t.heuristic == Heuristic::power ? power_weight(q, 2, k)
-                                                                           : balance_weight(q, 2, k);
+    switch (weighting_of(t)) {
+        case detail::Weighting::one: return 1;
+        case detail::Weighting::power: return power_weight(q, 2, k);
+        case detail::Weighting::balance: return balance_weight(q, 2, k);
+    }
+    return 0;
 }
 
 // Estimates side by side, for the fixed-weight techniques over one density.
@@ -103,14 +111,6 @@ constexpr uint32_t kMaxLaneSamples = 8;  // per estimate; estimates that spend m
 bool runs_in_lanes(const Technique& t, const Allocation& a) noexcept {
     return !t.adaptive() && !t.mixture && t.strategy != Strategy::one_sample && a.total() <= kMaxLaneSamples;
 }
-
-#ifdef ENVMIS_AVX2_BATCHES
-detail::Weighting weighting_of(const Technique& t) noexcept {
-    if (t.strategy == Strategy::env || t.strategy == Strategy::bsdf) return detail::Weighting::one;
-    return t.strategy == Strategy::mis && t.heuristic == Heuristic::power ? detail::Weighting::power
-                                                                          : detail::Weighting::balance;
-}
-#endif
 
 // Up to `lanes` (<= kMaxLanes) estimates at once, each step over all of them: the random
 // numbers (drawn in the order one estimate at a time would draw them: each estimate's

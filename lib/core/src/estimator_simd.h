@@ -3,7 +3,8 @@
 // operation by operation, so that a lane's result is bit-identical to an estimate made
 // alone (tests/estimator_test.cpp, ManyEstimatesAtOnceEqualTheSameEstimatesOneAtATime).
 // Lane counts are multiples of kSimdWidth: callers pad their arrays with valid inputs.
-// Declared on x86-64 only (ENVMIS_AVX2_BATCHES); call where simd::avx2_available().
+// The functions are declared on x86-64 only (ENVMIS_AVX2_BATCHES); call them where
+// simd::avx2_available().
 #pragma once
 
 #include <cstdint>
@@ -11,6 +12,14 @@
 #include "envmis/envmap.h"
 #include "envmis/frame.h"
 #include "simd.h"
+
+namespace envmis::detail {
+
+// The fixed MIS weights of the lanes' techniques (estimator.cpp, fixed_weight): 1 for a
+// single technique, the balance or the power heuristic.
+enum class Weighting { one, balance, power };
+
+}  // namespace envmis::detail
 
 #ifdef ENVMIS_AVX2_BATCHES
 namespace envmis::detail {
@@ -28,10 +37,6 @@ struct BsdfValueArrays {
     float *pdf, *r, *g, *b;
 };
 void eval_lambert(const Frame& frame, Rgb albedo, DirectionArrays wi, BsdfValueArrays out, uint32_t n) noexcept;
-
-// The fixed MIS weights of the lanes' techniques (estimator.cpp, fixed_weight): 1 for a
-// single technique, the balance or the power heuristic.
-enum class Weighting { one, balance, power };
 
 // One sample per lane of technique k (0: environment, 1: BSDF), added to the lanes'
 // sums as the scalar add_lanes (estimator.cpp) adds it: value L v per channel, weight
