@@ -74,16 +74,12 @@ void sample_batch(benchmark::State& state) {
     constexpr size_t kBatch = 64;
     const EnvMap map(sky(static_cast<uint32_t>(state.range(0))), envmis::EnvMapOptions{});
     const EnvMapView view = map.view();
-    static const std::vector<float> ux = [] {
+    const auto coordinate = [](float envmis::Vec2::*c) {
         std::vector<float> v;
-        for (const envmis::Vec2 u : uniforms()) v.push_back(u.x);
+        for (const envmis::Vec2 u : uniforms()) v.push_back(u.*c);
         return v;
-    }();
-    static const std::vector<float> uy = [] {
-        std::vector<float> v;
-        for (const envmis::Vec2 u : uniforms()) v.push_back(u.y);
-        return v;
-    }();
+    };
+    static const std::vector<float> ux = coordinate(&envmis::Vec2::x), uy = coordinate(&envmis::Vec2::y);
     std::vector<float> out(7 * kBatch);
     float* o = out.data();
     const envmis::SampleArrays arrays{o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch, o + 4 * kBatch, o + 5 * kBatch,

@@ -76,15 +76,18 @@ ENVMIS_AVX2 I8 cell8(F8 x, uint32_t n) noexcept {
     return _mm256_min_epu32(_mm256_set_m128i(hi, lo), _mm256_set1_epi32(static_cast<int>(n - 1)));
 }
 
+ENVMIS_AVX2 I8 gather(const uint32_t* a, I8 i) noexcept {
+    return _mm256_i32gather_epi32(reinterpret_cast<const int*>(a), i, 4);
+}
+
 // CdfView::width of cell i of the CDF at `start`, n cells: the next start (kCdfUnits
 // after the last cell) minus this one.
 ENVMIS_AVX2 I8 width8(const uint32_t* start, I8 base, I8 i, uint32_t n) noexcept {
-    const auto* s = reinterpret_cast<const int*>(start);
     const I8 last = _mm256_cmpeq_epi32(i, _mm256_set1_epi32(static_cast<int>(n - 1)));
     const I8 at = _mm256_add_epi32(base, i);
-    const I8 next = _mm256_i32gather_epi32(s, _mm256_sub_epi32(at, _mm256_andnot_si256(last, _mm256_set1_epi32(-1))), 4);
+    const I8 next = gather(start, _mm256_sub_epi32(at, _mm256_andnot_si256(last, _mm256_set1_epi32(-1))));
     const I8 end = _mm256_blendv_epi8(next, _mm256_set1_epi32(static_cast<int>(kCdfUnits)), last);
-    return _mm256_sub_epi32(end, _mm256_i32gather_epi32(s, at, 4));
+    return _mm256_sub_epi32(end, gather(start, at));
 }
 
 // Widths to float, as static_cast<float>(uint32_t): a width is at most 2^31, which as a
@@ -118,13 +121,24 @@ ENVMIS_AVX2 SinCos8 sincos_half_turns8(const SinCos* turns, F8 t) noexcept {
     return sincos_steps8(turns, _mm256_mul_ps(t, splat(static_cast<float>(kTurnSteps / 2))));
 }
 
-// EnvMapView::solid_angle_pdf of the density from a row's and a cell's widths
-// (Distribution2DView::pdf_of).
-ENVMIS_AVX2 F8 solid_angle_pdf8(const Distribution2DView& d, I8 row_width, I8 cell_width, F8 sin_theta) noexcept {
+// EnvMapView::solid_angle_pdf of the density of cell (x, y), row = y w, from its row's
+// and its own widths (Distribution2DView::pdf_of).
+ENVMIS_AVX2 F8 solid_angle_pdf8(const Distribution2DView& d, I8 x, I8 y, I8 row, F8 sin_theta) noexcept {
+    const I8 row_width = width8(d.marginal.start, _mm256_setzero_si256(), y, d.h);
+    const I8 cell_width = width8(d.start, row, x, d.w);
     const F8 image_pdf = _mm256_mul_ps(_mm256_mul_ps(width_to_float(row_width), width_to_float(cell_width)),
                                        splat(d.pdf_scale));
     const F8 pdf = _mm256_div_ps(image_pdf, _mm256_mul_ps(splat(kTwoPiSquared), sin_theta));
     return select(_mm256_cmp_ps(sin_theta, splat(0.0f), _CMP_GT_OQ), pdf, splat(0.0f));
+}
+
+// The radiance of eight texels (row-major indices), stored from lane l on.
+ENVMIS_AVX2 void store_radiance8(const Rgb* radiance, I8 texel, float* r, float* g, float* b, uint32_t l) noexcept {
+    const I8 three = _mm256_add_epi32(texel, _mm256_add_epi32(texel, texel));
+    const float* rgb = &radiance->r;
+    _mm256_storeu_ps(r + l, _mm256_i32gather_ps(rgb, three, 4));
+    _mm256_storeu_ps(g + l, _mm256_i32gather_ps(rgb + 1, three, 4));
+    _mm256_storeu_ps(b + l, _mm256_i32gather_ps(rgb + 2, three, 4));
 }
 
 // Where eight directions fall: their cells, the first texel of their rows (y w) and
@@ -159,15 +173,9 @@ ENVMIS_AVX2 Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l
 
 // Radiance and solid-angle pdf at eight located directions, stored from lane l on.
 ENVMIS_AVX2 void fetch8(const EnvMapView& env, const Cells8& c, LookupArrays out, uint32_t l) noexcept {
-    const Distribution2DView& d = env.distribution;
-    const I8 texel = _mm256_add_epi32(c.row, c.x), three = _mm256_add_epi32(texel, _mm256_add_epi32(texel, texel));
-    const float* rgb = &env.radiance->r;
-    _mm256_storeu_ps(out.r + l, _mm256_i32gather_ps(rgb, three, 4));
-    _mm256_storeu_ps(out.g + l, _mm256_i32gather_ps(rgb + 1, three, 4));
-    _mm256_storeu_ps(out.b + l, _mm256_i32gather_ps(rgb + 2, three, 4));
-    const I8 row_width = width8(d.marginal.start, _mm256_setzero_si256(), c.y, d.h);
-    const I8 cell_width = width8(d.start, c.row, c.x, d.w);
-    _mm256_storeu_ps(out.pdf + l, solid_angle_pdf8(d, row_width, cell_width, sincos_half_turns8(env.turns, c.v).sin));
+    store_radiance8(env.radiance, _mm256_add_epi32(c.row, c.x), out.r, out.g, out.b, l);
+    const F8 sin_theta = sincos_half_turns8(env.turns, c.v).sin;
+    _mm256_storeu_ps(out.pdf + l, solid_angle_pdf8(env.distribution, c.x, c.y, c.row, sin_theta));
 }
 
 // Lanes [0, n - n % 8) in groups of eight, up to four groups at a time: start(first)
@@ -192,10 +200,6 @@ ENVMIS_AVX2 uint32_t lookup_avx2(const EnvMapView& env, DirectionArrays in, Look
     return in_staged_groups(
         n, [&](uint32_t first) ENVMIS_AVX2 { return locate8(env, in, first); },
         [&](const Cells8& cells, uint32_t first) ENVMIS_AVX2 { fetch8(env, cells, out, first); });
-}
-
-ENVMIS_AVX2 I8 gather(const uint32_t* a, I8 i) noexcept {
-    return _mm256_i32gather_epi32(reinterpret_cast<const int*>(a), i, 4);
 }
 
 // Eight units u of CdfView::invert over n cells: u in CDF units (x), its integer part t
@@ -309,13 +313,8 @@ ENVMIS_AVX2 void sample8(const EnvMapView& env, const Rows8& rows, SampleArrays 
     _mm256_storeu_ps(out.x + l, _mm256_mul_ps(theta.sin, phi.cos));
     _mm256_storeu_ps(out.y + l, _mm256_mul_ps(theta.sin, phi.sin));
     _mm256_storeu_ps(out.z + l, theta.cos);
-    const I8 row_width = width8(d.marginal.start, _mm256_setzero_si256(), r.index, d.h);
-    _mm256_storeu_ps(out.pdf + l, solid_angle_pdf8(d, row_width, width8(d.start, row, c.index, d.w), theta.sin));
-    const I8 texel = _mm256_add_epi32(row, c.index), three = _mm256_add_epi32(texel, _mm256_add_epi32(texel, texel));
-    const float* rgb = &env.radiance->r;
-    _mm256_storeu_ps(out.r + l, _mm256_i32gather_ps(rgb, three, 4));
-    _mm256_storeu_ps(out.g + l, _mm256_i32gather_ps(rgb + 1, three, 4));
-    _mm256_storeu_ps(out.b + l, _mm256_i32gather_ps(rgb + 2, three, 4));
+    _mm256_storeu_ps(out.pdf + l, solid_angle_pdf8(d, c.index, r.index, row, theta.sin));
+    store_radiance8(env.radiance, _mm256_add_epi32(row, c.index), out.r, out.g, out.b, l);
 }
 
 // Rows found and columns' data prefetched for up to four groups before the first

@@ -85,16 +85,18 @@ Counts sample_counts(const Technique& t, const Allocation& a) noexcept {
              static_cast<float>(s == Strategy::bsdf ? a.total() : (both ? a.bsdf : 0))}};
 }
 
-// The weight of a sample of technique k (0: environment, 1: BSDF), q = n p of both, for
-// the techniques whose weights depend on the densities alone: 1 for a single technique,
-// the balance or power heuristic for MIS. One-sample MIS picks technique k with
-// probability n_k / total: its estimate, averaged over total draws, is f / sum q as for
-// multi-sample balance.
+// The heuristic fixed_weight applies to technique t (the SIMD sums take the same).
 detail::Weighting weighting_of(const Technique& t) noexcept {
     if (t.strategy == Strategy::env || t.strategy == Strategy::bsdf) return detail::Weighting::one;
     return t.strategy == Strategy::mis && t.heuristic == Heuristic::power ? detail::Weighting::power
                                                                           : detail::Weighting::balance;
 }
+
+// The weight of a sample of technique k (0: environment, 1: BSDF), q = n p of both, for
+// the techniques whose weights depend on the densities alone: 1 for a single technique,
+// the balance or power heuristic for MIS. One-sample MIS picks technique k with
+// probability n_k / total: its estimate, averaged over total draws, is f / sum q as for
+// multi-sample balance.
 float fixed_weight(const Technique& t, const float* q, int k) noexcept {
     switch (weighting_of(t)) {
         case detail::Weighting::one: return 1;
