@@ -8,9 +8,9 @@
 #include <random>
 #include <vector>
 
-#include "envmis/comparison.h"
-#include "envmis/envmap.h"
-#include "envmis/estimator.h"
+#include "envmis/study/comparison/comparison.h"
+#include "envmis/sampling/envmap.h"
+#include "envmis/study/techniques/estimator.h"
 #include "reference.h"
 
 namespace {

@@ -9,8 +9,8 @@
 
 #include <cstdint>
 
-#include "envmis/envmap.h"
-#include "envmis/textbook.h"
+#include "envmis/sampling/envmap.h"
+#include "envmis/study/reference/textbook.h"
 
 namespace envmis::reference {
 

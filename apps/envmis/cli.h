@@ -12,9 +12,9 @@
 
 #include <CLI/CLI.hpp>
 
-#include "envmis/alpha.h"
-#include "envmis/envmap.h"
-#include "envmis/table.h"
+#include "envmis/study/comparison/alpha.h"
+#include "envmis/sampling/envmap.h"
+#include "envmis/table/table.h"
 
 namespace envmis::cli {
 

@@ -13,8 +13,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
-#include "envmis/atomic_file.h"
-#include "envmis/comparison.h"
+#include "envmis/table/atomic_file.h"
+#include "envmis/study/comparison/comparison.h"
 #include "envmis/io/image_io.h"
 #include "render.h"
 #include "sweeps.h"
@@ -88,7 +88,7 @@ nlohmann::json stats_json(const BsdfComparison& b, const TechniqueStats& t, floa
 // Writes plots/name as a PNG.
 template <class Chart>
 void write_plot(const std::filesystem::path& plots, const char* name, const Chart& chart) {
-    io::write_png(plots / name, io::draw(chart));
+    io::write_png(plots / name, pictures::draw(chart));
 }
 
 }  // namespace

@@ -7,7 +7,7 @@
 
 #include "cli.h"
 #include "envmis/io/image_io.h"
-#include "envmis/remap.h"
+#include "envmis/image/remap.h"
 
 namespace envmis::cli {
 

@@ -15,7 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
-#include "envmis/atomic_file.h"
+#include "envmis/table/atomic_file.h"
 
 namespace envmis::cli {
 namespace {

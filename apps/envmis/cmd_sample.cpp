@@ -6,7 +6,7 @@
 #include <random>
 
 #include "cli.h"
-#include "envmis/atomic_file.h"
+#include "envmis/table/atomic_file.h"
 
 namespace envmis::cli {
 namespace {

@@ -7,7 +7,7 @@
 
 #include "cli.h"
 #include "envmis/io/image_io.h"
-#include "envmis/io/picture.h"
+#include "envmis/pictures/picture.h"
 
 namespace envmis::cli {
 namespace {
@@ -54,19 +54,19 @@ Subcommand add_visualize(CLI::App& app) {
                 const uint32_t pw = std::min(args->panel_width, std::max(w, 64u));
                 const uint32_t ph = std::max(1u, static_cast<uint32_t>(static_cast<uint64_t>(pw) * h / w));
                 std::vector<float> pdfs[2];
-                for (int i = 0; i < 2; ++i) pdfs[i] = io::resize(pdf_image(*maps[i]), w, h, pw, ph);
-                const io::ColourScale scale = io::shared_log_scale({pdfs[0], pdfs[1]});
+                for (int i = 0; i < 2; ++i) pdfs[i] = pictures::resize(pdf_image(*maps[i]), w, h, pw, ph);
+                const pictures::ColourScale scale = pictures::shared_log_scale({pdfs[0], pdfs[1]});
 
                 char caption[256];
                 std::snprintf(caption, sizeof caption, "%s  %ux%u  mean luminance %.3g  alpha %.3g: compensation zeroes %.1f%% of texels",
                               loaded.source.name.c_str(), w, h, maps[1]->stats().mean_luminance, compensated.compensation.alpha,
                               100.0 * maps[1]->stats().zeroed_texels / (static_cast<double>(w) * h));
-                const io::Panel panels[] = {
-                    {io::tonemap(io::resize(loaded.map.radiance(), pw, ph), 0, plain.luma), "radiance (tone-mapped)", false},
-                    {io::false_colour(pdfs[0], pw, ph, scale), "pdf without compensation", true},
-                    {io::false_colour(pdfs[1], pw, ph, scale), "pdf with compensation", true}};
-                const io::Image8 bar = io::colour_bar(scale, "solid-angle pdf [1/sr]", 2 * pw);
-                io::write_png(args->output, io::montage(panels, caption, &bar));
+                const pictures::Panel panels[] = {
+                    {pictures::tonemap(pictures::resize(loaded.map.radiance(), pw, ph), 0, plain.luma), "radiance (tone-mapped)", false},
+                    {pictures::false_colour(pdfs[0], pw, ph, scale), "pdf without compensation", true},
+                    {pictures::false_colour(pdfs[1], pw, ph, scale), "pdf with compensation", true}};
+                const io::Image8 bar = pictures::colour_bar(scale, "solid-angle pdf [1/sr]", 2 * pw);
+                io::write_png(args->output, pictures::montage(panels, caption, &bar));
                 std::printf("envmis visualize: %s -> %s (%ux%u panels, pdf scale %.3g to %.3g per sr)\n",
                             args->input.c_str(), args->output.c_str(), pw, ph, scale.lo, scale.hi);
             }};

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "envmis/io/image_io.h"
-#include "envmis/io/picture.h"
+#include "envmis/pictures/picture.h"
 
 namespace envmis::cli {
 namespace {
@@ -67,15 +67,15 @@ std::vector<float> relative_squared_error(const RgbImage& image, const RgbImage&
 }
 
 io::Image8 crop(const io::Image8& image, uint32_t x0, uint32_t width) {
-    io::Image8 out = io::make_image(width, image.height, {});
-    io::blit(out, image, -static_cast<int>(x0), 0);
+    io::Image8 out = pictures::make_image(width, image.height, {});
+    pictures::blit(out, image, -static_cast<int>(x0), 0);
     return out;
 }
 
 io::Image8 stack(const io::Image8& top, const io::Image8& bottom) {
-    io::Image8 out = io::make_image(std::max(top.width, bottom.width), top.height + bottom.height, io::Style{}.background);
-    io::blit(out, top, 0, 0);
-    io::blit(out, bottom, 0, static_cast<int>(top.height));
+    io::Image8 out = pictures::make_image(std::max(top.width, bottom.width), top.height + bottom.height, pictures::Style{}.background);
+    pictures::blit(out, top, 0, 0);
+    pictures::blit(out, bottom, 0, static_cast<int>(top.height));
     return out;
 }
 
@@ -113,9 +113,9 @@ std::filesystem::path render_comparison(const EnvMap& plain, const EnvMap& compe
     };
     place(reference, 0);
     for (uint32_t i = 0; i < renders.size(); ++i) place(renders[i].second, i + 1);
-    const io::Image8 shown = io::tonemap(wide, 0, plain.options().luma);
+    const io::Image8 shown = pictures::tonemap(wide, 0, plain.options().luma);
 
-    std::vector<io::Panel> top = {{crop(shown, 0, w), "reference (" + std::to_string(render_options.reference_spp) + " spp)"}};
+    std::vector<pictures::Panel> top = {{crop(shown, 0, w), "reference (" + std::to_string(render_options.reference_spp) + " spp)"}};
     io::write_png(folder / "reference.png", top[0].image);
     std::vector<std::vector<float>> errors;
     std::vector<double> mean_errors;
@@ -127,22 +127,22 @@ std::filesystem::path render_comparison(const EnvMap& plain, const EnvMap& compe
     }
     // A fixed scale: a few pixels hit by a rare bright sample would otherwise stretch it
     // over many decades and leave the typical errors indistinguishable.
-    const io::ColourScale scale{1e-4f, 10.0f, true};
-    std::vector<io::Panel> bottom;
+    const pictures::ColourScale scale{1e-4f, 10.0f, true};
+    std::vector<pictures::Panel> bottom;
     for (uint32_t i = 0; i < renders.size(); ++i) {
         char title[96];
         std::snprintf(title, sizeof title, "%s relMSE %.3g", renders[i].first.c_str(), mean_errors[i]);
-        bottom.push_back({io::false_colour(errors[i], w, h, scale), title, true});
+        bottom.push_back({pictures::false_colour(errors[i], w, h, scale), title, true});
         io::write_png(folder / (renders[i].first + "-relmse.png"), bottom.back().image);
     }
-    const io::Image8 bar = io::colour_bar(scale, "per-pixel relative squared error", std::min(4u * w, 1600u));
+    const io::Image8 bar = pictures::colour_bar(scale, "per-pixel relative squared error", std::min(4u * w, 1600u));
     std::string bsdf_names;
     for (const Bsdf& b : options.bsdfs) bsdf_names += (bsdf_names.empty() ? "" : ", ") + b.name();
     char caption[256];
     std::snprintf(caption, sizeof caption, "%s: %s at %u spp (%u env + %u BSDF samples each), alpha %.3g", map_name.c_str(),
                   bsdf_names.c_str(), render_options.spp, options.allocation.env, options.allocation.bsdf,
                   compensated.options().compensation.alpha);
-    const io::Image8 montage = stack(io::montage(top, caption), io::montage(bottom, "", &bar));
+    const io::Image8 montage = stack(pictures::montage(top, caption), pictures::montage(bottom, "", &bar));
     const std::filesystem::path path = folder / "montage.png";
     io::write_png(path, montage);
     return path;

@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <string>
 
-#include "envmis/comparison.h"
+#include "envmis/study/comparison/comparison.h"
 
 namespace envmis::cli {
 

@@ -267,13 +267,13 @@ nlohmann::json alpha_sweep_summary_json(const AlphaSweep& sweep, const std::vect
     return summary;
 }
 
-io::LinePlot alpha_sweep_plot(const AlphaSweep& sweep, const std::string& map_name) {
-    io::LinePlot plot{"Compensation strength: " + map_name, "alpha",
+pictures::LinePlot alpha_sweep_plot(const AlphaSweep& sweep, const std::string& map_name) {
+    pictures::LinePlot plot{"Compensation strength: " + map_name, "alpha",
                       std::string("var(mis-balance-comp) / var(mis-balance), ") +
                           (sweep.exact.empty() ? "measured" : "exact"),
                       {}, true};
     for (size_t b = 0; !sweep.alphas.empty() && b < sweep.comparisons.front().bsdfs.size(); ++b) {
-        io::Series series{sweep.comparisons.front().bsdfs[b].bsdf.name(), {}, {}};
+        pictures::Series series{sweep.comparisons.front().bsdfs[b].bsdf.name(), {}, {}};
         for (size_t i = 0; i < sweep.alphas.size(); ++i) {
             series.x.push_back(sweep.alphas[i]);
             series.y.push_back(sweep.ratio(i, b));
@@ -349,15 +349,15 @@ void print_allocation_sweep(std::ostream& out, const AllocationSweep& sweep) {
         }
 }
 
-io::LinePlot allocation_plot(const AllocationSweep& sweep, const std::string& map_name) {
+pictures::LinePlot allocation_plot(const AllocationSweep& sweep, const std::string& map_name) {
     const uint32_t total = sweep.allocations.empty() ? 0 : sweep.allocations.front().total();
-    io::LinePlot plot{"Sample allocation (" + std::to_string(total) + " per estimate): " + map_name,
+    pictures::LinePlot plot{"Sample allocation (" + std::to_string(total) + " per estimate): " + map_name,
                       "environment samples per estimate", "efficiency, 1 / (variance x seconds per estimate)", {}, true};
     if (sweep.allocations.empty()) return plot;
     const Comparison& first = sweep.comparisons.front();
     for (size_t b = 0; b < first.bsdfs.size(); ++b)
         for (size_t t = 0; t < first.bsdfs[b].techniques.size(); ++t) {
-            io::Series series{first.bsdfs[b].bsdf.name() + " " + first.bsdfs[b].techniques[t].technique.name(), {}, {}};
+            pictures::Series series{first.bsdfs[b].bsdf.name() + " " + first.bsdfs[b].techniques[t].technique.name(), {}, {}};
             for (size_t i = 0; i < sweep.allocations.size(); ++i) {
                 series.x.push_back(sweep.allocations[i].env);
                 series.y.push_back(sweep.comparisons[i].bsdfs[b].techniques[t].efficiency);
@@ -367,8 +367,8 @@ io::LinePlot allocation_plot(const AllocationSweep& sweep, const std::string& ma
     return plot;
 }
 
-io::BarChart variance_chart(const Comparison& comparison, const std::string& map_name) {
-    io::BarChart chart{"Variance relative to mis-balance: " + map_name, "var / var(mis-balance), geometric mean over points",
+pictures::BarChart variance_chart(const Comparison& comparison, const std::string& map_name) {
+    pictures::BarChart chart{"Variance relative to mis-balance: " + map_name, "var / var(mis-balance), geometric mean over points",
                        {}, {}, {}, true, 1.0};
     for (const BsdfComparison& b : comparison.bsdfs) {
         chart.groups.push_back(b.bsdf.name());

@@ -20,9 +20,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "envmis/alpha.h"
-#include "envmis/comparison.h"
-#include "envmis/io/plot.h"
+#include "envmis/study/comparison/alpha.h"
+#include "envmis/study/comparison/comparison.h"
+#include "envmis/pictures/plot.h"
 
 namespace envmis::cli {
 
@@ -98,7 +98,7 @@ void print_alpha_sweep(std::ostream& out, const AlphaSweep& sweep, const std::ve
 nlohmann::json alpha_sweep_summary_json(const AlphaSweep& sweep, const std::vector<float>* auto_alphas);
 
 // mis-balance-comp's ratio() against alpha, one series per BSDF, log y.
-io::LinePlot alpha_sweep_plot(const AlphaSweep& sweep, const std::string& map_name);
+pictures::LinePlot alpha_sweep_plot(const AlphaSweep& sweep, const std::string& map_name);
 
 // The study at each allocation n_env : n_bsdf = k : (total - k), k = 1 .. total - 1.
 struct AllocationSweep {
@@ -126,11 +126,11 @@ AllocationSweep run_allocation_sweep(const EnvMap& plain, const CompensatedMaps&
 void print_allocation_sweep(std::ostream& out, const AllocationSweep& sweep);
 
 // Efficiency against n_env, one series per BSDF and technique, log y.
-io::LinePlot allocation_plot(const AllocationSweep& sweep, const std::string& map_name);
+pictures::LinePlot allocation_plot(const AllocationSweep& sweep, const std::string& map_name);
 
 // Every technique's var/mis per BSDF (groups: BSDFs, bars: techniques), log y, a
 // reference line at 1.
-io::BarChart variance_chart(const Comparison& comparison, const std::string& map_name);
+pictures::BarChart variance_chart(const Comparison& comparison, const std::string& map_name);
 
 // One row of a sweep, as the JSON arrays and the CSV file hold it.
 struct SweepRow {

@@ -35,13 +35,13 @@
 #include <thread>
 #include <vector>
 
-#include "envmis/bsdf.h"
-#include "envmis/envmap.h"
-#include "envmis/frame.h"
+#include "envmis/study/shading/bsdf.h"
+#include "envmis/sampling/envmap.h"
+#include "envmis/study/shading/frame.h"
 #include "envmis/io/image_io.h"
-#include "envmis/io/picture.h"
-#include "envmis/random.h"
-#include "envmis/table.h"
+#include "envmis/pictures/picture.h"
+#include "envmis/math/random.h"
+#include "envmis/table/table.h"
 
 namespace {
 
@@ -235,7 +235,7 @@ int run_render(const Options& o) {
     std::filesystem::path png = o.output;
     png.replace_extension(".png");
     envmis::io::write_exr(o.output, image);
-    envmis::io::write_png(png, envmis::io::tonemap(image, 0, map.options().luma));
+    envmis::io::write_png(png, envmis::pictures::tonemap(image, 0, map.options().luma));
     const char* names[] = {"1 environment + 1 BSDF sample, balance heuristic", "1 environment sample", "1 BSDF sample"};
     std::printf("%s: %ux%u, %u spp (%s), %s density, %.2f s -> %s, %s\n", o.table.string().c_str(), o.width, o.height,
                 o.spp, names[static_cast<int>(o.technique)], map.compensated() ? "compensated" : "plain", seconds,

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "envmis/envmap.h"
-#include "envmis/table.h"
+#include "envmis/sampling/envmap.h"
+#include "envmis/table/table.h"
 #ifdef ENVMIS_CONSUMER_IO
 #include "envmis/io/colour.h"
 #include "envmis/io/image_io.h"

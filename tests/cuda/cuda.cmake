@@ -7,13 +7,14 @@
 # map C++20 to recent nvcc versions, and this check needs nothing else from CMake.
 find_program(ENVMIS_NVCC nvcc HINTS $ENV{CUDA_HOME}/bin /usr/local/cuda/bin)
 if(ENVMIS_NVCC)
-  file(GLOB envmis_core_headers CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/lib/core/include/envmis/*.h)
+  file(GLOB_RECURSE envmis_device_headers CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/lib/core/include/*.h
+    ${PROJECT_SOURCE_DIR}/lib/study/include/*.h)
   set(object ${CMAKE_CURRENT_BINARY_DIR}/device_compile.o)
   add_custom_command(
     OUTPUT ${object}
     COMMAND ${ENVMIS_NVCC} -std=c++20 -Werror all-warnings -ccbin ${CMAKE_CXX_COMPILER}
-            -I${PROJECT_SOURCE_DIR}/lib/core/include -c ${CMAKE_CURRENT_LIST_DIR}/device_compile.cu -o ${object}
-    DEPENDS ${CMAKE_CURRENT_LIST_DIR}/device_compile.cu ${envmis_core_headers}
+            -I${PROJECT_SOURCE_DIR}/lib/core/include -I${PROJECT_SOURCE_DIR}/lib/study/include -c ${CMAKE_CURRENT_LIST_DIR}/device_compile.cu -o ${object}
+    DEPENDS ${CMAKE_CURRENT_LIST_DIR}/device_compile.cu ${envmis_device_headers}
     COMMENT "Compiling the sampling path as CUDA device code (nvcc)")
   add_custom_target(envmis_cuda_compile_check ALL DEPENDS ${object})
   message(STATUS "envmis: CUDA compile check enabled (${ENVMIS_NVCC})")

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "envmis/table.h"
+#include "envmis/table/table.h"
 
 namespace {
 

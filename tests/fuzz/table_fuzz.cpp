@@ -11,8 +11,8 @@
 #include <span>
 #include <vector>
 
-#include "envmis/hash.h"
-#include "envmis/table.h"
+#include "envmis/math/hash.h"
+#include "envmis/table/table.h"
 
 namespace {
 

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "envmis/image.h"
+#include "envmis/image/image.h"
 #include "stats.h"
 
 namespace envmis::test {

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "envmis/math.h"
+#include "envmis/math/math.h"
 
 namespace envmis::test {
 

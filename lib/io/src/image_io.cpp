@@ -1,6 +1,6 @@
 #include "envmis/io/image_io.h"
 
-#include "envmis/atomic_file.h"
+#include "envmis/table/atomic_file.h"
 
 #include <OpenImageIO/imageio.h>
 
@@ -8,8 +8,8 @@
 #include <fstream>
 #include <span>
 
-#include "envmis/atomic_file.h"
-#include "envmis/hash.h"
+#include "envmis/table/atomic_file.h"
+#include "envmis/math/hash.h"
 #include "envmis/io/colour.h"
 
 namespace envmis::io {

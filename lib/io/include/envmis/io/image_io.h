@@ -19,8 +19,8 @@
 #include <string>
 #include <vector>
 
-#include "envmis/image.h"
-#include "envmis/math.h"
+#include "envmis/image/image.h"
+#include "envmis/math/math.h"
 
 namespace envmis::io {
 

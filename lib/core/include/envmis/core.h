@@ -1,0 +1,23 @@
+// envmis::core in one include, for people who do not care which stage a name lives in.
+// The runtime a renderer links: no third-party dependency. Its headers follow the data
+// path, each stage using only those before it:
+//   math/          vectors, fast polynomial maths, random numbers, hashing
+//   image/         RGB images and bad-pixel repair, mappings and axes, remapping
+//   compensation/  the compensation threshold (Karlik et al. 2019)
+//   sampling/      2D distributions and the environment-map sampler, with batch calls
+//   table/         table files (written atomically, read or memory-mapped)
+#pragma once
+
+#include "envmis/compensation/compensation.h"
+#include "envmis/image/image.h"
+#include "envmis/image/mapping.h"
+#include "envmis/image/remap.h"
+#include "envmis/math/fast_math.h"
+#include "envmis/math/hash.h"
+#include "envmis/math/math.h"
+#include "envmis/math/random.h"
+#include "envmis/sampling/allocator.h"
+#include "envmis/sampling/distribution.h"
+#include "envmis/sampling/envmap.h"
+#include "envmis/table/atomic_file.h"
+#include "envmis/table/table.h"

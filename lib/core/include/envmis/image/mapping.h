@@ -1,0 +1,147 @@
+// Mappings between image space and directions: equirectangular (latitude-longitude,
+// the default) and equal-area octahedral (Clarberg 2008, the square maps of pbrt-v4).
+//
+// Equirectangular convention (canonical frame, z up, right-handed), for a point (u, v)
+// in [0,1)^2 of the image, u along a row (left to right), v down the columns (v = 0 is
+// the top row):
+//   theta = pi v,  phi = 2 pi u,
+//   direction = (sin theta cos phi, sin theta sin phi, cos theta).
+// Measure: d(omega) = 2 pi^2 sin(theta) du dv, so an image-space density p(u, v) is the
+// solid-angle density p / (2 pi^2 sin theta).
+//
+// Equal-area octahedral: a square image; its centre is +z, the midpoints of its edges
+// lie on the equator, its four corners are -z. Every texel covers the same solid angle:
+// d(omega) = 4 pi du dv, so the solid-angle density is p / (4 pi). Same (u, v) and
+// direction conventions as pbrt-v4's EqualAreaSquareToSphere, so a square map written
+// with it is one pbrt-v4's `imagemap` infinite light reads with the same orientation.
+//
+// Renderers that use another up axis or handedness pick an `Axes` at table-build time;
+// it is recorded in the table and applied on the way out (`to_world`) and in
+// (`to_canonical`), so the image and its density never change.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "envmis/math/fast_math.h"
+#include "envmis/math/math.h"
+
+namespace envmis {
+
+// A signed permutation of the axes: world component i = sign(code[i]) * canonical
+// component |code[i]| - 1. {1, 2, 3} is the identity (z up); {1, 3, -2} is y up.
+struct Axes {
+    int8_t code[3] = {1, 2, 3};
+
+    // Parses "x,y,z", "x,z,-y", ... or the presets "z-up" and "y-up".
+    // Throws std::invalid_argument naming the text if it is not a signed permutation.
+    static Axes parse(std::string_view text);
+    std::string to_string() const;
+    bool valid() const noexcept;
+    ENVMIS_HD bool identity() const noexcept { return code[0] == 1 && code[1] == 2 && code[2] == 3; }
+    friend bool operator==(const Axes&, const Axes&) = default;
+};
+
+ENVMIS_HD inline float axis_component(Vec3 v, int8_t code) noexcept {
+    const float c = v[(code < 0 ? -code : code) - 1];
+    return code < 0 ? -c : c;
+}
+
+// Both return early for the default frame, which most renderers use: the general
+// permutation takes some thirty instructions and three branches per call.
+ENVMIS_HD inline Vec3 to_world(const Axes& a, Vec3 canonical) noexcept {
+    if (a.identity()) return canonical;
+    return {axis_component(canonical, a.code[0]), axis_component(canonical, a.code[1]),
+            axis_component(canonical, a.code[2])};
+}
+
+ENVMIS_HD inline Vec3 to_canonical(const Axes& a, Vec3 world) noexcept {
+    if (a.identity()) return world;
+    float c[3] = {0, 0, 0};
+    for (int i = 0; i < 3; ++i) {
+        const int8_t code = a.code[i];
+        c[(code < 0 ? -code : code) - 1] = code < 0 ? -world[i] : world[i];
+    }
+    return {c[0], c[1], c[2]};
+}
+
+// Canonical direction of image point uv, with sin(theta) (>= 0) alongside.
+ENVMIS_HD inline Vec3 equirect_direction(Vec2 uv, float* sin_theta = nullptr) noexcept {
+    const SinCos t = fast_sincos(kPiF * uv.y), p = fast_sincos(2 * kPiF * uv.x);
+    const float st = max(t.sin, 0.0f);
+    if (sin_theta) *sin_theta = st;
+    return {st * p.cos, st * p.sin, t.cos};
+}
+
+// Image point of a canonical unit direction; the inverse of equirect_direction.
+ENVMIS_HD inline Vec2 equirect_uv(Vec3 d) noexcept {
+    const float z = clamp(d.z, -1.0f, 1.0f);
+    const float theta = fast_atan2(std::sqrt(max(0.0f, (1 - z) * (1 + z))), z);
+    const float phi = fast_atan2(d.y, d.x);
+    constexpr float kInvPi = static_cast<float>(1 / kPi);
+    const float u = 0.5f * kInvPi * (phi < 0 ? phi + 2 * kPiF : phi);
+    return {clamp(u, 0.0f, kOneMinusEpsilon), clamp(theta * kInvPi, 0.0f, kOneMinusEpsilon)};
+}
+
+enum class Mapping : uint32_t { equirect = 1, equal_area = 2 };
+std::string_view to_string(Mapping m) noexcept;  // "equirect", "equal-area"
+// Reads the names to_string gives. Throws std::invalid_argument naming the text.
+Mapping parse_mapping(std::string_view text);
+
+inline constexpr float kFourPi = 4 * kPiF;
+
+// Canonical direction of point uv of an equal-area square (pbrt-v4's convention).
+ENVMIS_HD inline Vec3 equal_area_direction(Vec2 uv) noexcept {
+    const float u = 2 * uv.x - 1, v = 2 * uv.y - 1, au = std::abs(u), av = std::abs(v);
+    // Signed distance from the diamond |u| + |v| = 1 (the equator); r is the distance
+    // from the nearer pole, measured along the square.
+    const float signed_distance = 1 - (au + av), r = 1 - std::abs(signed_distance);
+    const float phi = (r == 0 ? 1 : (av - au) / r + 1) * (kPiF / 4);
+    const SinCos p = fast_sincos(phi);
+    const float z = std::copysign(1 - r * r, signed_distance), s = r * std::sqrt(max(0.0f, 2 - r * r));
+    return {std::copysign(p.cos, u) * s, std::copysign(p.sin, v) * s, z};
+}
+
+// Point of an equal-area square for a canonical unit direction; the inverse of
+// equal_area_direction.
+ENVMIS_HD inline Vec2 equal_area_uv(Vec3 d) noexcept {
+    const float ax = std::abs(d.x), ay = std::abs(d.y), az = min(std::abs(d.z), 1.0f);
+    const float r = std::sqrt(1 - az);
+    // The angle within the quadrant, as a fraction of a quarter turn.
+    const float t = fast_atan2(ay, ax) * static_cast<float>(2 / kPi);
+    float v = t * r, u = r - v;
+    if (d.z < 0) {
+        const float old_u = u;
+        u = 1 - v;
+        v = 1 - old_u;
+    }
+    u = std::copysign(u, d.x);
+    v = std::copysign(v, d.y);
+    return {clamp(0.5f * (u + 1), 0.0f, kOneMinusEpsilon), clamp(0.5f * (v + 1), 0.0f, kOneMinusEpsilon)};
+}
+
+// sin(theta) at the centre of image row y of h: the row's weight in every
+// solid-angle sum over the map (texel solid angle = 2 pi^2 sin(theta_y) / (w h)).
+ENVMIS_HD inline float row_sin_theta(uint32_t y, uint32_t h) noexcept {
+    return static_cast<float>(std::sin(kPi * (y + 0.5) / h));
+}
+
+// Relative solid angle of the texels of row y of h: sin(theta_y) (row centre) for
+// equirect, 1 for equal-area, whose texels all cover 4 pi / (w h).
+ENVMIS_HD inline float row_weight(Mapping m, uint32_t y, uint32_t h) noexcept {
+    return m == Mapping::equal_area ? 1.0f : row_sin_theta(y, h);
+}
+
+// Canonical direction of image point uv under mapping m.
+ENVMIS_HD inline Vec3 image_direction(Mapping m, Vec2 uv) noexcept {
+    return m == Mapping::equal_area ? equal_area_direction(uv) : equirect_direction(uv);
+}
+
+// Image point of a canonical unit direction under mapping m.
+ENVMIS_HD inline Vec2 image_uv(Mapping m, Vec3 d) noexcept {
+    return m == Mapping::equal_area ? equal_area_uv(d) : equirect_uv(d);
+}
+
+}  // namespace envmis

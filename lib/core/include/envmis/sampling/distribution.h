@@ -1,0 +1,301 @@
+// Piecewise-constant distributions over [0,1) and [0,1)^2, sampled by CDF inversion
+// accelerated with a guide table (Chen & Asau 1974).
+//
+// Measure: image space. A distribution over n cells with function values f_i has
+// density pdf(x) = p_i n on cell i, where p_i is the cell's probability, so the pdf
+// integrates to 1 over [0,1)^d. `sample` inverts the CDF: it preserves the
+// stratification of its input and is exactly invertible (`invert(sample(u).p) == u` up
+// to float rounding).
+//
+// Precision: sums are accumulated in double, then each CDF is stored in 31-bit fixed
+// point (uint32: cell i covers [start_i, start_{i+1}) of 2^31 units). Fixed point has
+// the same resolution everywhere (a float CDF has 2^-24 near 1 and loses small cells
+// after large ones). Every cell with f_i > 0 gets at least one unit, so pdf > 0 exactly
+// where f > 0, and pdf() reports the stored probability itself: sample and pdf agree
+// exactly. p_i differs from f_i / sum f by at most one unit, 2^-31 = 4.7e-10.
+//
+// Cost (n cells): build O(n); 6 bytes per cell (uint32 CDF, uint16 guide entry);
+// sample O(1) expected (a guide-table lookup, then a binary search only inside the few
+// cells that share one guide bucket); pdf O(1); invert O(1). Sizes: 1 to 65536 cells per
+// dimension.
+//
+// The owning classes hold the tables and throw on invalid input. Their `view()` is a
+// set of flat arrays with noexcept, allocation-free methods that also compile for
+// CUDA: upload the arrays and use the same view on the device.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "envmis/sampling/allocator.h"
+#include "envmis/math/math.h"
+
+namespace envmis {
+
+inline constexpr uint32_t kCdfUnits = 1u << 31;   // total of a fixed-point CDF
+inline constexpr uint32_t kMaxCells1D = 1u << 16;  // per dimension (uint16 guide entries)
+
+// A point found by inverting a CDF: the cell and the position inside it, in [0,1).
+struct CellHit {
+    uint32_t index = 0;
+    float offset = 0;
+};
+
+// The hint of CdfView::invert that does nothing.
+struct NoHint {
+    ENVMIS_HD void operator()(uint32_t) const noexcept {}
+};
+
+// Non-owning view of one fixed-point CDF over n cells.
+struct CdfView {
+    const uint32_t* start = nullptr;  // n: first unit of each cell; zero-width cells are empty
+    const uint16_t* guide = nullptr;  // n: guide[k] = cell of the first unit of bucket k
+    uint32_t n = 0;
+
+    ENVMIS_HD uint32_t width(uint32_t i) const noexcept { return (i + 1 < n ? start[i + 1] : kCdfUnits) - start[i]; }
+
+    // The cell holding unit u * 2^31, and the position inside it.
+    // Single precision throughout: x is exact (a power-of-two scale of u), and so are
+    // its integer part t and the fraction x - t; only the offset's division rounds.
+    //
+    // Memory: a map beyond the cache misses on the guide entry, then on the CDF entry it
+    // names, then on the caller's data for the cell found. The answer is usually near
+    // cell k of the guide bucket (for a smooth function, within a cache line of it), so
+    // the CDF around k is prefetched and `near_answer(k)` lets the caller prefetch its
+    // own: the three loads overlap instead of waiting for each other.
+    template <class Hint = NoHint>
+    ENVMIS_HD CellHit invert(float u, Hint near_answer = {}) const noexcept {
+        const float x = u * static_cast<float>(kCdfUnits);
+        const auto t = static_cast<uint32_t>(x);
+        const auto k = static_cast<uint32_t>((static_cast<uint64_t>(t) * n) >> 31);
+        ENVMIS_PREFETCH(start + k);
+        near_answer(k);
+        uint32_t lo = guide[k], hi = k + 1 < n ? guide[k + 1] : n - 1;
+        while (lo < hi) {  // last cell whose start is <= t
+            const uint32_t mid = (lo + hi + 1) / 2;
+            if (start[mid] <= t) lo = mid; else hi = mid - 1;
+        }
+        const float offset = (static_cast<float>(t - start[lo]) + (x - static_cast<float>(t))) /
+                             static_cast<float>(width(lo));
+        // Both terms are >= 0 (t >= start[lo], t <= x) and the found cell is not empty,
+        // so only the rounding up to 1 needs a clamp.
+        return {lo, min(offset, kOneMinusEpsilon)};
+    }
+
+    // The u that `invert` maps to (index, offset).
+    ENVMIS_HD float at(uint32_t index, float offset) const noexcept {
+        const double units = start[index] + static_cast<double>(offset) * width(index);
+        return clamp(static_cast<float>(units / kCdfUnits), 0.0f, kOneMinusEpsilon);
+    }
+};
+
+namespace detail {
+
+// Cell of x in [0,1); exact, because a float times n <= 2^31 is exact in double.
+ENVMIS_HD inline uint32_t cell_of(float x, uint32_t n) noexcept {
+    const auto i = static_cast<uint32_t>(static_cast<double>(clamp(x, 0.0f, 1.0f)) * n);
+    return i < n ? i : n - 1;
+}
+
+// Position of x inside cell i, in [0,1), from the same exact product as cell_of.
+ENVMIS_HD inline float offset_in_cell(float x, uint32_t i, uint32_t n) noexcept {
+    return clamp(static_cast<float>(static_cast<double>(x) * n - i), 0.0f, kOneMinusEpsilon);
+}
+
+// The float nearest (index + offset) / n that still lies in cell `index`: rounding to
+// float can step over a cell edge, and one step back always suffices because a cell is
+// many float ulps wide.
+ENVMIS_HD inline float point_in_cell(uint32_t index, float offset, uint32_t n) noexcept {
+    if ((n & (n - 1)) == 0) {
+        // Power-of-two n (most maps): index / n and offset / n are exact floats, so
+        // their sum rounds once, to the same float as the division below, and can only
+        // round up onto the next cell's edge, which is exact too.
+        const float inv_n = 1.0f / static_cast<float>(n), i = static_cast<float>(index);
+        const float x = i * inv_n + offset * inv_n;
+        const float next_edge = (i + 1) * inv_n;
+        return x < next_edge ? x : bit_cast<float>(bit_cast<uint32_t>(next_edge) - 1);
+    }
+    float x = static_cast<float>((index + static_cast<double>(offset)) / n);
+    const uint32_t c = cell_of(x, n);
+    if (c > index) x = ::nextafterf(x, 0.0f);
+    if (c < index) x = ::nextafterf(x, 1.0f);
+    return clamp(x, 0.0f, kOneMinusEpsilon);
+}
+
+// The uniform CDF over n cells: what build_cdf gives a function without a positive value.
+struct UniformCdf {
+    std::vector<uint32_t> start;
+    std::vector<uint16_t> guide;
+
+    explicit UniformCdf(uint32_t n);
+};
+
+// Working memory of build_cdf for up to n cells, reusable from one call to the next.
+// `uniform`, when given (over the same n cells), is copied for a function without a
+// positive value rather than built again: the rows of a 2D distribution share one.
+struct CdfScratch {
+    std::vector<double> prefix;
+    std::vector<uint16_t> marks;
+    const UniformCdf* uniform = nullptr;
+
+    explicit CdfScratch(uint32_t n, const UniformCdf* shared_uniform = nullptr)
+        : prefix(n), marks(size_t{n} + 1), uniform(shared_uniform) {}
+};
+
+// Fills start and guide (n each) from func and returns the sum of func (double); adds
+// the number of negative, NaN or infinite values to `invalid` (the caller rejects them).
+// A zero function gets a uniform CDF.
+template <class T>
+double build_cdf(const T* func, uint32_t n, uint32_t* start, uint16_t* guide, uint32_t& invalid,
+                 CdfScratch& scratch) noexcept;
+
+}  // namespace detail
+
+// Non-owning view of a 1D distribution; see the file comment.
+struct Distribution1DView {
+    CdfView cdf;
+
+    struct Sample {
+        float x = 0;         // continuous point in [0,1)
+        float pdf = 0;       // density at x (measure: dx on [0,1))
+        uint32_t index = 0;  // cell of x
+    };
+
+    ENVMIS_HD Sample sample(float u) const noexcept {
+        const CellHit hit = cdf.invert(u);
+        return {detail::point_in_cell(hit.index, hit.offset, cdf.n), cell_pdf(hit.index), hit.index};
+    }
+    ENVMIS_HD float pdf(float x) const noexcept { return cell_pdf(detail::cell_of(x, cdf.n)); }
+    ENVMIS_HD float invert(float x) const noexcept {
+        const uint32_t i = detail::cell_of(x, cdf.n);
+        return cdf.at(i, detail::offset_in_cell(x, i, cdf.n));
+    }
+    ENVMIS_HD float cell_pdf(uint32_t i) const noexcept {
+        return static_cast<float>(static_cast<double>(cdf.width(i)) * cdf.n / kCdfUnits);
+    }
+};
+
+// A piecewise-constant distribution over [0,1) with func.size() cells.
+class Distribution1D {
+public:
+    Distribution1D() = default;
+    // Throws std::invalid_argument if func is empty, has more than 65536 cells, or holds
+    // a negative or non-finite value. An all-zero func gives the uniform distribution.
+    explicit Distribution1D(std::span<const float> func);
+
+    Distribution1DView view() const noexcept { return {{start_.data(), guide_.data(), size()}}; }
+    Distribution1DView::Sample sample(float u) const noexcept { return view().sample(u); }
+    float pdf(float x) const noexcept { return view().pdf(x); }
+    float invert(float x) const noexcept { return view().invert(x); }
+
+    uint32_t size() const noexcept { return static_cast<uint32_t>(start_.size()); }
+    double integral() const noexcept { return integral_; }  // mean of the input func over [0,1)
+    bool uniform_fallback() const noexcept { return uniform_; }
+
+private:
+    LargeVector<uint32_t> start_;
+    LargeVector<uint16_t> guide_;
+    double integral_ = 0;
+    bool uniform_ = false;
+};
+
+// Non-owning view of a 2D distribution: a marginal CDF over rows, then one
+// conditional CDF per row. Cell (x, y) covers [x/w, (x+1)/w) x [y/h, (y+1)/h).
+struct Distribution2DView {
+    const uint32_t* start = nullptr;  // w h, row-major: row y's CDF is start[y w, y w + w)
+    const uint16_t* guide = nullptr;  // w h, likewise
+    CdfView marginal;                 // over the h rows
+    uint32_t w = 0, h = 0;
+    float pdf_scale = 0;              // w h 2^-62: density per unit of the marginal times unit of a row
+
+    struct Sample {
+        Vec2 p;                 // continuous point in [0,1)^2
+        float pdf = 0;          // density at p (measure: dx dy on [0,1)^2)
+        uint32_t x = 0, y = 0;  // cell of p
+    };
+
+    ENVMIS_HD CdfView row(uint32_t y) const noexcept {
+        const size_t offset = static_cast<size_t>(y) * w;
+        return {start + offset, guide + offset, w};
+    }
+    // u.y picks the row, u.x the column within it. `near_answer(i)` is told the
+    // row-major index i = y w + x of a cell usually near the one sampled (see
+    // CdfView::invert), for the caller to prefetch its data.
+    template <class Hint = NoHint>
+    ENVMIS_HD Sample sample(Vec2 u, Hint near_answer = {}) const noexcept {
+        const CellHit r = marginal.invert(u.y);
+        const CdfView cdf = row(r.index);
+        const size_t row_start = static_cast<size_t>(r.index) * w;
+        const CellHit c = cdf.invert(u.x, [&](uint32_t x) { near_answer(row_start + x); });
+        const Vec2 p{detail::point_in_cell(c.index, c.offset, w), detail::point_in_cell(r.index, r.offset, h)};
+        return {p, pdf_of(marginal.width(r.index), cdf.width(c.index)), c.index, r.index};
+    }
+    ENVMIS_HD float pdf(Vec2 p) const noexcept {
+        const uint32_t x = detail::cell_of(p.x, w), y = detail::cell_of(p.y, h);
+        return pdf_of(marginal.width(y), row(y).width(x));
+    }
+    ENVMIS_HD Vec2 invert(Vec2 p) const noexcept {
+        const uint32_t x = detail::cell_of(p.x, w), y = detail::cell_of(p.y, h);
+        return {row(y).at(x, detail::offset_in_cell(p.x, x, w)), marginal.at(y, detail::offset_in_cell(p.y, y, h))};
+    }
+    // Density of a cell from its row's and its own fixed-point widths. In float: the
+    // int-to-double conversions cost more than the whole rest of the product (measured),
+    // and the two extra roundings leave it within 3 float ulps of the exact value.
+    ENVMIS_HD float pdf_of(uint32_t row_width, uint32_t cell_width) const noexcept {
+        return static_cast<float>(row_width) * static_cast<float>(cell_width) * pdf_scale;
+    }
+};
+
+// A piecewise-constant distribution over [0,1)^2 from a w x h row-major function.
+class Distribution2D {
+public:
+    // Fills `row` (w values) with the function on row y; called once per row, from
+    // several threads at a time for different rows.
+    using RowFunction = std::function<void(uint32_t y, std::span<float> row)>;
+    // The same from `cells`, row y of the values given to the constructor that takes
+    // them, read before the build overwrites them.
+    using CellRowFunction = std::function<void(uint32_t y, std::span<const uint32_t> cells, std::span<float> row)>;
+
+    Distribution2D() = default;
+    // Throws std::invalid_argument on a size mismatch, w or h outside [1, 65536], or a
+    // negative or non-finite value. An all-zero func gives the uniform distribution.
+    // Rows are built in parallel on all cores; the result does not depend on the
+    // number of threads.
+    Distribution2D(std::span<const float> func, uint32_t w, uint32_t h);
+    // The same from a function evaluated row by row, never held whole in memory.
+    Distribution2D(uint32_t w, uint32_t h, const RowFunction& rows);
+    // The same, building the start table in `cells` (w h values) and each row from its
+    // previous contents: a caller with per-cell data to derive the function from (EnvMap:
+    // luminance) needs no second w x h buffer.
+    Distribution2D(uint32_t w, uint32_t h, LargeVector<uint32_t> cells, const CellRowFunction& rows);
+
+    Distribution2DView view() const noexcept {
+        return {start_.data(), guide_.data(), {marginal_start_.data(), marginal_guide_.data(), h_}, w_, h_,
+                static_cast<float>(uint64_t{w_} * h_) * 0x1p-62f};
+    }
+    Distribution2DView::Sample sample(Vec2 u) const noexcept { return view().sample(u); }
+    float pdf(Vec2 p) const noexcept { return view().pdf(p); }
+    Vec2 invert(Vec2 p) const noexcept { return view().invert(p); }
+
+    uint32_t width() const noexcept { return w_; }
+    uint32_t height() const noexcept { return h_; }
+    double integral() const noexcept { return integral_; }  // mean of the input func over [0,1)^2
+    bool uniform_fallback() const noexcept { return uniform_; }
+    size_t bytes() const noexcept {
+        return (start_.size() + marginal_start_.size()) * sizeof(uint32_t) +
+               (guide_.size() + marginal_guide_.size()) * sizeof(uint16_t);
+    }
+
+private:
+    LargeVector<uint32_t> start_, marginal_start_;
+    LargeVector<uint16_t> guide_, marginal_guide_;
+    uint32_t w_ = 0, h_ = 0;
+    double integral_ = 0;
+    bool uniform_ = false;
+};
+
+}  // namespace envmis

@@ -1,0 +1,90 @@
+// Table files: a built EnvMap saved to disk, readable with envmis::core alone.
+//
+// The format (version 3; versions 1 and 2 are read too) is specified in docs/table-format.md: a fixed preamble (magic,
+// version, byte order, total size), a metadata block with the build options and the
+// source's name and content hash, a header checksum, then the payload (the image
+// density q sin(theta) and the RGB radiance, both float32) and a payload checksum.
+// The sampling structures are derived data and are rebuilt on load by the same code
+// that built them, so a loaded table samples bit-identically to the saved one, and no
+// index read from a file can ever address memory.
+//
+// Writing goes to a temporary file in the destination's folder, renamed over the
+// destination only when complete: an interrupted run never leaves a partial table.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "envmis/sampling/envmap.h"
+
+namespace envmis {
+
+inline constexpr uint32_t kTableVersion = 3;
+
+// Where a table's map came from.
+struct TableSource {
+    std::string name;                 // file name of the source image (no folders)
+    uint64_t content_hash = 0;        // hash64 of the source file's bytes
+    std::string input_colorspace;     // colour space the pixels were read in
+    std::string working_colorspace;   // colour space of the stored radiance
+};
+
+struct Table {
+    EnvMap map;
+    TableSource source;
+    uint32_t version = 0;  // the file's format version
+    bool mapped = false;   // the map borrows its radiance from a mapping of the file
+};
+
+// A table file that cannot be read; what() names the file and the problem.
+class TableError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// How the payload is stored.
+//   full:    float32 density and RGB radiance, 16 bytes a texel; loads bit-identical to
+//            the map written.
+//   compact: radiance only, in RGBE (8-bit mantissas with a shared exponent, as in
+//            Radiance .hdr files), 4 bytes a texel; the density is rebuilt from it on
+//            load. The table holds the RGBE-rounded map (rgbe_round): channels within
+//            1/255 of the pixel's largest channel, the largest within 0.4% (values
+//            above 1.7e38 saturate); it loads bit-identical to
+//            EnvMap(rgbe_round(radiance), options). Lossless for .hdr sources.
+enum class TableEncoding { full, compact };
+
+// Writes atomically (temporary file, then rename). Throws TableError on I/O failure.
+void write_table(const std::filesystem::path& path, const EnvMap& map, const TableSource& source,
+                 TableEncoding encoding = TableEncoding::full);
+
+// The radiance a compact table stores: each pixel rounded to RGBE and back.
+RgbImage rgbe_round(RgbImageView image);
+
+// How read_table gets a full table's radiance (12 bytes a texel).
+//   map:  borrowed from a read-only mapping of the file (POSIX mmap), which the map keeps
+//         alive: no copy, pages shared with the page cache and with other processes
+//         mapping the same table. Compact and version 1-2 tables are copied out of the
+//         mapping into memory the map owns; without mmap, `map` reads as `copy` does.
+//         write_table replaces a file by renaming, which leaves a mapping of the old one
+//         intact; a program that truncates a mapped table in place makes the next
+//         access to it fault (SIGBUS): read such files with `copy`.
+//   copy: read into memory the map owns.
+// Either way the density is read into the buffer that becomes the CDF table.
+enum class TableLoading { map, copy };
+
+// Reads and verifies a table. Throws TableError if the file is missing, truncated,
+// corrupted (checksums), of another format, or of an unsupported version.
+Table read_table(const std::filesystem::path& path, TableLoading loading = TableLoading::map);
+
+// The same checks on bytes already in memory; `name` appears in error messages.
+Table parse_table(std::span<const std::byte> bytes, std::string_view name);
+
+// True if the file starts with the table magic (cheap; does not validate the rest).
+bool looks_like_table(const std::filesystem::path& path) noexcept;
+
+}  // namespace envmis

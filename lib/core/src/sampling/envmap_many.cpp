@@ -1,0 +1,353 @@
+// lookup_many and sample_many (envmap.h): EnvMapView::lookup and EnvMapView::sample
+// for many directions or random points, eight at a time with AVX2 where the CPU has it.
+//
+// The AVX2 paths repeat the scalar arithmetic operation for operation (equirect_uv,
+// fast_atan2, detail::cell_of, CdfView::width and invert, detail::point_in_cell,
+// Distribution2DView::pdf_of, sincos_turns, sincos_half_turns, solid_angle_pdf): the
+// same IEEE operations in the same order, no fused multiply-add, so every lane's result
+// is bit-identical to the scalar call (tests/envmap_test.cpp checks it on maps of
+// several sizes, at the poles, the seam and the last column). If one of those functions
+// changes, this file must change with it; the tests fail until it does. GCC 12's
+// auto-vectoriser does not vectorise the scalar loops in a target("avx2") function
+// (README, Performance), hence the intrinsics.
+#include "envmis/sampling/envmap.h"
+
+#include <algorithm>
+
+#include "detail/simd.h"
+
+namespace envmis {
+namespace {
+
+// Lanes first..n one at a time, in chunks whose texels are all prefetched before the
+// first is read, so that their cache misses overlap.
+void lookup_one_by_one(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t first,
+                       uint32_t n) noexcept {
+    constexpr uint32_t kChunk = 32;
+    Vec2 uv[kChunk];
+    for (uint32_t begin = first; begin < n; begin += kChunk) {
+        const uint32_t end = n - begin < kChunk ? n : begin + kChunk;
+        for (uint32_t l = begin; l < end; ++l) {
+            uv[l - begin] = env.uv_of({in.x[l], in.y[l], in.z[l]});
+            env.prefetch_uv(uv[l - begin]);
+        }
+        for (uint32_t l = begin; l < end; ++l) {
+            const Rgb c = env.eval_uv(uv[l - begin]);
+            out.r[l] = c.r, out.g[l] = c.g, out.b[l] = c.b, out.pdf[l] = env.pdf_uv(uv[l - begin]);
+        }
+    }
+}
+
+#ifdef ENVMIS_AVX2_BATCHES
+using namespace simd;
+
+// The SIMD path's preconditions: the equirectangular mapping in the default axes, and
+// 32-bit gather indices for the three floats of every texel.
+bool avx2_applies(const EnvMapView& env) noexcept {
+    return env.mapping == Mapping::equirect && env.axes.identity() &&
+           uint64_t{env.distribution.w} * env.distribution.h * 3 < (uint64_t{1} << 31);
+}
+
+// fast_atan2 (fast_math.h).
+ENVMIS_AVX2 F8 atan2_8(F8 y, F8 x) noexcept {
+    const F8 ax = abs8(x), ay = abs8(y);
+    const F8 swap = _mm256_cmp_ps(ay, ax, _CMP_GT_OQ);
+    const F8 n = select(swap, ax, ay), d = select(swap, ay, ax);
+    const F8 reduce = _mm256_cmp_ps(n, _mm256_mul_ps(splat(0.41421356237309515f), d), _CMP_GT_OQ);
+    const F8 num = select(reduce, _mm256_sub_ps(n, d), n), den = select(reduce, _mm256_add_ps(n, d), d);
+    const F8 r = select(_mm256_cmp_ps(den, splat(0.0f), _CMP_GT_OQ), _mm256_div_ps(num, den), splat(0.0f));
+    const F8 z = _mm256_mul_ps(r, r);
+    F8 p = _mm256_sub_ps(_mm256_mul_ps(splat(8.05374449538e-2f), z), splat(1.38776856032e-1f));
+    p = _mm256_add_ps(_mm256_mul_ps(p, z), splat(1.99777106478e-1f));
+    p = _mm256_sub_ps(_mm256_mul_ps(p, z), splat(3.33329491539e-1f));
+    F8 a = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(p, z), r), r);
+    a = _mm256_add_ps(a, select(reduce, splat(kPiF / 4), splat(0.0f)));
+    a = select(swap, _mm256_sub_ps(splat(kPiF / 2), a), a);
+    a = select(less(x, splat(0.0f)), _mm256_sub_ps(splat(kPiF), a), a);
+    return _mm256_or_ps(abs8(a), _mm256_and_ps(splat(-0.0f), y));  // copysign(a, y)
+}
+
+// detail::cell_of: the product in double, truncated, at most n - 1.
+ENVMIS_AVX2 I8 cell8(F8 x, uint32_t n) noexcept {
+    const F8 c = clamp8(x, 0.0f, 1.0f);
+    const __m256d dn = _mm256_set1_pd(static_cast<double>(n));
+    const __m128i lo = _mm256_cvttpd_epi32(_mm256_mul_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(c)), dn));
+    const __m128i hi = _mm256_cvttpd_epi32(_mm256_mul_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(c, 1)), dn));
+    return _mm256_min_epu32(_mm256_set_m128i(hi, lo), _mm256_set1_epi32(static_cast<int>(n - 1)));
+}
+
+ENVMIS_AVX2 I8 gather(const uint32_t* a, I8 i) noexcept {
+    return _mm256_i32gather_epi32(reinterpret_cast<const int*>(a), i, 4);
+}
+
+// CdfView::width of cell i of the CDF at `start`, n cells: the next start (kCdfUnits
+// after the last cell) minus this one.
+ENVMIS_AVX2 I8 width8(const uint32_t* start, I8 base, I8 i, uint32_t n) noexcept {
+    const I8 last = _mm256_cmpeq_epi32(i, _mm256_set1_epi32(static_cast<int>(n - 1)));
+    const I8 at = _mm256_add_epi32(base, i);
+    const I8 next = gather(start, _mm256_sub_epi32(at, _mm256_andnot_si256(last, _mm256_set1_epi32(-1))));
+    const I8 end = _mm256_blendv_epi8(next, _mm256_set1_epi32(static_cast<int>(kCdfUnits)), last);
+    return _mm256_sub_epi32(end, gather(start, at));
+}
+
+// Widths to float, as static_cast<float>(uint32_t): a width is at most 2^31, which as a
+// signed 32-bit value is -2^31 and converts exactly; adding 2^32 then gives 2^31.
+ENVMIS_AVX2 F8 width_to_float(I8 w) noexcept {
+    const F8 f = _mm256_cvtepi32_ps(w);
+    return _mm256_add_ps(f, select(less(f, splat(0.0f)), splat(0x1p32f), splat(0.0f)));
+}
+
+// detail::sincos_steps (fast_math.h): sin and cos of 2 pi x / kTurnSteps.
+struct SinCos8 {
+    F8 sin, cos;
+};
+ENVMIS_AVX2 SinCos8 sincos_steps8(const SinCos* turns, F8 x) noexcept {
+    constexpr float kRound = 0x1.8p23f;
+    constexpr float c = 2 * kPiF / kTurnSteps;
+    const F8 rounded = _mm256_add_ps(x, splat(kRound));
+    const F8 f = _mm256_sub_ps(x, _mm256_sub_ps(rounded, splat(kRound))), f2 = _mm256_mul_ps(f, f);
+    const F8 sin_d = _mm256_sub_ps(_mm256_mul_ps(splat(c), f), _mm256_mul_ps(f2, _mm256_mul_ps(splat(c * c * c / 6), f)));
+    const F8 cos_d = _mm256_sub_ps(splat(1.0f), _mm256_mul_ps(splat(c * c / 2), f2));
+    const I8 k = _mm256_slli_epi32(_mm256_and_si256(_mm256_castps_si256(rounded), _mm256_set1_epi32(kTurnSteps - 1)), 1);
+    const F8 s = _mm256_i32gather_ps(&turns->sin, k, 4), co = _mm256_i32gather_ps(&turns->sin + 1, k, 4);
+    return {_mm256_add_ps(_mm256_mul_ps(s, cos_d), _mm256_mul_ps(co, sin_d)),
+            _mm256_sub_ps(_mm256_mul_ps(co, cos_d), _mm256_mul_ps(s, sin_d))};
+}
+// sincos_turns and sincos_half_turns.
+ENVMIS_AVX2 SinCos8 sincos_turns8(const SinCos* turns, F8 t) noexcept {
+    return sincos_steps8(turns, _mm256_mul_ps(t, splat(static_cast<float>(kTurnSteps))));
+}
+ENVMIS_AVX2 SinCos8 sincos_half_turns8(const SinCos* turns, F8 t) noexcept {
+    return sincos_steps8(turns, _mm256_mul_ps(t, splat(static_cast<float>(kTurnSteps / 2))));
+}
+
+// EnvMapView::solid_angle_pdf of the density of cell (x, y), row = y w, from its row's
+// and its own widths (Distribution2DView::pdf_of).
+ENVMIS_AVX2 F8 solid_angle_pdf8(const Distribution2DView& d, I8 x, I8 y, I8 row, F8 sin_theta) noexcept {
+    const I8 row_width = width8(d.marginal.start, _mm256_setzero_si256(), y, d.h);
+    const I8 cell_width = width8(d.start, row, x, d.w);
+    const F8 image_pdf = _mm256_mul_ps(_mm256_mul_ps(width_to_float(row_width), width_to_float(cell_width)),
+                                       splat(d.pdf_scale));
+    const F8 pdf = _mm256_div_ps(image_pdf, _mm256_mul_ps(splat(kTwoPiSquared), sin_theta));
+    return select(_mm256_cmp_ps(sin_theta, splat(0.0f), _CMP_GT_OQ), pdf, splat(0.0f));
+}
+
+// The radiance of eight texels (row-major indices), stored from lane l on.
+ENVMIS_AVX2 void store_radiance8(const Rgb* radiance, I8 texel, float* r, float* g, float* b, uint32_t l) noexcept {
+    const I8 three = _mm256_add_epi32(texel, _mm256_add_epi32(texel, texel));
+    const float* rgb = &radiance->r;
+    _mm256_storeu_ps(r + l, _mm256_i32gather_ps(rgb, three, 4));
+    _mm256_storeu_ps(g + l, _mm256_i32gather_ps(rgb + 1, three, 4));
+    _mm256_storeu_ps(b + l, _mm256_i32gather_ps(rgb + 2, three, 4));
+}
+
+// Where eight directions fall: their cells, the first texel of their rows (y w) and
+// the image v (for sin theta).
+struct Cells8 {
+    I8 x, y, row;
+    F8 v;
+};
+
+// equirect_uv (mapping.h) and the cells of eval_uv and pdf_uv (envmap.h), for the
+// eight directions from lane l on; starts loading each texel's radiance and CDF entry.
+ENVMIS_AVX2 Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l) noexcept {
+    constexpr float kInvPi = static_cast<float>(1 / kPi);
+    const F8 z = clamp8(_mm256_loadu_ps(in.z + l), -1.0f, 1.0f);
+    const F8 s2 = _mm256_mul_ps(_mm256_sub_ps(splat(1.0f), z), _mm256_add_ps(splat(1.0f), z));
+    const F8 sin_theta = _mm256_sqrt_ps(select(less(splat(0.0f), s2), s2, splat(0.0f)));
+    const F8 theta = atan2_8(sin_theta, z);
+    const F8 phi = atan2_8(_mm256_loadu_ps(in.y + l), _mm256_loadu_ps(in.x + l));
+    const F8 turn = select(less(phi, splat(0.0f)), _mm256_add_ps(phi, splat(2 * kPiF)), phi);
+    const F8 u = clamp8(_mm256_mul_ps(splat(0.5f * kInvPi), turn), 0.0f, kOneMinusEpsilon);
+    const F8 v = clamp8(_mm256_mul_ps(theta, splat(kInvPi)), 0.0f, kOneMinusEpsilon);
+    const I8 x = cell8(u, env.distribution.w), y = cell8(v, env.distribution.h);
+    const Cells8 c{x, y, _mm256_mullo_epi32(y, _mm256_set1_epi32(static_cast<int>(env.distribution.w))), v};
+    alignas(32) uint32_t texel[8];
+    _mm256_store_si256(reinterpret_cast<I8*>(texel), _mm256_add_epi32(c.row, c.x));
+    for (const uint32_t i : texel) {
+        ENVMIS_PREFETCH(env.radiance + i);
+        ENVMIS_PREFETCH(env.distribution.start + i);
+    }
+    return c;
+}
+
+// Radiance and solid-angle pdf at eight located directions, stored from lane l on.
+ENVMIS_AVX2 void fetch8(const EnvMapView& env, const Cells8& c, LookupArrays out, uint32_t l) noexcept {
+    store_radiance8(env.radiance, _mm256_add_epi32(c.row, c.x), out.r, out.g, out.b, l);
+    const F8 sin_theta = sincos_half_turns8(env.turns, c.v).sin;
+    _mm256_storeu_ps(out.pdf + l, solid_angle_pdf8(env.distribution, c.x, c.y, c.row, sin_theta));
+}
+
+// Lanes [0, n - n % 8) in groups of eight, up to four groups at a time: start(first)
+// for each of them (it finds what its group will read, prefetches it and returns where
+// it is), then finish(started, first) for each, so that the cache misses of all four
+// overlap. Without the staging, three quarters of lookup_avx2's time went waiting on
+// its first radiance gather. Returns n - n % 8.
+template <class Start, class Finish>
+ENVMIS_AVX2 uint32_t in_staged_groups(uint32_t n, Start&& start, Finish&& finish) noexcept {
+    constexpr uint32_t kGroups = 4;
+    const uint32_t whole = n - n % 8;
+    for (uint32_t first = 0; first < whole; first += 8 * kGroups) {
+        const uint32_t groups = std::min(kGroups, (whole - first) / 8);
+        decltype(start(first)) started[kGroups];
+        for (uint32_t k = 0; k < groups; ++k) started[k] = start(first + 8 * k);
+        for (uint32_t k = 0; k < groups; ++k) finish(started[k], first + 8 * k);
+    }
+    return whole;
+}
+
+ENVMIS_AVX2 uint32_t lookup_avx2(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
+    return in_staged_groups(
+        n, [&](uint32_t first) ENVMIS_AVX2 { return locate8(env, in, first); },
+        [&](const Cells8& cells, uint32_t first) ENVMIS_AVX2 { fetch8(env, cells, out, first); });
+}
+
+// Eight units u of CdfView::invert over n cells: u in CDF units (x), its integer part t
+// and its guide bucket k = t n / 2^31 (from 64-bit products of the even and odd lanes).
+struct Unit8 {
+    F8 x;
+    I8 t, k;
+};
+ENVMIS_AVX2 Unit8 unit8(F8 u, uint32_t n) noexcept {
+    const F8 x = _mm256_mul_ps(u, splat(static_cast<float>(kCdfUnits)));
+    const I8 t = _mm256_cvttps_epi32(x);  // x < 2^31
+    const I8 nn = _mm256_set1_epi32(static_cast<int>(n));
+    const I8 even = _mm256_srli_epi64(_mm256_mul_epu32(t, nn), 31);
+    const I8 odd = _mm256_slli_epi64(_mm256_srli_epi64(_mm256_mul_epu32(_mm256_srli_epi64(t, 32), nn), 31), 32);
+    return {x, t, _mm256_min_epu32(_mm256_blend_epi32(even, odd, 0xAA), _mm256_set1_epi32(static_cast<int>(n - 1)))};
+}
+
+// The rest of CdfView::invert for eight units, lane i searching the CDF of n >= 2 cells
+// at start + base_i (guide likewise): the cell index and the offset in it.
+struct Hit8 {
+    I8 index;
+    F8 offset;
+};
+ENVMIS_AVX2 Hit8 search8(const uint32_t* start, const uint16_t* guide, I8 base, uint32_t n, const Unit8& unit) noexcept {
+    const F8 x = unit.x;
+    const I8 t = unit.t, k = unit.k, last = _mm256_set1_epi32(static_cast<int>(n - 1));
+    // guide[k] and guide[k + 1] (or n - 1 after the last bucket) from one 32-bit gather of
+    // the pair at j = min(k, n - 2), which stays inside the guide's n entries.
+    const I8 j = _mm256_min_epu32(k, _mm256_set1_epi32(static_cast<int>(n - 2)));
+    const I8 pair = _mm256_i32gather_epi32(reinterpret_cast<const int*>(guide), _mm256_add_epi32(base, j), 2);
+    const I8 inside = _mm256_cmpeq_epi32(k, j), low = _mm256_and_si256(pair, _mm256_set1_epi32(0xffff));
+    const I8 high = _mm256_srli_epi32(pair, 16);
+    I8 lo = _mm256_blendv_epi8(high, low, inside), hi = _mm256_blendv_epi8(last, high, inside);
+    // The scalar search, all lanes in step: a lane whose lo = hi keeps them (mid = lo,
+    // whose start is <= t), so the loop runs until the longest search ends.
+    const I8 one = _mm256_set1_epi32(1);
+    for (;;) {
+        const I8 open = _mm256_cmpgt_epi32(hi, lo);
+        if (_mm256_testz_si256(open, open)) break;
+        const I8 mid = _mm256_srli_epi32(_mm256_add_epi32(_mm256_add_epi32(lo, hi), one), 1);
+        const I8 s = gather(start, _mm256_add_epi32(base, mid));
+        const I8 at_most_t = _mm256_cmpeq_epi32(_mm256_max_epu32(s, t), t);  // unsigned s <= t
+        lo = _mm256_blendv_epi8(lo, mid, at_most_t);
+        hi = _mm256_blendv_epi8(_mm256_sub_epi32(mid, one), hi, at_most_t);
+    }
+    const I8 before = _mm256_sub_epi32(t, gather(start, _mm256_add_epi32(base, lo)));  // < 2^31
+    const F8 offset = _mm256_div_ps(_mm256_add_ps(_mm256_cvtepi32_ps(before), _mm256_sub_ps(x, _mm256_cvtepi32_ps(t))),
+                                    width_to_float(width8(start, base, lo, n)));
+    return {lo, select(less(splat(kOneMinusEpsilon), offset), splat(kOneMinusEpsilon), offset)};
+}
+
+// (index + offset) / n in double, rounded to float, for four lanes.
+ENVMIS_AVX2 __m128 quotient4(__m128i index, __m128 offset, uint32_t n) noexcept {
+    const __m256d sum = _mm256_add_pd(_mm256_cvtepi32_pd(index), _mm256_cvtps_pd(offset));
+    return _mm256_cvtpd_ps(_mm256_div_pd(sum, _mm256_set1_pd(static_cast<double>(n))));
+}
+
+// detail::point_in_cell, both of its cases.
+ENVMIS_AVX2 F8 point_in_cell8(I8 index, F8 offset, uint32_t n) noexcept {
+    const F8 i = _mm256_cvtepi32_ps(index);
+    if ((n & (n - 1)) == 0) {
+        const F8 inv_n = splat(1.0f / static_cast<float>(n));
+        const F8 x = _mm256_add_ps(_mm256_mul_ps(i, inv_n), _mm256_mul_ps(offset, inv_n));
+        const F8 next_edge = _mm256_mul_ps(_mm256_add_ps(i, splat(1.0f)), inv_n);
+        const F8 below = _mm256_castsi256_ps(_mm256_sub_epi32(_mm256_castps_si256(next_edge), _mm256_set1_epi32(1)));
+        return select(less(x, next_edge), x, below);
+    }
+    const F8 x = _mm256_set_m128(quotient4(_mm256_extracti128_si256(index, 1), _mm256_extractf128_ps(offset, 1), n),
+                                 quotient4(_mm256_castsi256_si128(index), _mm256_castps256_ps128(offset), n));
+    // One float step towards the cell where rounding left it (x > 0 in the first case,
+    // x < 1 in the second, so the step is an increment of its bits).
+    const I8 c = cell8(x, n);
+    const I8 step = _mm256_sub_epi32(_mm256_cmpgt_epi32(index, c), _mm256_cmpgt_epi32(c, index));
+    return clamp8(_mm256_castsi256_ps(_mm256_sub_epi32(_mm256_castps_si256(x), step)), 0.0f, kOneMinusEpsilon);
+}
+
+// Eight points of EnvMapView::sample with their rows found (the marginal is small and
+// stays in cache) and their columns' guide bucket.
+struct Rows8 {
+    Hit8 r;
+    I8 row;  // r.index w: the row's first cell
+    Unit8 column;
+};
+
+// The rows of the eight points from lane l on; starts loading what the column search
+// reads first (the guide entry and CDF around the bucket) and the radiance near it.
+ENVMIS_AVX2 Rows8 rows8(const EnvMapView& env, PointArrays in, uint32_t l) noexcept {
+    const Distribution2DView& d = env.distribution;
+    const I8 zero = _mm256_setzero_si256();
+    const Hit8 r = search8(d.marginal.start, d.marginal.guide, zero, d.h, unit8(_mm256_loadu_ps(in.y + l), d.h));
+    const Rows8 rows{r, _mm256_mullo_epi32(r.index, _mm256_set1_epi32(static_cast<int>(d.w))),
+                     unit8(_mm256_loadu_ps(in.x + l), d.w)};
+    alignas(32) uint32_t near[8];
+    _mm256_store_si256(reinterpret_cast<I8*>(near), _mm256_add_epi32(rows.row, rows.column.k));
+    for (const uint32_t i : near) {
+        ENVMIS_PREFETCH(d.guide + i);
+        ENVMIS_PREFETCH(d.start + i);
+        ENVMIS_PREFETCH(env.radiance + i);
+    }
+    return rows;
+}
+
+// EnvMapView::sample for the eight points from lane l on, their rows found.
+ENVMIS_AVX2 void sample8(const EnvMapView& env, const Rows8& rows, SampleArrays out, uint32_t l) noexcept {
+    const Distribution2DView& d = env.distribution;
+    const Hit8& r = rows.r;
+    const I8 row = rows.row;
+    const Hit8 c = search8(d.start, d.guide, row, d.w, rows.column);
+    const SinCos8 theta = sincos_half_turns8(env.turns, point_in_cell8(r.index, r.offset, d.h));
+    const SinCos8 phi = sincos_turns8(env.turns, point_in_cell8(c.index, c.offset, d.w));
+    _mm256_storeu_ps(out.x + l, _mm256_mul_ps(theta.sin, phi.cos));
+    _mm256_storeu_ps(out.y + l, _mm256_mul_ps(theta.sin, phi.sin));
+    _mm256_storeu_ps(out.z + l, theta.cos);
+    _mm256_storeu_ps(out.pdf + l, solid_angle_pdf8(d, c.index, r.index, row, theta.sin));
+    store_radiance8(env.radiance, _mm256_add_epi32(row, c.index), out.r, out.g, out.b, l);
+}
+
+// Rows found and columns' data prefetched for up to four groups before the first
+// group's column search.
+ENVMIS_AVX2 uint32_t sample_avx2(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t n) noexcept {
+    return in_staged_groups(
+        n, [&](uint32_t first) ENVMIS_AVX2 { return rows8(env, in, first); },
+        [&](const Rows8& rows, uint32_t first) ENVMIS_AVX2 { sample8(env, rows, out, first); });
+}
+#endif
+
+}  // namespace
+
+void lookup_many(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
+    uint32_t done = 0;
+#ifdef ENVMIS_AVX2_BATCHES
+    if (avx2_applies(env) && simd::avx2_available()) done = lookup_avx2(env, in, out, n);
+#endif
+    lookup_one_by_one(env, in, out, done, n);
+}
+
+void sample_many(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t n) noexcept {
+    uint32_t done = 0;
+#ifdef ENVMIS_AVX2_BATCHES
+    // The guide pairs of search8 need two cells in each dimension.
+    if (avx2_applies(env) && env.distribution.w > 1 && env.distribution.h > 1 && simd::avx2_available())
+        done = sample_avx2(env, in, out, n);
+#endif
+    for (uint32_t l = done; l < n; ++l) {
+        const EnvSample e = env.sample({in.x[l], in.y[l]});
+        out.x[l] = e.direction.x, out.y[l] = e.direction.y, out.z[l] = e.direction.z, out.pdf[l] = e.pdf;
+        out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b;
+    }
+}
+
+}  // namespace envmis

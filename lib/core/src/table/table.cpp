@@ -1,0 +1,487 @@
+#include "envmis/table/table.h"
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <optional>
+#include <vector>
+
+#include "envmis/table/atomic_file.h"
+#include "envmis/math/hash.h"
+#include "detail/mapped_file.h"
+#include "detail/parallel.h"
+
+namespace envmis {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "table files are little-endian; port the I/O first");
+
+constexpr std::byte kMagic[8] = {std::byte{0x89}, std::byte{'E'}, std::byte{'N'}, std::byte{'V'},
+                                 std::byte{'M'},  std::byte{'I'}, std::byte{'S'}, std::byte{0x1A}};
+constexpr uint32_t kByteOrderMark = 0x01020304;
+constexpr size_t kPreambleSize = 32;
+constexpr uint32_t kMaxMetadataSize = 64 * 1024;
+constexpr uint32_t kMaxStringSize = 4096;
+constexpr uint64_t kMaxTexels = uint64_t{1} << 31;
+constexpr uint32_t kSamplerCdf = 1;
+constexpr uint32_t kFlagCompensation = 1;
+constexpr uint32_t kFlagCompact = 2;  // payload: RGBE radiance only (TableEncoding::compact)
+// Version 3 pads the metadata block with zeros to a multiple of this, so that the payload's
+// arrays are aligned in the file and a mapping of it can be used in place.
+constexpr uint32_t kMetadataAlignment = 8;
+
+// RGBE (Ward 1991): three 8-bit mantissas sharing the exponent of the largest channel,
+// rounded to nearest. Byte 3 is the exponent + 128; 0 means black.
+// 2^k as a double, for |k| < 1023, from its bits (no libm call on the per-texel path).
+double power_of_two(int k) noexcept { return std::bit_cast<double>(static_cast<uint64_t>(k + 1023) << 52); }
+
+uint32_t rgbe_encode(Rgb c) noexcept {
+    const float m = std::max({c.r, c.g, c.b});
+    if (!(m >= 1e-38f)) return 0;
+    // m = f 2^e with f in [0.5, 1) (m is a normal float): the largest mantissa is 128..255.
+    int e = static_cast<int>((std::bit_cast<uint32_t>(m) >> 23) & 0xff) - 126;
+    if (m * power_of_two(8 - e) + 0.5 >= 256) ++e;  // rounds up to 256: one more bit of exponent
+    e = std::min(e, 127);  // above 2^127 (1.7e38) the largest channel saturates at 255 2^119
+    const double scale = power_of_two(8 - e);
+    const auto byte = [&](float v) { return static_cast<uint32_t>(std::min(v * scale + 0.5, 255.0)); };
+    return byte(c.r) | byte(c.g) << 8 | byte(c.b) << 16 | static_cast<uint32_t>(e + 128) << 24;
+}
+
+Rgb rgbe_decode(uint32_t v) noexcept {
+    const int e = static_cast<int>(v >> 24);
+    if (e == 0) return {};
+    const double scale = power_of_two(e - 128 - 8);
+    const auto channel = [&](int shift) { return static_cast<float>(static_cast<double>((v >> shift) & 0xff) * scale); };
+    return {channel(0), channel(8), channel(16)};
+}
+
+class ByteWriter {
+public:
+    template <class T>
+    void put(const T& v) {
+        const auto* p = reinterpret_cast<const std::byte*>(&v);
+        bytes.insert(bytes.end(), p, p + sizeof(T));
+    }
+    void put_string(const std::string& s) {
+        put(static_cast<uint32_t>(s.size()));
+        const auto* p = reinterpret_cast<const std::byte*>(s.data());
+        bytes.insert(bytes.end(), p, p + s.size());
+    }
+    std::vector<std::byte> bytes;
+};
+
+// Reads fields from a byte span; every read is checked against what is left.
+class Cursor {
+public:
+    Cursor(std::span<const std::byte> bytes, std::string_view name) : bytes_(bytes), name_(name) {}
+
+    [[noreturn]] void fail(const std::string& problem) const {
+        throw TableError(std::string(name_) + ": " + problem);
+    }
+    void need(uint64_t size, const char* what) const {
+        if (size > bytes_.size() - pos_)
+            fail(std::string("truncated: ") + what + " needs " + std::to_string(size) + " bytes, " +
+                 std::to_string(bytes_.size() - pos_) + " left");
+    }
+    template <class T>
+    T take(const char* what) {
+        need(sizeof(T), what);
+        T v;
+        std::memcpy(&v, bytes_.data() + pos_, sizeof(T));
+        pos_ += sizeof(T);
+        return v;
+    }
+    std::span<const std::byte> take_bytes(uint64_t size, const char* what) {
+        need(size, what);
+        auto s = bytes_.subspan(pos_, static_cast<size_t>(size));
+        pos_ += static_cast<size_t>(size);
+        return s;
+    }
+    std::string take_string(const char* what) {
+        const auto size = take<uint32_t>(what);
+        if (size > kMaxStringSize)
+            fail(std::string(what) + " is " + std::to_string(size) + " bytes, above the limit of " +
+                 std::to_string(kMaxStringSize));
+        const auto s = take_bytes(size, what);
+        return {reinterpret_cast<const char*>(s.data()), s.size()};
+    }
+    size_t position() const noexcept { return pos_; }
+
+private:
+    std::span<const std::byte> bytes_;
+    std::string_view name_;
+    size_t pos_ = 0;
+};
+
+std::vector<std::byte> metadata_block(const EnvMap& map, const EnvMapStats& s, const TableSource& source,
+                                      TableEncoding encoding) {
+    const EnvMapOptions& o = map.options();
+    ByteWriter w;
+    w.put(map.width());
+    w.put(map.height());
+    w.put(kSamplerCdf);
+    w.put((o.compensation.enabled ? kFlagCompensation : 0u) | (encoding == TableEncoding::compact ? kFlagCompact : 0u));
+    w.put(o.compensation.alpha);
+    w.put(o.luma);
+    w.put(o.axes);
+    w.put(static_cast<uint8_t>(o.mapping));
+    w.put(s.mean_luminance);
+    w.put(s.threshold);
+    w.put(s.max_luminance);
+    w.put(s.min_positive_luminance);
+    w.put(s.zeroed_texels);
+    w.put(static_cast<uint32_t>(s.fallback));
+    w.put(s.bad_pixels.nan);
+    w.put(s.bad_pixels.infinite);
+    w.put(s.bad_pixels.negative);
+    w.put(source.content_hash);
+    w.put_string(source.name);
+    w.put_string(source.input_colorspace);
+    w.put_string(source.working_colorspace);
+    w.bytes.resize((w.bytes.size() + kMetadataAlignment - 1) / kMetadataAlignment * kMetadataAlignment);
+    return std::move(w.bytes);
+}
+
+template <class T>
+std::span<const std::byte> as_bytes_of(std::span<const T> v) {
+    return std::as_bytes(v);
+}
+
+std::string describe_errno(const std::filesystem::path& path, const char* action) {
+    return path.string() + ": cannot " + action + ": " + std::strerror(errno);
+}
+
+}  // namespace
+
+namespace {
+
+// Writes the preamble, `metadata`, the header checksum, the payload of `payload_size`
+// bytes that for_each_chunk(use) hands to `use` in order (it is called twice: for the
+// payload checksum, then to write), and the payload checksum; atomically.
+template <class ForEachChunk>
+void write_file(const std::filesystem::path& path, const std::vector<std::byte>& metadata, uint64_t payload_size,
+                ForEachChunk&& for_each_chunk) {
+    ByteWriter head;
+    for (std::byte b : kMagic) head.put(b);
+    head.put(kTableVersion);
+    head.put(kByteOrderMark);
+    head.put(uint64_t{kPreambleSize + metadata.size() + 8 + payload_size + 8});
+    head.put(static_cast<uint32_t>(metadata.size()));
+    head.put(uint32_t{0});
+    head.bytes.insert(head.bytes.end(), metadata.begin(), metadata.end());
+    head.put(hash64(head.bytes));
+
+    Hasher payload_hash;
+    for_each_chunk([&](std::span<const std::byte> bytes) { payload_hash.update(bytes); });
+    const uint64_t payload_digest = payload_hash.digest();
+    try {
+        write_file_atomically(path, [&](std::ostream& out) {
+            auto write = [&](std::span<const std::byte> bytes) {
+                out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+            };
+            write(head.bytes);
+            for_each_chunk(write);
+            write(std::as_bytes(std::span(&payload_digest, 1)));
+        });
+    } catch (const std::runtime_error& e) {
+        throw TableError(e.what());
+    }
+}
+
+}  // namespace
+
+RgbImage rgbe_round(RgbImageView image) {
+    RgbImage out = to_image(image);
+    detail::parallel_for(out.height, 16, [&](uint32_t lo, uint32_t hi) {
+        for (size_t i = size_t{lo} * out.width; i < size_t{hi} * out.width; ++i) {
+            BadPixels ignored;
+            sanitize_pixel(out.pixels[i], ignored);
+            out.pixels[i] = rgbe_decode(rgbe_encode(out.pixels[i]));
+        }
+    });
+    return out;
+}
+
+void write_table(const std::filesystem::path& path, const EnvMap& map, const TableSource& source,
+                 TableEncoding encoding) {
+    for (const std::string* s : {&source.name, &source.input_colorspace, &source.working_colorspace})
+        if (s->size() > kMaxStringSize)
+            throw TableError(path.string() + ": metadata string longer than " + std::to_string(kMaxStringSize) + " bytes");
+    const auto& radiance = map.radiance().pixels;
+    if (encoding == TableEncoding::compact) {
+        // The table holds the rounded map: its statistics (Lbar, threshold) are the
+        // rounded map's, which the reader's rebuild reproduces exactly; the bad-pixel
+        // counts are the source's.
+        const EnvMap rounded(rgbe_round(map.radiance()), map.options());
+        EnvMapStats stats = rounded.stats();
+        stats.bad_pixels = map.stats().bad_pixels;
+        std::vector<uint32_t> rgbe(radiance.size());
+        const uint32_t w = map.width();
+        detail::parallel_for(map.height(), 16, [&](uint32_t lo, uint32_t hi) {
+            for (size_t i = size_t{lo} * w; i < size_t{hi} * w; ++i) rgbe[i] = rgbe_encode(radiance[i]);
+        });
+        write_file(path, metadata_block(map, stats, source, encoding), rgbe.size() * sizeof(uint32_t),
+                   [&](auto&& use) { use(as_bytes_of<uint32_t>(rgbe)); });
+        return;
+    }
+    // The density is computed a row at a time, twice (for the checksum, then to write):
+    // cheaper than holding a copy of the map's size.
+    std::vector<float> row(map.width());
+    write_file(path, metadata_block(map, map.stats(), source, encoding), radiance.size() * (sizeof(float) + sizeof(Rgb)),
+               [&](auto&& use) {
+                   for (uint32_t y = 0; y < map.height(); ++y) {
+                       map.density_row(y, row);
+                       use(as_bytes_of<float>(row));
+                   }
+                   use(as_bytes_of<Rgb>(radiance));
+               });
+}
+
+namespace {
+
+// What the header (preamble, metadata, header checksum) says; the payload follows.
+struct Header {
+    uint32_t w = 0, h = 0;
+    EnvMapOptions options;
+    EnvMapStats stats;
+    TableSource source;
+    bool compact = false;  // payload: RGBE radiance only
+    uint32_t version = 0;
+    uint64_t payload_offset = 0;
+};
+
+// Parses and checks the header from `head`, the first bytes of a file of `file_size`
+// bytes (all of it, or at least the preamble, metadata and header checksum).
+Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::string_view name) {
+    Cursor in(head, name);
+    if (head.size() < sizeof kMagic || std::memcmp(head.data(), kMagic, sizeof kMagic) != 0)
+        in.fail("not an envmis table (bad magic)");
+    in.take_bytes(sizeof kMagic, "magic");
+    const auto version = in.take<uint32_t>("version");
+    const auto order = in.take<uint32_t>("byte-order mark");
+    if (order == 0x04030201) in.fail("table was written on a big-endian machine; this build reads little-endian");
+    if (order != kByteOrderMark) in.fail("corrupted byte-order mark");
+    if (version > kTableVersion)
+        in.fail("format version " + std::to_string(version) + " is newer than this envmis reads (version " +
+                std::to_string(kTableVersion) + "); upgrade envmis");
+    if (version == 0) in.fail("unknown format version 0");
+    const auto total = in.take<uint64_t>("file size");
+    if (total != file_size)
+        in.fail(total > file_size ? "truncated: header says " + std::to_string(total) + " bytes, file has " +
+                                        std::to_string(file_size)
+                                  : "header says " + std::to_string(total) + " bytes, file has " +
+                                        std::to_string(file_size) + " (trailing data)");
+    const auto metadata_size = in.take<uint32_t>("metadata size");
+    in.take<uint32_t>("reserved");
+    if (metadata_size > kMaxMetadataSize) in.fail("metadata block of " + std::to_string(metadata_size) + " bytes is too large");
+    in.need(uint64_t{metadata_size} + 8, "metadata and header checksum");
+    const uint64_t header_digest = hash64(head.first(kPreambleSize + metadata_size));
+
+    Header out;
+    out.version = version;
+    Cursor meta(head.subspan(kPreambleSize, metadata_size), name);
+    out.w = meta.take<uint32_t>("width");
+    out.h = meta.take<uint32_t>("height");
+    const auto sampler = meta.take<uint32_t>("sampler kind");
+    const auto flags = meta.take<uint32_t>("flags");
+    EnvMapOptions& options = out.options;
+    options.compensation.enabled = flags & kFlagCompensation;
+    out.compact = flags & kFlagCompact;
+    options.compensation.alpha = meta.take<float>("alpha");
+    options.luma = meta.take<LumaCoefficients>("luma coefficients");
+    options.axes = meta.take<Axes>("axes");
+    // Version 1 had a reserved 0 here: every version 1 table is equirectangular.
+    const auto mapping = meta.take<uint8_t>("mapping");
+    EnvMapStats& stats = out.stats;
+    stats.mean_luminance = meta.take<double>("mean luminance");
+    stats.threshold = meta.take<float>("threshold");
+    stats.max_luminance = meta.take<float>("max luminance");
+    stats.min_positive_luminance = meta.take<float>("min luminance");
+    stats.zeroed_texels = meta.take<uint64_t>("zeroed texels");
+    const auto fallback = meta.take<uint32_t>("fallback");
+    stats.bad_pixels.nan = meta.take<uint64_t>("NaN count");
+    stats.bad_pixels.infinite = meta.take<uint64_t>("Inf count");
+    stats.bad_pixels.negative = meta.take<uint64_t>("negative count");
+    TableSource& source = out.source;
+    source.content_hash = meta.take<uint64_t>("source hash");
+    source.name = meta.take_string("source name");
+    source.input_colorspace = meta.take_string("input colour space");
+    source.working_colorspace = meta.take_string("working colour space");
+
+    in.take_bytes(metadata_size, "metadata");
+    if (in.take<uint64_t>("header checksum") != header_digest) in.fail("corrupted header (checksum mismatch)");
+    // Version 3 pads the block to a multiple of kMetadataAlignment with zeros; older
+    // versions have no padding.
+    const std::span<const std::byte> rest = head.subspan(kPreambleSize + meta.position(), metadata_size - meta.position());
+    const bool padded = version >= 3 && metadata_size % kMetadataAlignment == 0 && rest.size() < kMetadataAlignment &&
+                        std::all_of(rest.begin(), rest.end(), [](std::byte b) { return b == std::byte{0}; });
+    if (!rest.empty() && !padded) in.fail("metadata block has " + std::to_string(rest.size()) + " unexpected bytes");
+    const uint32_t w = out.w, h = out.h;
+    if (w == 0 || h == 0 || w > kMaxCells1D || h > kMaxCells1D || uint64_t{w} * h > kMaxTexels)
+        in.fail("invalid size " + std::to_string(w) + "x" + std::to_string(h));
+    if (sampler != kSamplerCdf) in.fail("unknown sampler kind " + std::to_string(sampler));
+    if (flags & ~(kFlagCompensation | kFlagCompact)) in.fail("unknown flags " + std::to_string(flags));
+    if (version == 1 ? mapping != 0 : mapping != 1 && mapping != 2)
+        in.fail("unknown mapping " + std::to_string(mapping));
+    options.mapping = mapping == 2 ? Mapping::equal_area : Mapping::equirect;
+    if (options.mapping == Mapping::equal_area && w != h)
+        in.fail("equal-area table of size " + std::to_string(w) + "x" + std::to_string(h) + " is not square");
+    if (fallback > static_cast<uint32_t>(DensityFallback::uniform)) in.fail("unknown fallback " + std::to_string(fallback));
+    stats.fallback = static_cast<DensityFallback>(fallback);
+
+    // The payload's size, checked against the file before anything is allocated for it.
+    out.payload_offset = in.position();
+    const uint64_t texels = uint64_t{w} * h;
+    const uint64_t payload = texels * (out.compact ? sizeof(uint32_t) : sizeof(float) + sizeof(Rgb)) + 8;
+    const uint64_t left = file_size - out.payload_offset;
+    if (payload > left)
+        in.fail("truncated: payload needs " + std::to_string(payload) + " bytes, " + std::to_string(left) + " left");
+    if (payload < left)
+        in.fail(std::to_string(left - payload) + " bytes of trailing data after the payload");
+    return out;
+}
+
+[[noreturn]] void fail(std::string_view name, const std::string& problem) {
+    throw TableError(std::string(name) + ": " + problem);
+}
+
+// The table of the map that `build` makes, its errors reported as the file's.
+template <class Build>
+Table checked_table(std::string_view name, uint32_t version, TableSource source, Build&& build) {
+    try {
+        return {build(), std::move(source), version};
+    } catch (const std::invalid_argument& e) {
+        fail(name, std::string("inconsistent contents: ") + e.what());
+    }
+}
+
+// Reads the payload with `read(destination, bytes)` (in file order) straight into the
+// buffers the map keeps: the density's bits become the CDF table, the radiance the
+// image; nothing else of the payload's size is held. Then checks its checksum. A
+// compact payload's RGBE words are decoded into the radiance, and their buffer then
+// takes the density rebuilt from it.
+template <class Read>
+Table read_payload(Header header, Read&& read, std::string_view name) {
+    const uint64_t texels = uint64_t{header.w} * header.h;
+    LargeVector<uint32_t> density(texels);
+    RgbImage radiance{header.w, header.h, std::vector<Rgb>(texels)};
+    uint64_t digest = 0;
+    Hasher payload_hash;
+    read(density.data(), texels * sizeof(uint32_t));
+    payload_hash.update(std::as_bytes(std::span(density.data(), density.size())));
+    if (!header.compact) {
+        read(radiance.pixels.data(), texels * sizeof(Rgb));
+        payload_hash.update(std::as_bytes(std::span(radiance.pixels)));
+    }
+    read(&digest, sizeof digest);
+    if (digest != payload_hash.digest()) fail(name, "corrupted payload (checksum mismatch)");
+    if (header.compact) {
+        const uint32_t w = header.w;
+        detail::parallel_for(header.h, 16, [&](uint32_t lo, uint32_t hi) {
+            std::vector<float> row(w);
+            for (uint32_t y = lo; y < hi; ++y) {
+                const size_t offset = size_t{y} * w;
+                for (uint32_t x = 0; x < w; ++x) radiance.pixels[offset + x] = rgbe_decode(density[offset + x]);
+                density_row(std::span(radiance.pixels).subspan(offset, w), y, header.h, header.options, header.stats, row);
+                std::memcpy(density.data() + offset, row.data(), row.size() * sizeof(float));
+            }
+        });
+    }
+    return checked_table(name, header.version, std::move(header.source),
+                         [&] { return EnvMap(std::move(radiance), std::move(density), header.options, header.stats); });
+}
+
+// A full version 3 payload in a file mapping, used in place: the map borrows the
+// radiance from the mapping, which it keeps alive; only the density is copied, into the
+// buffer that becomes the CDF table. Null if the payload cannot be used in place (compact,
+// or an older version whose arrays may be misaligned).
+std::optional<Table> read_mapped_payload(Header header, const std::shared_ptr<const detail::MappedFile>& file,
+                                         std::string_view name) {
+    const uint64_t texels = uint64_t{header.w} * header.h;
+    const std::span<const std::byte> payload = file->bytes().subspan(static_cast<size_t>(header.payload_offset));
+    const auto density_bytes = payload.first(texels * sizeof(uint32_t));
+    const auto radiance_bytes = payload.subspan(density_bytes.size(), texels * sizeof(Rgb));
+    if (header.compact || header.version < 3 || reinterpret_cast<uintptr_t>(radiance_bytes.data()) % alignof(Rgb) != 0)
+        return std::nullopt;
+    // The density a chunk at a time: hashed, copied, and its mapped pages released at
+    // once, so that they and the copy are never both resident (the load's peak memory).
+    constexpr size_t kChunk = size_t{32} << 20;
+    LargeVector<uint32_t> density(texels);
+    Hasher payload_hash;
+    for (size_t at = 0; at < density_bytes.size(); at += kChunk) {
+        const auto chunk = density_bytes.subspan(at, std::min(kChunk, density_bytes.size() - at));
+        payload_hash.update(chunk);
+        std::memcpy(reinterpret_cast<std::byte*>(density.data()) + at, chunk.data(), chunk.size());
+        file->release(chunk);
+    }
+    payload_hash.update(radiance_bytes);
+    uint64_t digest = 0;
+    std::memcpy(&digest, payload.data() + density_bytes.size() + radiance_bytes.size(), sizeof digest);
+    if (digest != payload_hash.digest()) fail(name, "corrupted payload (checksum mismatch)");
+    const RgbImageView radiance{header.w, header.h,
+                                std::span(reinterpret_cast<const Rgb*>(radiance_bytes.data()), static_cast<size_t>(texels))};
+    Table table = checked_table(name, header.version, std::move(header.source), [&] {
+        return EnvMap(radiance, file, std::move(density), header.options, header.stats);
+    });
+    table.mapped = true;
+    return table;
+}
+
+// The payload of `bytes`, a whole table file in memory, copied out of it.
+Table copy_payload(Header header, std::span<const std::byte> bytes, std::string_view name) {
+    size_t pos = static_cast<size_t>(header.payload_offset);
+    return read_payload(
+        std::move(header),
+        [&](void* destination, uint64_t size) {
+            std::memcpy(destination, bytes.data() + pos, static_cast<size_t>(size));
+            pos += static_cast<size_t>(size);
+        },
+        name);
+}
+
+}  // namespace
+
+Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
+    return copy_payload(parse_header(bytes, bytes.size(), name), bytes, name);
+}
+
+Table read_table(const std::filesystem::path& path, TableLoading loading) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw TableError(path.string() + ": no such file");
+    if (!std::filesystem::is_regular_file(path, ec)) throw TableError(path.string() + ": not a regular file");
+    if (loading == TableLoading::map)
+        if (const std::shared_ptr<const detail::MappedFile> file = detail::MappedFile::map(path)) {
+            const std::span<const std::byte> bytes = file->bytes();
+            Header header = parse_header(bytes, bytes.size(), path.string());
+            if (std::optional<Table> table = read_mapped_payload(header, file, path.string())) return std::move(*table);
+            return copy_payload(std::move(header), bytes, path.string());
+        }
+    std::ifstream file(path, std::ios::binary | std::ios::ate);
+    if (!file) throw TableError(describe_errno(path, "open"));
+    const std::streamoff size = file.tellg();
+    if (size < 0) throw TableError(path.string() + ": cannot determine the file size");
+    // The header is at most 32 + 64 KiB + 8 bytes; the payload goes straight to its place.
+    std::vector<std::byte> head(std::min<size_t>(static_cast<size_t>(size), kPreambleSize + kMaxMetadataSize + 8));
+    file.seekg(0);
+    if (!file.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size())))
+        throw TableError(describe_errno(path, "read"));
+    Header header = parse_header(head, static_cast<uint64_t>(size), path.string());
+    file.seekg(static_cast<std::streamoff>(header.payload_offset));
+    return read_payload(
+        std::move(header),
+        [&](void* destination, uint64_t bytes) {
+            if (!file.read(static_cast<char*>(destination), static_cast<std::streamsize>(bytes)))
+                throw TableError(describe_errno(path, "read"));
+        },
+        path.string());
+}
+
+bool looks_like_table(const std::filesystem::path& path) noexcept {
+    std::ifstream file(path, std::ios::binary);
+    char magic[sizeof kMagic] = {};
+    return file.read(magic, sizeof magic) && std::memcmp(magic, kMagic, sizeof kMagic) == 0;
+}
+
+}  // namespace envmis

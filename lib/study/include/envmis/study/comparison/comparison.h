@@ -1,0 +1,91 @@
+// The variance study: each technique (estimator.h) on each BSDF at a set of shading
+// points, at equal sample count, against quadrature references (quadrature.h).
+//
+// Per point, `spp` estimates of each technique give its mean and the variance of one
+// estimate; the tables aggregate over points as follows (for one point they are simply
+// that point's figures):
+//   mean, reference, variance   arithmetic means over points
+//   std_error                   standard error of the aggregated mean
+//   rel_mse                     mean over points and estimates of ((F - ref) / ref)^2
+//   ns_per_estimate             wall time per estimate, all estimates of the technique
+//                               (the estimator's own time, without the statistics kept)
+//   efficiency                  1 / (variance * seconds per estimate)
+//   variance_ratio_vs_mis       geometric mean over points of variance / variance of
+//                               mis-balance (each point counts equally, bright or dim)
+//   variance_ratio_log_std_error  standard error of log(variance_ratio_vs_mis): the
+//                               noise of each point's variance estimate, measured as
+//                               the spread of the variances of 8 interleaved batches
+//
+// Determinism: every (point, BSDF, technique) draws from its own PCG32 stream derived
+// from the seed, so the estimates do not depend on the number of threads.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "envmis/study/shading/bsdf.h"
+#include "envmis/sampling/envmap.h"
+#include "envmis/study/techniques/estimator.h"
+#include "envmis/study/reference/quadrature.h"
+
+namespace envmis {
+
+struct ComparisonOptions {
+    std::vector<Bsdf> bsdfs = {Bsdf::lambert(), Bsdf::phong(50), Bsdf::ggx(0.1f)};
+    std::vector<Technique> techniques = default_techniques();
+    Allocation allocation;
+    uint32_t spp = 1024;   // estimates per point, BSDF and technique
+    uint64_t seed = 1;
+    uint32_t threads = 0;  // 0: all cores
+    QuadratureOptions quadrature{1e-3, 32};
+
+    static std::vector<Technique> default_techniques();
+};
+
+struct TechniqueStats {
+    Technique technique;
+    double mean = 0, reference = 0, variance = 0, std_error = 0, rel_mse = 0;
+    double ns_per_estimate = 0, efficiency = 0, variance_ratio_vs_mis = 0;
+    uint64_t estimates = 0;
+    double variance_ratio_log_std_error = 0;
+    // Optimal MIS: points whose linear system stayed singular, so that their estimates
+    // kept the balance heuristic's weights.
+    uint32_t ill_conditioned_points = 0;
+    // Per point, in order: the variance of one estimate and its relative standard error.
+    std::vector<double> point_variances, point_variance_rel_se;
+};
+
+struct BsdfComparison {
+    Bsdf bsdf;
+    std::vector<TechniqueStats> techniques;  // in ComparisonOptions::techniques order
+
+    const TechniqueStats* find(std::string_view technique) const;
+};
+
+struct Comparison {
+    std::vector<BsdfComparison> bsdfs;
+    size_t points_done = 0, points_total = 0;  // fewer done if stopped early
+};
+
+// K normals spread evenly over the sphere (a spherical Fibonacci lattice), each viewed
+// head-on (wo = normal).
+std::vector<ShadingPoint> sphere_points(uint32_t k);
+
+// Runs the study. `plain` and `compensated` are the same map without and with
+// compensation. Throws std::invalid_argument for an invalid technique (env-comp), an
+// empty list or spp of 0. Checks `stop` between points and returns what is done;
+// calls `progress(done, total)` after each point.
+Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<const ShadingPoint> points,
+                   const ComparisonOptions& options, const std::atomic<bool>* stop = nullptr,
+                   const std::function<void(size_t, size_t)>& progress = {});
+
+// Runs `spp` estimates of `technique` at one point, learning as adaptive techniques do,
+// and returns their mean (RGB): one pixel of a rendered comparison.
+Rgb average_estimate(const DirectLightingEstimator& estimator, const ShadingPoint& point, const Bsdf& bsdf,
+                     uint32_t spp, uint64_t seed, uint64_t stream);
+
+}  // namespace envmis

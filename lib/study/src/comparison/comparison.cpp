@@ -1,0 +1,180 @@
+#include "envmis/study/comparison/comparison.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <thread>
+
+#include "envmis/study/statistics/statistics.h"
+
+namespace envmis {
+namespace {
+
+// Interleaved batches per cell: the spread of their variances is the noise of the
+// cell's variance estimate, whatever the estimates' distribution.
+constexpr uint32_t kBatches = 8;
+// Estimates asked of an estimator at a time: enough for it to run them side by side.
+constexpr uint32_t kChunk = 64;
+
+// What one (point, BSDF, technique) cell of the study measured.
+struct Cell {
+    RunningStats estimates, squared_relative_error;
+    RunningStats batches[kBatches];
+    double seconds = 0;
+    bool ill_conditioned = false;  // optimal MIS ended on balance weights
+};
+
+double square(double x) { return x * x; }
+
+// Standard error of a cell's variance estimate relative to it, from its batches.
+double relative_standard_error(const Cell& c) {
+    RunningStats variances;
+    for (const RunningStats& b : c.batches) variances.add(b.variance());
+    const double v = c.estimates.variance();
+    return v > 0 ? variances.standard_error() / v : 0.0;
+}
+
+}  // namespace
+
+std::vector<Technique> ComparisonOptions::default_techniques() {
+    std::vector<Technique> t;
+    for (const char* name : {"env", "bsdf", "mis-balance", "mis-power", "mis-balance-comp", "mis-power-comp",
+                             "mis-optimal-comp", "mis-optimal-all"})
+        t.push_back(Technique::parse(name));
+    return t;
+}
+
+const TechniqueStats* BsdfComparison::find(std::string_view technique) const {
+    for (const TechniqueStats& t : techniques)
+        if (t.technique.name() == technique) return &t;
+    return nullptr;
+}
+
+std::vector<ShadingPoint> sphere_points(uint32_t k) {
+    constexpr double kGoldenAngle = 2.39996322972865332;
+    std::vector<ShadingPoint> points(k);
+    for (uint32_t i = 0; i < k; ++i) {
+        const double z = 1 - (2 * i + 1.0) / k, r = std::sqrt(1 - z * z), phi = kGoldenAngle * i;
+        const Vec3 n{static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z)};
+        points[i] = {n, n};
+    }
+    return points;
+}
+
+Rgb average_estimate(const DirectLightingEstimator& estimator, const ShadingPoint& point, const Bsdf& bsdf,
+                     uint32_t spp, uint64_t seed, uint64_t stream) {
+    Pcg32 rng(seed, stream);
+    PointState state;
+    double r = 0, g = 0, b = 0;
+    Rgb chunk[kChunk];
+    for (uint64_t first = 0; first < spp; first += kChunk) {
+        const std::span<Rgb> estimates(chunk, std::min<uint64_t>(kChunk, spp - first));
+        estimator.estimate(point, bsdf, rng, state, estimates);
+        for (const Rgb& e : estimates) r += e.r, g += e.g, b += e.b;
+    }
+    return {static_cast<float>(r / spp), static_cast<float>(g / spp), static_cast<float>(b / spp)};
+}
+
+Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<const ShadingPoint> points,
+                   const ComparisonOptions& options, const std::atomic<bool>* stop,
+                   const std::function<void(size_t, size_t)>& progress) {
+    if (options.bsdfs.empty() || options.techniques.empty() || options.spp == 0 || points.empty())
+        throw std::invalid_argument("compare: needs at least one BSDF, technique, shading point and sample");
+    std::vector<DirectLightingEstimator> estimators;
+    for (const Technique& t : options.techniques)
+        estimators.emplace_back(plain, compensated, t, options.allocation);
+    const size_t nb = options.bsdfs.size(), nt = options.techniques.size();
+    const uint32_t threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+    const LumaCoefficients luma = plain.options().luma;
+
+    // cells[(p * nb + b) * nt + t]; references[p * nb + b].
+    std::vector<Cell> cells;
+    std::vector<double> references;
+    size_t done = 0;
+    for (; done < points.size() && !(stop && stop->load()); ++done) {
+        const ShadingPoint& point = points[done];
+        for (const Bsdf& bsdf : options.bsdfs)
+            references.push_back(reflected_radiance(plain, bsdf, point, options.quadrature).luminance);
+        const size_t first = cells.size();
+        cells.resize(first + nb * nt);
+        std::atomic<size_t> next{0};
+        auto work = [&] {
+            for (size_t job; (job = next.fetch_add(1)) < nb * nt;) {
+                const size_t b = job / nt, t = job % nt;
+                const double reference = references[done * nb + b];
+                Cell& cell = cells[first + job];
+                Pcg32 rng(options.seed, (done * nb + b) * nt + t);
+                PointState state;
+                Rgb chunk[kChunk];
+                for (uint64_t begin = 0; begin < options.spp; begin += kChunk) {
+                    const uint64_t count = std::min<uint64_t>(kChunk, options.spp - begin);
+                    const auto start = std::chrono::steady_clock::now();
+                    estimators[t].estimate(point, options.bsdfs[b], rng, state, {chunk, count});
+                    cell.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+                    for (uint64_t i = begin; i < begin + count; ++i) {
+                        const double x = luminance(chunk[i - begin], luma);
+                        cell.estimates.add(x);
+                        cell.batches[i % kBatches].add(x);
+                        if (reference > 0) cell.squared_relative_error.add((x - reference) * (x - reference) / (reference * reference));
+                    }
+                }
+                cell.ill_conditioned = options.techniques[t].heuristic == Heuristic::optimal && state.estimates >= 8 &&
+                                       !state.optimal.solved;
+            }
+        };
+        std::vector<std::jthread> pool;
+        for (uint32_t i = 1; i < threads; ++i) pool.emplace_back(work);
+        work();
+        pool.clear();
+        if (progress) progress(done + 1, points.size());
+    }
+
+    Comparison result{{}, done, points.size()};
+    if (done == 0) return result;
+    size_t mis_index = nt;
+    for (size_t t = 0; t < nt; ++t)
+        if (options.techniques[t] == Technique::parse("mis-balance")) mis_index = t;
+    for (size_t b = 0; b < nb; ++b) {
+        BsdfComparison bc{options.bsdfs[b], {}};
+        for (size_t t = 0; t < nt; ++t) {
+            TechniqueStats s;
+            s.technique = options.techniques[t];
+            RunningStats rel;
+            double seconds = 0, variance_sum = 0, log_ratio = 0, log_ratio_se2 = 0;
+            size_t ratios = 0;
+            for (size_t p = 0; p < done; ++p) {
+                const Cell& c = cells[(p * nb + b) * nt + t];
+                s.mean += c.estimates.mean() / done;
+                s.reference += references[p * nb + b] / done;
+                s.variance += c.estimates.variance() / done;
+                variance_sum += c.estimates.variance() / c.estimates.count();
+                rel.merge(c.squared_relative_error);
+                seconds += c.seconds;
+                s.estimates += c.estimates.count();
+                s.ill_conditioned_points += c.ill_conditioned;
+                s.point_variances.push_back(c.estimates.variance());
+                s.point_variance_rel_se.push_back(relative_standard_error(c));
+                if (mis_index < nt && t != mis_index) {
+                    const Cell& mis = cells[(p * nb + b) * nt + mis_index];
+                    const double v = c.estimates.variance(), v_mis = mis.estimates.variance();
+                    if (v > 0 && v_mis > 0) {
+                        log_ratio += std::log(v / v_mis), ++ratios;
+                        log_ratio_se2 += square(relative_standard_error(c)) + square(relative_standard_error(mis));
+                    }
+                }
+            }
+            s.std_error = std::sqrt(variance_sum) / done;
+            s.rel_mse = rel.mean();
+            s.ns_per_estimate = 1e9 * seconds / static_cast<double>(s.estimates);
+            s.efficiency = s.variance > 0 ? 1 / (s.variance * seconds / static_cast<double>(s.estimates)) : 0;
+            s.variance_ratio_vs_mis = t == mis_index ? 1.0 : (ratios ? std::exp(log_ratio / ratios) : 0);
+            s.variance_ratio_log_std_error = ratios ? std::sqrt(log_ratio_se2) / static_cast<double>(ratios) : 0;
+            bc.techniques.push_back(s);
+        }
+        result.bsdfs.push_back(std::move(bc));
+    }
+    return result;
+}
+
+}  // namespace envmis

@@ -1,0 +1,55 @@
+// Internal: steps of the estimator's side-by-side lanes (estimator.cpp) eight lanes at a
+// time with AVX2 (estimator_simd.cpp). Each repeats the scalar code it stands for
+// operation by operation, so that a lane's result is bit-identical to an estimate made
+// alone (tests/estimator_test.cpp, ManyEstimatesAtOnceEqualTheSameEstimatesOneAtATime).
+// Lane counts are multiples of kSimdWidth: callers pad their arrays with valid inputs.
+// The functions are declared on x86-64 only (ENVMIS_AVX2_BATCHES); call them where
+// simd::avx2_available().
+#pragma once
+
+#include <cstdint>
+
+#include "envmis/sampling/envmap.h"
+#include "envmis/study/shading/frame.h"
+#include "detail/simd.h"
+
+namespace envmis::detail {
+
+// The fixed MIS weights of the lanes' techniques (estimator.cpp, fixed_weight): 1 for a
+// single technique, the balance or the power heuristic.
+enum class Weighting { one, balance, power };
+
+}  // namespace envmis::detail
+
+#ifdef ENVMIS_AVX2_BATCHES
+namespace envmis::detail {
+
+inline constexpr uint32_t kSimdWidth = 8;
+
+// Bsdf::sample of a Lambertian BSDF for a view direction above the surface, then
+// Frame::to_world of the sampled direction, for n points u: the world direction, the
+// pdf and the value (f cos, in the r, g, b arrays).
+void sample_lambert(const Frame& frame, Rgb albedo, PointArrays u, SampleArrays out, uint32_t n) noexcept;
+
+// Bsdf::pdf and Bsdf::eval of a Lambertian BSDF (view direction above the surface) at n
+// world directions wi, through Frame::to_local.
+struct BsdfValueArrays {
+    float *pdf, *r, *g, *b;
+};
+void eval_lambert(const Frame& frame, Rgb albedo, DirectionArrays wi, BsdfValueArrays out, uint32_t n) noexcept;
+
+// One sample per lane of technique k (0: environment, 1: BSDF), added to the lanes'
+// sums as the scalar add_lanes (estimator.cpp) adds it: value L v per channel, weight
+// from q = n p of both techniques, divided by q_k; nothing where p_k is not > 0.
+struct LaneSamples {
+    const float *radiance_r, *radiance_g, *radiance_b;  // L
+    const float *value_r, *value_g, *value_b;           // v: the BSDF's f cos
+    const float *p_env, *p_bsdf;                        // solid-angle densities
+};
+struct LaneSums {
+    float *r, *g, *b;
+};
+void add_samples(Weighting weighting, const float counts[2], int k, LaneSamples s, LaneSums sums, uint32_t n) noexcept;
+
+}  // namespace envmis::detail
+#endif

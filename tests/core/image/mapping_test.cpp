@@ -1,0 +1,102 @@
+// Specification of the equirectangular and equal-area mappings and axes (mapping.h).
+#include <gtest/gtest.h>
+
+#include "envmis/image/mapping.h"
+#include "stats.h"
+
+namespace envmis {
+namespace {
+
+TEST(Mapping, FollowsTheDocumentedConvention) {
+    EXPECT_NEAR(equirect_direction({0.3f, 0.0f}).z, 1.0f, 1e-6f);  // v = 0: top row, +z
+    EXPECT_NEAR(equirect_direction({0.3f, 0.99999f}).z, -1.0f, 1e-4f);
+    const Vec3 d = equirect_direction({0.25f, 0.5f});  // theta = pi/2, phi = pi/2
+    EXPECT_NEAR(d.x, 0.0f, 1e-6f);
+    EXPECT_NEAR(d.y, 1.0f, 1e-6f);
+    EXPECT_NEAR(d.z, 0.0f, 1e-6f);
+}
+
+TEST(Mapping, UvOfDirectionInvertsDirectionOfUv) {
+    test::Rng rng(1);
+    for (int i = 0; i < 10000; ++i) {
+        const Vec2 uv{rng.uniform(), 0.001f + 0.998f * rng.uniform()};
+        const Vec2 back = equirect_uv(equirect_direction(uv));
+        EXPECT_NEAR(back.y, uv.y, 1e-5f);
+        const float du = std::abs(back.x - uv.x);
+        EXPECT_LT(std::min(du, 1 - du), 1e-5f);  // u wraps around
+    }
+}
+
+// pbrt-v4's EqualAreaSquareToSphere: centre +z, corners -z, edge midpoints on the
+// equator, u along +x and v along +y.
+TEST(EqualArea, FollowsPbrtsConvention) {
+    const auto near = [](Vec3 a, Vec3 b) { return length(a - b) < 1e-5f; };
+    EXPECT_TRUE(near(equal_area_direction({0.5f, 0.5f}), {0, 0, 1}));
+    for (Vec2 corner : {Vec2{0, 0}, Vec2{1, 0}, Vec2{0, 1}, Vec2{1, 1}})
+        EXPECT_TRUE(near(equal_area_direction(corner), {0, 0, -1}));
+    EXPECT_TRUE(near(equal_area_direction({1, 0.5f}), {1, 0, 0}));
+    EXPECT_TRUE(near(equal_area_direction({0, 0.5f}), {-1, 0, 0}));
+    EXPECT_TRUE(near(equal_area_direction({0.5f, 1}), {0, 1, 0}));
+    EXPECT_TRUE(near(equal_area_direction({0.5f, 0}), {0, -1, 0}));
+    const float c = std::sqrt(0.5f);  // the diagonal's midpoint: the equator at 45 degrees
+    EXPECT_TRUE(near(equal_area_direction({0.75f, 0.75f}), {c, c, 0}));
+}
+
+TEST(EqualArea, UvOfDirectionInvertsDirectionOfUv) {
+    test::Rng rng(2);
+    for (int i = 0; i < 100000; ++i) {
+        const Vec2 uv = rng.uniform2();
+        const Vec3 d = equal_area_direction(uv);
+        ASSERT_NEAR(length(d), 1.0f, 2e-6f);
+        const Vec2 back = equal_area_uv(d);
+        // Float precision: the -z corners lose a few bits to 1 - |z|.
+        ASSERT_NEAR(back.x, uv.x, 1e-5f) << uv.x << "," << uv.y;
+        ASSERT_NEAR(back.y, uv.y, 1e-5f) << uv.x << "," << uv.y;
+    }
+}
+
+// Equal area: uniform points of the square give uniform directions, so z is uniform on
+// [-1, 1] and the azimuth on [0, 2 pi) (chi-square, 64 bins each, and jointly 16 x 16).
+TEST(EqualArea, UniformSquareGivesUniformDirections) {
+    const int bins = 16, n = 400000;
+    std::vector<double> observed(bins * bins), expected(bins * bins, static_cast<double>(n) / (bins * bins));
+    test::Rng rng(3);
+    for (int i = 0; i < n; ++i) {
+        const Vec3 d = equal_area_direction(rng.uniform2());
+        double phi = std::atan2(double{d.y}, double{d.x});
+        if (phi < 0) phi += 2 * kPi;
+        const int zb = std::min(bins - 1, static_cast<int>((d.z + 1) / 2 * bins));
+        const int pb = std::min(bins - 1, static_cast<int>(phi / (2 * kPi) * bins));
+        observed[static_cast<size_t>(zb * bins + pb)] += 1;
+    }
+    const auto chi = test::chi_square(expected, observed);
+    EXPECT_GT(chi.p_value, 1e-3) << chi.describe();
+}
+
+TEST(Mapping, NamesReadBack) {
+    for (Mapping m : {Mapping::equirect, Mapping::equal_area}) EXPECT_EQ(parse_mapping(to_string(m)), m);
+    EXPECT_THROW(parse_mapping("cube"), std::invalid_argument);
+}
+
+TEST(Axes, ParseAndPrint) {
+    EXPECT_EQ(Axes::parse("z-up"), Axes{});
+    EXPECT_EQ(Axes::parse("x,y,z"), Axes{});
+    EXPECT_EQ(Axes::parse("y-up"), Axes::parse("x,z,-y"));
+    EXPECT_EQ(Axes::parse("-y,+x,z").to_string(), "-y,x,z");
+    for (const char* bad : {"", "x,y", "x,x,z", "x,y,w", "x,y,z,x", "xy,z", "up"})
+        EXPECT_THROW(Axes::parse(bad), std::invalid_argument) << bad;
+}
+
+TEST(Axes, ToCanonicalInvertsToWorld) {
+    const Vec3 v{0.1f, -0.7f, 0.3f};
+    for (const char* a : {"x,y,z", "x,z,-y", "-z,y,x", "y,-x,-z"}) {
+        const Axes axes = Axes::parse(a);
+        const Vec3 back = to_canonical(axes, to_world(axes, v));
+        EXPECT_EQ(back.x, v.x) << a;
+        EXPECT_EQ(back.y, v.y) << a;
+        EXPECT_EQ(back.z, v.z) << a;
+    }
+}
+
+}  // namespace
+}  // namespace envmis

@@ -1,0 +1,263 @@
+// Specification of the piecewise-constant distributions (distribution.h, textbook.h).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "envmis/sampling/distribution.h"
+#include "envmis/study/reference/textbook.h"
+#include "maps.h"
+#include "stats.h"
+
+namespace envmis {
+namespace {
+
+using test::Rng;
+
+// Chi-square tests in this file; each runs at the Sidak level for a 1% family-wise rate.
+const double kLevel = test::sidak_level(0.01, 40);
+
+struct Grid {
+    uint32_t w, h;
+    std::vector<float> func;
+};
+
+std::vector<Grid> test_grids() {
+    std::vector<Grid> grids;
+    grids.push_back({1, 1, {3.0f}});
+    grids.push_back({7, 3, test::random_function(21, 1)});
+    grids.push_back({64, 32, test::random_function(64 * 32, 2)});
+    grids.push_back({33, 17, test::random_function(33 * 17, 3, 8)});  // 8 decades
+    Grid sun{48, 24, std::vector<float>(48 * 24, 0.01f)};
+    sun.func[5 * 48 + 40] = 1e5f;  // one cell holds nearly all the mass
+    grids.push_back(sun);
+    Grid rows{16, 16, test::random_function(256, 4)};
+    std::fill(rows.func.begin() + 3 * 16, rows.func.begin() + 9 * 16, 0.0f);  // empty rows
+    grids.push_back(rows);
+    return grids;
+}
+
+template <class D>
+class Distribution2DTest : public ::testing::Test {};
+using Samplers2D = ::testing::Types<Distribution2D, TextbookDistribution2D>;
+TYPED_TEST_SUITE(Distribution2DTest, Samplers2D);
+
+TYPED_TEST(Distribution2DTest, SamplesFollowTheFunction) {
+    uint64_t seed = 10;
+    for (const Grid& g : test_grids()) {
+        const TypeParam d(g.func, g.w, g.h);
+        const size_t n = std::max<size_t>(50000, 20 * g.func.size());
+        std::vector<double> observed(g.func.size()), expected(g.func.size());
+        Rng rng(seed++);
+        for (size_t i = 0; i < n; ++i) {
+            const auto s = d.sample(rng.uniform2());
+            ASSERT_EQ(detail::cell_of(s.p.x, g.w), s.x);
+            ASSERT_EQ(detail::cell_of(s.p.y, g.h), s.y);
+            observed[size_t{s.y} * g.w + s.x] += 1;
+        }
+        const double sum = std::accumulate(g.func.begin(), g.func.end(), 0.0);
+        for (size_t i = 0; i < g.func.size(); ++i) expected[i] = n * g.func[i] / sum;
+        const auto chi = test::chi_square(expected, observed);
+        EXPECT_GT(chi.p_value, kLevel) << g.w << "x" << g.h << ": " << chi.describe();
+    }
+}
+
+TYPED_TEST(Distribution2DTest, PdfIntegratesToOne) {
+    for (const Grid& g : test_grids()) {
+        const TypeParam d(g.func, g.w, g.h);
+        // Midpoint rule on a grid 3x finer than the cells: exact for a piecewise-constant pdf.
+        const uint32_t nx = 3 * g.w, ny = 3 * g.h;
+        double integral = 0;
+        for (uint32_t y = 0; y < ny; ++y)
+            for (uint32_t x = 0; x < nx; ++x) integral += d.pdf({(x + 0.5f) / nx, (y + 0.5f) / ny});
+        EXPECT_NEAR(integral / (static_cast<double>(nx) * ny), 1.0, 1e-3) << g.w << "x" << g.h;
+    }
+}
+
+TYPED_TEST(Distribution2DTest, SampledPdfEqualsPdfAtThePoint) {
+    for (const Grid& g : test_grids()) {
+        const TypeParam d(g.func, g.w, g.h);
+        Rng rng(7);
+        for (int i = 0; i < 20000; ++i) {
+            const auto s = d.sample(rng.uniform2());
+            ASSERT_EQ(s.pdf, d.pdf(s.p));
+            ASSERT_GT(s.pdf, 0.0f);
+        }
+    }
+}
+
+TYPED_TEST(Distribution2DTest, InvertUndoesSample) {
+    for (const Grid& g : test_grids()) {
+        const TypeParam d(g.func, g.w, g.h);
+        Rng rng(8);
+        for (int i = 0; i < 20000; ++i) {
+            const Vec2 u = rng.uniform2();
+            const auto s = d.sample(u);
+            const Vec2 back = d.invert(s.p);
+            // The point is a float: its position inside a cell is known to n ulps of 1,
+            // which the cell's probability scales back into u.
+            const float tol_x = 1e-6f + 4 * g.w * 0x1p-24f, tol_y = 1e-6f + 4 * g.h * 0x1p-24f;
+            ASSERT_NEAR(back.x, u.x, tol_x) << g.w << "x" << g.h << " u=" << u.x << "," << u.y;
+            ASSERT_NEAR(back.y, u.y, tol_y) << g.w << "x" << g.h << " u=" << u.x << "," << u.y;
+        }
+    }
+}
+
+TYPED_TEST(Distribution2DTest, IntegralIsTheMeanOfTheFunction) {
+    for (const Grid& g : test_grids()) {
+        const TypeParam d(g.func, g.w, g.h);
+        const double mean = std::accumulate(g.func.begin(), g.func.end(), 0.0) / g.func.size();
+        EXPECT_NEAR(d.integral(), mean, 1e-5 * mean);
+        EXPECT_FALSE(d.uniform_fallback());
+    }
+}
+
+TYPED_TEST(Distribution2DTest, AllZeroFunctionGivesUniformWithFlag) {
+    const std::vector<float> zero(12 * 5, 0.0f);
+    const TypeParam d(zero, 12, 5);
+    EXPECT_TRUE(d.uniform_fallback());
+    EXPECT_EQ(d.integral(), 0.0);
+    Rng rng(9);
+    for (int i = 0; i < 1000; ++i) EXPECT_FLOAT_EQ(d.sample(rng.uniform2()).pdf, 1.0f);
+}
+
+TYPED_TEST(Distribution2DTest, RejectsInvalidInput) {
+    const std::vector<float> four(4, 1.0f);
+    EXPECT_THROW(TypeParam(four, 3, 2), std::invalid_argument);
+    EXPECT_THROW(TypeParam(std::vector<float>{}, 0, 0), std::invalid_argument);
+    EXPECT_THROW(TypeParam(std::vector<float>(65537, 1.0f), 65537, 1), std::invalid_argument);
+    for (float bad : {-1.0f, NAN, INFINITY}) {
+        std::vector<float> f = four;
+        f[2] = bad;
+        EXPECT_THROW(TypeParam(f, 2, 2), std::invalid_argument) << bad;
+    }
+}
+
+TEST(Distribution2D, ExtremeAspectRatiosWork) {
+    for (auto [w, h] : {std::pair{16384u, 1u}, std::pair{1u, 8192u}}) {
+        const auto f = test::random_function(size_t{w} * h, 11);
+        const Distribution2D d(f, w, h);
+        Rng rng(12);
+        for (int i = 0; i < 1000; ++i) {
+            const auto s = d.sample(rng.uniform2());
+            ASSERT_LT(s.x, w);
+            ASSERT_LT(s.y, h);
+            ASSERT_EQ(s.pdf, d.pdf(s.p));
+        }
+    }
+}
+
+TEST(Distribution2D, KeepsCellsFarBelowFloatResolution) {
+    // Cells 1e-12 of their row's mass, after a large one: a float CDF loses them; here
+    // they keep a positive pdf (their one unit of 2^-31 is below the 2^-24 grid of a float
+    // u, so they are practically never sampled, as their mass says).
+    std::vector<float> f(4, 0.0f);
+    f[0] = 1e12f, f[1] = 1.0f, f[3] = 1.0f;
+    const Distribution2D d(f, 4, 1);
+    EXPECT_GT(d.pdf({0.3f, 0.5f}), 0.0f);
+    EXPECT_GT(d.pdf({0.8f, 0.5f}), 0.0f);
+    EXPECT_EQ(d.pdf({0.6f, 0.5f}), 0.0f);
+}
+
+TEST(Distribution2D, ProbabilitiesMatchTheFunctionToFixedPointResolution) {
+    const auto f = test::random_function(300 * 200, 13, 6);
+    const Distribution2D d(f, 300, 200);
+    const double mean = std::accumulate(f.begin(), f.end(), 0.0) / f.size();
+    for (uint32_t y = 0; y < 200; ++y)
+        for (uint32_t x = 0; x < 300; ++x) {
+            const double expected = f[y * 300 + x] / mean;
+            // Two fixed-point widths, each within one unit (2^-31) of the ideal probability.
+            ASSERT_NEAR(d.pdf({(x + 0.5f) / 300, (y + 0.5f) / 200}), expected, 1e-6 * expected + 300.0 * 200 * 0x1p-30)
+                << x << "," << y;
+        }
+}
+
+TEST(Distribution2D, BuildDoesNotDependOnThreads) {
+    // Rows are built in parallel; a second build must give identical tables.
+    const auto f = test::random_function(300 * 200, 13);
+    const Distribution2D a(f, 300, 200), b(f, 300, 200);
+    for (size_t i = 0; i < f.size(); ++i) {
+        ASSERT_EQ(a.view().start[i], b.view().start[i]);
+        ASSERT_EQ(a.view().guide[i], b.view().guide[i]);
+    }
+}
+
+TEST(Distribution2D, RowFunctionExceptionsReachTheCaller) {
+    EXPECT_THROW(Distribution2D(8, 64, [](uint32_t y, std::span<float>) {
+                     if (y == 40) throw std::runtime_error("row 40");
+                 }),
+                 std::runtime_error);
+}
+
+TEST(Distribution1D, SamplesFollowTheFunction) {
+    const auto f = test::random_function(500, 14, 5);
+    const Distribution1D d(f);
+    std::vector<double> observed(f.size()), expected(f.size());
+    Rng rng(15);
+    const size_t n = 100000;
+    for (size_t i = 0; i < n; ++i) {
+        const auto s = d.sample(rng.uniform());
+        ASSERT_EQ(detail::cell_of(s.x, 500), s.index);
+        ASSERT_EQ(s.pdf, d.pdf(s.x));
+        observed[s.index] += 1;
+    }
+    const double sum = std::accumulate(f.begin(), f.end(), 0.0);
+    for (size_t i = 0; i < f.size(); ++i) expected[i] = n * f[i] / sum;
+    const auto chi = test::chi_square(expected, observed);
+    EXPECT_GT(chi.p_value, kLevel) << chi.describe();
+}
+
+TEST(Distribution1D, PdfIntegratesToOneAndInvertUndoesSample) {
+    const auto f = test::random_function(37, 16);
+    const Distribution1D d(f);
+    double integral = 0;
+    for (int i = 0; i < 37 * 5; ++i) integral += d.pdf((i + 0.5f) / (37 * 5));
+    EXPECT_NEAR(integral / (37 * 5), 1.0, 1e-4);
+    Rng rng(17);
+    for (int i = 0; i < 10000; ++i) {
+        const float u = rng.uniform();
+        ASSERT_NEAR(d.invert(d.sample(u).x), u, 1e-5f);
+    }
+}
+
+TEST(Distribution1D, SingleCellAndAllZero) {
+    const Distribution1D one(std::vector<float>{2.0f});
+    EXPECT_EQ(one.sample(0.3f).index, 0u);
+    EXPECT_FLOAT_EQ(one.sample(0.3f).x, 0.3f);
+    EXPECT_FLOAT_EQ(one.pdf(0.7f), 1.0f);
+    const Distribution1D zero(std::vector<float>(5, 0.0f));
+    EXPECT_TRUE(zero.uniform_fallback());
+    EXPECT_FLOAT_EQ(zero.pdf(0.5f), 1.0f);
+}
+
+// The point of a sample is the float nearest (index + offset) / n inside cell `index`.
+// Power-of-two n take a float-only path: it must give the very same float.
+TEST(PointInCell, IsTheNearestFloatInsideTheCellForEverySize) {
+    const auto reference = [](uint32_t index, float offset, uint32_t n) {
+        float x = static_cast<float>((index + static_cast<double>(offset)) / n);
+        while (detail::cell_of(x, n) > index) x = std::nextafter(x, 0.0f);
+        while (detail::cell_of(x, n) < index) x = std::nextafter(x, 1.0f);
+        return std::min(x, kOneMinusEpsilon);  // cell_of counts 1 in the last cell
+    };
+    Rng rng(17);
+    for (uint32_t n : {1u, 2u, 3u, 7u, 64u, 1000u, 1024u, 4096u, 8191u, 8192u, 65535u, 65536u}) {
+        for (int i = 0; i < 20000; ++i) {
+            const uint32_t index = std::min(static_cast<uint32_t>(rng.uniform() * n), n - 1);
+            const float offset = i % 4 == 0 ? kOneMinusEpsilon : (i % 4 == 1 ? 0.0f : rng.uniform());
+            const float x = detail::point_in_cell(index, offset, n);
+            ASSERT_EQ(x, reference(index, offset, n)) << "n=" << n << " index=" << index << " offset=" << offset;
+            ASSERT_EQ(detail::cell_of(x, n), index);
+        }
+    }
+}
+
+TEST(Distribution1D, RejectsInvalidInput) {
+    EXPECT_THROW(Distribution1D(std::vector<float>{}), std::invalid_argument);
+    EXPECT_THROW(Distribution1D(std::vector<float>(65537, 1.0f)), std::invalid_argument);
+    EXPECT_THROW(Distribution1D(std::vector<float>{1.0f, -0.5f}), std::invalid_argument);
+    EXPECT_THROW(Distribution1D(std::vector<float>{NAN}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace envmis

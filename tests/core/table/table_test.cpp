@@ -1,0 +1,357 @@
+// Specification of table files (table.h, docs/table-format.md).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
+#include "envmis/math/hash.h"
+#include "envmis/table/table.h"
+#include "maps.h"
+#include "stats.h"
+
+namespace envmis {
+namespace {
+
+namespace fs = std::filesystem;
+
+class TableTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() / ("envmis_table_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    fs::path saved_table() {
+        EnvMapOptions o;
+        o.compensation.alpha = 0.75f;
+        o.axes = Axes::parse("y-up");
+        map_ = EnvMap(test::sun_sky_map(96, 48), o);
+        const fs::path path = dir_ / "sky.envmis";
+        write_table(path, map_, source_);
+        return path;
+    }
+    static std::vector<char> bytes_of(const fs::path& p) {
+        std::ifstream in(p, std::ios::binary);
+        return {std::istreambuf_iterator<char>(in), {}};
+    }
+    static void write_bytes(const fs::path& p, const std::vector<char>& bytes) {
+        std::ofstream(p, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    }
+    // Expects read_table to throw a TableError whose message names the file and contains `problem`.
+    static void expect_rejected(const fs::path& p, const std::string& problem) {
+        try {
+            read_table(p);
+            ADD_FAILURE() << p << " was accepted; expected: " << problem;
+        } catch (const TableError& e) {
+            EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(problem), std::string::npos) << e.what();
+        }
+    }
+
+    fs::path dir_;
+    EnvMap map_;
+    TableSource source_{"sky.exr", 0x1234abcd5678ef90ull, "lin_rec709", "ACEScg"};
+};
+
+// `loaded` samples exactly as `expected`: every field of n samples, bit for bit, and
+// the pdf of each sampled direction.
+void expect_identical_samples(const EnvMap& expected, const EnvMap& loaded, uint64_t seed, int n) {
+    test::Rng rng(seed);
+    for (int i = 0; i < n; ++i) {
+        const Vec2 u = rng.uniform2();
+        const EnvSample a = expected.sample(u), b = loaded.sample(u);
+        ASSERT_EQ(std::memcmp(&a, &b, sizeof a), 0) << "sample " << i;
+        ASSERT_EQ(expected.pdf(a.direction), loaded.pdf(a.direction));
+    }
+}
+
+TEST_F(TableTest, RoundTripGivesBitIdenticalSamples) {
+    const Table t = read_table(saved_table());
+    expect_identical_samples(map_, t.map, 1, 100000);
+}
+
+TEST_F(TableTest, RoundTripKeepsOptionsStatsAndSource) {
+    const Table t = read_table(saved_table());
+    EXPECT_EQ(t.source.name, source_.name);
+    EXPECT_EQ(t.source.content_hash, source_.content_hash);
+    EXPECT_EQ(t.source.input_colorspace, source_.input_colorspace);
+    EXPECT_EQ(t.source.working_colorspace, source_.working_colorspace);
+    EXPECT_EQ(t.map.options().compensation.alpha, 0.75f);
+    EXPECT_TRUE(t.map.options().compensation.enabled);
+    EXPECT_EQ(t.map.options().axes, Axes::parse("y-up"));
+    EXPECT_EQ(t.map.stats().mean_luminance, map_.stats().mean_luminance);
+    EXPECT_EQ(t.map.stats().zeroed_texels, map_.stats().zeroed_texels);
+    EXPECT_EQ(t.map.stats().threshold, map_.stats().threshold);
+    EXPECT_EQ(t.map.compensated(), map_.compensated());
+    EXPECT_EQ(t.map.complete(), map_.complete());
+}
+
+TEST_F(TableTest, EveryCorruptedByteIsDetected) {
+    const fs::path path = saved_table();
+    const std::vector<char> good = bytes_of(path);
+    // Flip one bit at a spread of offsets through preamble, metadata and payload.
+    for (size_t offset = 0; offset < good.size(); offset += good.size() / 97 + 1) {
+        std::vector<char> bad = good;
+        bad[offset] ^= 0x10;
+        write_bytes(path, bad);
+        EXPECT_THROW(read_table(path), TableError) << "offset " << offset;
+    }
+}
+
+TEST_F(TableTest, CorruptedPayloadIsNamedAsSuch) {
+    const fs::path path = saved_table();
+    std::vector<char> bytes = bytes_of(path);
+    bytes[bytes.size() - 100] ^= 1;
+    write_bytes(path, bytes);
+    expect_rejected(path, "corrupted payload");
+}
+
+TEST_F(TableTest, TruncatedFilesAreRejected) {
+    const fs::path path = saved_table();
+    const std::vector<char> good = bytes_of(path);
+    for (size_t size : {size_t{0}, size_t{5}, size_t{20}, size_t{40}, good.size() / 2, good.size() - 1}) {
+        write_bytes(path, {good.begin(), good.begin() + static_cast<std::ptrdiff_t>(size)});
+        EXPECT_THROW(read_table(path), TableError) << size;
+    }
+    write_bytes(path, {good.begin(), good.begin() + static_cast<std::ptrdiff_t>(good.size() / 2)});
+    expect_rejected(path, "truncated");
+}
+
+TEST_F(TableTest, ForeignFilesAreRejected) {
+    const fs::path path = dir_ / "foreign.envmis";
+    write_bytes(path, {'#', '?', 'R', 'A', 'D', 'I', 'A', 'N', 'C', 'E', '\n'});
+    expect_rejected(path, "not an envmis table");
+    expect_rejected(dir_ / "missing.envmis", "no such file");
+    expect_rejected(dir_, "not a regular file");
+}
+
+// A compact table stores RGBE radiance (4 bytes a texel) and loads as the map built
+// from the RGBE-rounded radiance, bit for bit; damage is still caught.
+TEST_F(TableTest, CompactTablesHoldTheRoundedMap) {
+    EnvMapOptions o;
+    o.compensation.alpha = 0.75f;
+    RgbImage image = test::random_map(96, 48, 11, 8);
+    image.pixels[5] = {NAN, 1, 2};  // repaired and counted by the map; the count is kept
+    const EnvMap map(image, o);
+    const fs::path path = dir_ / "compact.envmis";
+    write_table(path, map, source_, TableEncoding::compact);
+    const fs::path full = dir_ / "full.envmis";
+    write_table(full, map, source_);
+    EXPECT_EQ(fs::file_size(full) - fs::file_size(path), 96u * 48 * 12);
+
+    const Table loaded = read_table(path);
+    const EnvMap rounded(rgbe_round(map.radiance()), o);
+    EXPECT_EQ(loaded.map.stats().bad_pixels.nan, 1u);
+    EXPECT_EQ(loaded.map.stats().threshold, rounded.stats().threshold);
+    expect_identical_samples(rounded, loaded.map, 12, 10000);
+
+    std::vector<char> bytes = bytes_of(path);
+    bytes[bytes.size() - 20] ^= 0x10;
+    write_bytes(path, bytes);
+    expect_rejected(path, "corrupted payload");
+}
+
+// RGBE keeps each pixel's largest channel within half a step of its 8-bit mantissa
+// (0.4%), the others within half a step of the largest's scale; black stays black.
+TEST(Rgbe, RoundingErrorIsBounded) {
+    test::Rng rng(13);
+    RgbImage image{1000, 1, {}};
+    for (int i = 0; i < 1000; ++i) {
+        const float scale = std::pow(10.0f, 16 * rng.uniform() - 8);
+        image.pixels.push_back({scale * rng.uniform(), scale * rng.uniform(), scale * rng.uniform()});
+    }
+    image.pixels[0] = {0, 0, 0};
+    image.pixels[1] = {1.6e38f, 1, 0};  // the largest RGBE represents
+    const RgbImage rounded = rgbe_round(image);
+    EXPECT_EQ(rounded.pixels[0].r, 0.0f);
+    EXPECT_GT(rgbe_round(RgbImage{1, 1, {{3e38f, 0, 0}}}).pixels[0].r, 1.6e38f);  // saturates, never wraps to black
+    for (size_t i = 0; i < image.pixels.size(); ++i) {
+        const Rgb a = image.pixels[i], b = rounded.pixels[i];
+        const float m = std::max({a.r, a.g, a.b});
+        for (auto [x, y] : {std::pair{a.r, b.r}, std::pair{a.g, b.g}, std::pair{a.b, b.b}}) {
+            ASSERT_TRUE(std::isfinite(y)) << i;
+            ASSERT_LE(std::abs(x - y), m / 255) << i;  // half a step of 2^e / 256 with m >= 2^(e-1)
+        }
+        const float bm = std::max({b.r, b.g, b.b});
+        ASSERT_LE(std::abs(bm - m), m / 256) << i;
+    }
+}
+
+TEST_F(TableTest, EqualAreaTablesRoundTrip) {
+    EnvMapOptions o;
+    o.mapping = Mapping::equal_area;
+    const EnvMap map(test::sun_sky_map(48, 48), o);
+    const fs::path path = dir_ / "square.envmis";
+    write_table(path, map, source_);
+    const Table loaded = read_table(path);
+    EXPECT_EQ(loaded.map.options().mapping, Mapping::equal_area);
+    expect_identical_samples(map, loaded.map, 9, 10000);
+}
+
+// Offsets in a table file (docs/table-format.md).
+constexpr size_t kPreamble = 32, kVersionAt = 8, kTotalSizeAt = 16, kMetadataSizeAt = 24;
+constexpr size_t kMappingByte = kPreamble + 5 * 4 + 3 * 4 + 3;  // after size, kind, flags, alpha, luma, axes
+constexpr size_t kFixedMetadata = 100;                           // the fields before the three strings
+
+uint32_t u32_at(const std::vector<char>& bytes, size_t offset) {
+    uint32_t v = 0;
+    std::memcpy(&v, bytes.data() + offset, sizeof v);
+    return v;
+}
+
+// Size of the metadata block's fields, without version 3's padding.
+size_t unpadded_metadata(const std::vector<char>& bytes) {
+    size_t end = kFixedMetadata;
+    for (int i = 0; i < 3; ++i) end += 4 + u32_at(bytes, kPreamble + end);
+    return end;
+}
+
+// Recomputes the header checksum after an edit of the header.
+void reseal(std::vector<char>& bytes) {
+    const uint32_t m = u32_at(bytes, kMetadataSizeAt);
+    const uint64_t digest = hash64(std::as_bytes(std::span(bytes.data(), kPreamble + m)));
+    std::memcpy(bytes.data() + kPreamble + m, &digest, sizeof digest);
+}
+
+// The same table as an older version writes it: no metadata padding; version 1 also
+// has a reserved 0 where later versions keep the mapping.
+std::vector<char> as_version(std::vector<char> bytes, uint32_t version) {
+    const uint32_t m = u32_at(bytes, kMetadataSizeAt), unpadded = static_cast<uint32_t>(unpadded_metadata(bytes));
+    bytes.erase(bytes.begin() + kPreamble + unpadded, bytes.begin() + kPreamble + m);
+    const uint64_t total = bytes.size();
+    std::memcpy(bytes.data() + kVersionAt, &version, sizeof version);
+    std::memcpy(bytes.data() + kTotalSizeAt, &total, sizeof total);
+    std::memcpy(bytes.data() + kMetadataSizeAt, &unpadded, sizeof unpadded);
+    if (version == 1) bytes[kMappingByte] = 0;
+    reseal(bytes);
+    return bytes;
+}
+
+// Version 1 had a reserved zero byte where version 2 keeps the mapping: such files are
+// equirectangular and still read; a version 1 file with another byte there is corrupt.
+TEST_F(TableTest, VersionOneTablesStillRead) {
+    const fs::path path = saved_table();
+    std::vector<char> bytes = bytes_of(path);
+    ASSERT_EQ(bytes[kMappingByte], 1);  // equirect, as version 3 writes it
+    bytes = as_version(bytes, 1);
+    write_bytes(path, bytes);
+    const Table loaded = read_table(path);
+    EXPECT_EQ(loaded.map.options().mapping, Mapping::equirect);
+    expect_identical_samples(map_, loaded.map, 4, 1000);
+    bytes[kMappingByte] = 2;
+    reseal(bytes);
+    write_bytes(path, bytes);
+    expect_rejected(path, "unknown mapping");
+}
+
+// Version 2 is version 3 without the metadata padding; its payload may be misaligned in
+// the file, so it is read into memory rather than used from a mapping.
+TEST_F(TableTest, VersionTwoTablesStillRead) {
+    const fs::path path = saved_table();
+    write_bytes(path, as_version(bytes_of(path), 2));
+    const Table loaded = read_table(path);
+    EXPECT_FALSE(loaded.mapped);
+    expect_identical_samples(map_, loaded.map, 5, 1000);
+}
+
+// Version 3 pads the metadata block with zeros to a multiple of 8 bytes, so that the
+// payload's arrays are aligned; anything else there is an error.
+TEST_F(TableTest, MetadataPaddingIsZerosToAMultipleOfEight) {
+    const fs::path path = saved_table();
+    std::vector<char> bytes = bytes_of(path);
+    const uint32_t m = u32_at(bytes, kMetadataSizeAt);
+    EXPECT_EQ(m % 8, 0u);
+    ASSERT_GT(m, unpadded_metadata(bytes)) << "choose a source name that needs padding";
+    bytes[kPreamble + m - 1] = 1;
+    reseal(bytes);
+    write_bytes(path, bytes);
+    expect_rejected(path, "unexpected bytes");
+}
+
+// By default a full table's radiance is used in place from a mapping of the file (where
+// the platform has mmap); loading with TableLoading::copy reads it into memory. Both
+// give the saved map, bit for bit.
+TEST_F(TableTest, MappedAndCopiedLoadsAreBitIdentical) {
+    const fs::path path = saved_table();
+    const Table mapped = read_table(path), copied = read_table(path, TableLoading::copy);
+#if defined(__unix__) || defined(__APPLE__)
+    EXPECT_TRUE(mapped.mapped);
+#endif
+    EXPECT_FALSE(copied.mapped);
+    expect_identical_samples(map_, mapped.map, 6, 100000);
+    expect_identical_samples(map_, copied.map, 6, 1000);
+    ASSERT_EQ(mapped.map.radiance().pixels.size(), map_.radiance().pixels.size());
+    EXPECT_EQ(std::memcmp(mapped.map.radiance().pixels.data(), map_.radiance().pixels.data(),
+                          map_.radiance().pixels.size_bytes()),
+              0);
+    // Compact tables decode their radiance: nothing to map.
+    write_table(path, map_, source_, TableEncoding::compact);
+    EXPECT_FALSE(read_table(path).mapped);
+}
+
+// write_table replaces a file by renaming a new one over it: a map loaded from the old
+// file, and copies of that map, keep sampling it after the loaded Table is gone.
+TEST_F(TableTest, AMappedMapOutlivesItsTableAndTheFilesReplacement) {
+    const fs::path path = saved_table();
+    EnvMap kept;
+    {
+        const Table t = read_table(path);
+        kept = t.map;
+    }
+    write_table(path, EnvMap(test::constant_map(8, 4, {1, 2, 3})), source_);
+    expect_identical_samples(map_, kept, 7, 10000);
+}
+
+TEST_F(TableTest, NewerVersionsAreRejectedWithAnUpgradeHint) {
+    const fs::path path = saved_table();
+    std::vector<char> bytes = bytes_of(path);
+    const uint32_t newer = kTableVersion + 1;
+    std::memcpy(bytes.data() + 8, &newer, sizeof newer);
+    write_bytes(path, bytes);
+    expect_rejected(path, "newer than this envmis reads");
+}
+
+TEST_F(TableTest, ImplausibleSizesAreRejectedBeforeAllocating) {
+    const fs::path path = saved_table();
+    std::vector<char> bytes = bytes_of(path);
+    const uint64_t huge = uint64_t{1} << 62;
+    std::memcpy(bytes.data() + 16, &huge, sizeof huge);  // total file size
+    write_bytes(path, bytes);
+    expect_rejected(path, "truncated");
+    bytes = bytes_of(saved_table());
+    const uint32_t big = 1u << 30;
+    std::memcpy(bytes.data() + 24, &big, sizeof big);  // metadata size
+    write_bytes(path, bytes);
+    expect_rejected(path, "too large");
+}
+
+TEST_F(TableTest, WritingIsAtomic) {
+    const fs::path path = saved_table();
+    const auto before = bytes_of(path);
+    // A destination in a missing folder fails, leaving nothing behind.
+    EXPECT_THROW(write_table(dir_ / "missing" / "x.envmis", map_, source_), TableError);
+    EXPECT_FALSE(fs::exists(dir_ / "missing"));
+    // Overwriting replaces the file whole and leaves no temporary file.
+    write_table(path, EnvMap(test::constant_map(8, 4, {1, 2, 3})), source_);
+    EXPECT_NE(bytes_of(path).size(), before.size());
+    size_t files = 0;
+    for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir_)) ++files;
+    EXPECT_EQ(files, 1u);
+}
+
+TEST(TableParse, InMemoryBytesGiveTheSameErrors) {
+    const std::vector<std::byte> empty;
+    EXPECT_THROW(parse_table(empty, "mem"), TableError);
+    const std::vector<std::byte> junk(100, std::byte{0x89});
+    EXPECT_THROW(parse_table(junk, "mem"), TableError);
+}
+
+}  // namespace
+}  // namespace envmis

@@ -1,0 +1,143 @@
+// Specification of the analytic BSDFs (bsdf.h): sampling matches pdf, pdf integrates to
+// 1 over the sphere, energy is conserved.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "envmis/study/shading/bsdf.h"
+#include "envmis/math/random.h"
+#include "stats.h"
+
+namespace envmis {
+namespace {
+
+const double kLevel = test::sidak_level(0.01, 12);
+
+std::vector<Bsdf> bsdfs() { return {Bsdf::lambert(), Bsdf::phong(5), Bsdf::phong(50), Bsdf::ggx(0.5f), Bsdf::ggx(0.1f)}; }
+std::vector<Vec3> views() { return {normalize(Vec3{0, 0, 1}), normalize(Vec3{0.6f, 0.1f, 0.5f}), normalize(Vec3{-0.9f, 0.2f, 0.15f})}; }
+
+// Direction at the centre of cell (i, j) of an nz x nphi grid equal-area in (z, phi).
+constexpr int kZ = 48, kPhi = 96, kSub = 6;
+Vec3 grid_direction(double zi, double pj) {
+    const double z = -1 + 2 * zi / kZ, phi = 2 * kPi * pj / kPhi, r = std::sqrt(std::max(0.0, 1 - z * z));
+    return {static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z)};
+}
+int grid_cell(Vec3 d) {
+    const int zi = std::clamp(static_cast<int>((d.z + 1) / 2 * kZ), 0, kZ - 1);
+    double phi = std::atan2(d.y, d.x);
+    if (phi < 0) phi += 2 * kPi;
+    return zi * kPhi + std::clamp(static_cast<int>(phi / (2 * kPi) * kPhi), 0, kPhi - 1);
+}
+// Probability of each grid cell under bsdf.pdf, by the midpoint rule on sub-cells.
+std::vector<double> cell_probabilities(const Bsdf& bsdf, Vec3 wo) {
+    std::vector<double> p(kZ * kPhi);
+    const double sub_area = 4 * kPi / (double{kZ} * kPhi * kSub * kSub);
+    for (int zi = 0; zi < kZ; ++zi)
+        for (int pj = 0; pj < kPhi; ++pj)
+            for (int a = 0; a < kSub; ++a)
+                for (int b = 0; b < kSub; ++b)
+                    p[zi * kPhi + pj] += bsdf.pdf(wo, grid_direction(zi + (a + 0.5) / kSub, pj + (b + 0.5) / kSub)) * sub_area;
+    return p;
+}
+
+TEST(Bsdf, SamplesFollowThePdf) {
+    uint64_t seed = 1;
+    for (const Bsdf& bsdf : bsdfs())
+        for (Vec3 wo : views()) {
+            const std::vector<double> p = cell_probabilities(bsdf, wo);
+            const int n = 300000;
+            std::vector<double> observed(p.size()), expected(p.size());
+            Pcg32 rng(seed++);
+            for (int i = 0; i < n; ++i) {
+                const BsdfSample s = bsdf.sample(wo, rng.uniform2());
+                if (s.pdf > 0) observed[grid_cell(s.wi)] += 1;
+            }
+            for (size_t c = 0; c < p.size(); ++c) expected[c] = n * p[c];
+            const auto chi = test::chi_square(expected, observed);
+            EXPECT_GT(chi.p_value, kLevel / 15) << bsdf.name() << " wo.z=" << wo.z << ": " << chi.describe();
+        }
+}
+
+TEST(Bsdf, PdfIntegratesToOneOverTheSphere) {
+    // Midpoint rule, equal-area in (z, phi), fine enough for the sharpest lobe here.
+    constexpr int nz = 3000, nphi = 1000;
+    for (const Bsdf& bsdf : bsdfs())
+        for (Vec3 wo : views()) {
+            double integral = 0;
+            for (int i = 0; i < nz; ++i) {
+                const double z = -1 + 2 * (i + 0.5) / nz, r = std::sqrt(1 - z * z);
+                for (int j = 0; j < nphi; ++j) {
+                    const double phi = 2 * kPi * (j + 0.5) / nphi;
+                    integral += bsdf.pdf(wo, {static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
+                                              static_cast<float>(z)});
+                }
+            }
+            integral *= 4 * kPi / (double{nz} * nphi);
+            Pcg32 rng(3);
+            int usable = 0;
+            const int n = 200000;
+            for (int i = 0; i < n; ++i) usable += bsdf.sample(wo, rng.uniform2()).pdf > 0;
+            // Every BSDF samples with a density, also where the direction goes below the
+            // surface (and carries no value): the pdf integrates to 1 over the sphere.
+            EXPECT_NEAR(integral, 1.0, 1e-3) << bsdf.name() << " wo.z=" << wo.z;
+            EXPECT_GT(usable, n - 10) << bsdf.name();
+        }
+}
+
+TEST(Bsdf, SampleReturnsEvalAndPdfOfItsDirection) {
+    for (const Bsdf& bsdf : bsdfs())
+        for (Vec3 wo : views()) {
+            Pcg32 rng(4);
+            for (int i = 0; i < 2000; ++i) {
+                const BsdfSample s = bsdf.sample(wo, rng.uniform2());
+                EXPECT_NEAR(length(s.wi), 1.0f, 1e-4f);
+                EXPECT_FLOAT_EQ(s.pdf, bsdf.pdf(wo, s.wi));
+                EXPECT_FLOAT_EQ(s.value.g, bsdf.eval(wo, s.wi).g);
+            }
+        }
+}
+
+TEST(Bsdf, WhiteFurnaceAlbedoIsAtMostOne) {
+    const Rgb white{1, 1, 1};
+    for (Bsdf bsdf : {Bsdf::lambert(white), Bsdf::phong(1, white), Bsdf::phong(50, white), Bsdf::ggx(0.1f, white), Bsdf::ggx(0.3f, white), Bsdf::ggx(1, white)})
+        for (Vec3 wo : views()) {
+            // Importance-sampled estimate of the directional albedo, integral of f cos.
+            Pcg32 rng(5);
+            double sum = 0;
+            const int n = 200000;
+            for (int i = 0; i < n; ++i) {
+                const BsdfSample s = bsdf.sample(wo, rng.uniform2());
+                if (s.pdf > 0) sum += s.value.g / s.pdf;
+            }
+            const double albedo = sum / n;
+            EXPECT_LE(albedo, 1.0 + 1e-2) << bsdf.name() << " wo.z=" << wo.z;
+            if (bsdf.kind == BsdfKind::lambert) {
+                EXPECT_NEAR(albedo, 1.0, 1e-6) << "a white Lambertian reflects everything";
+            }
+            if (bsdf.kind == BsdfKind::ggx && bsdf.alpha <= 0.1f && wo.z == 1) {
+                // 0.988 by independent quadrature: a smooth conductor loses little to multiple scattering.
+                EXPECT_NEAR(albedo, 0.988, 5e-3) << bsdf.name();
+            }
+        }
+}
+
+TEST(Bsdf, NothingBelowTheSurface) {
+    for (const Bsdf& bsdf : bsdfs()) {
+        EXPECT_EQ(bsdf.eval({0, 0, 1}, {0, 0.6f, -0.8f}).g, 0.0f);
+        EXPECT_EQ(bsdf.eval({0, 0.6f, -0.8f}, {0, 0, 1}).g, 0.0f);
+        EXPECT_EQ(bsdf.sample({0, 0.6f, -0.8f}, {0.3f, 0.3f}).pdf, 0.0f);
+    }
+}
+
+TEST(Bsdf, ParseAndName) {
+    EXPECT_EQ(Bsdf::parse("lambert").kind, BsdfKind::lambert);
+    EXPECT_EQ(Bsdf::parse("phong:50").exponent, 50.0f);
+    EXPECT_EQ(Bsdf::parse("ggx:0.1").alpha, 0.1f);
+    for (const Bsdf& b : bsdfs()) EXPECT_EQ(Bsdf::parse(b.name()).name(), b.name());
+    for (const char* bad : {"", "lambert:1", "phong", "phong:-1", "ggx:0", "ggx:2", "ggx:x", "metal"})
+        EXPECT_THROW(Bsdf::parse(bad), std::invalid_argument) << bad;
+}
+
+}  // namespace
+}  // namespace envmis
