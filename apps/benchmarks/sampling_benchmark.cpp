@@ -8,8 +8,8 @@
 #include <random>
 #include <vector>
 
-#include "envmis/study/comparison/comparison.h"
 #include "envmis/sampling/envmap.h"
+#include "envmis/study/comparison/comparison.h"
 #include "envmis/study/techniques/estimator.h"
 #include "reference.h"
 
@@ -46,8 +46,8 @@ void build(benchmark::State& state) {
         Sampler s(std::move(copy), envmis::EnvMapOptions{});
         benchmark::DoNotOptimize(s);
     }
-    state.counters["Mtexels/s"] = benchmark::Counter(static_cast<double>(image.pixels.size()) * state.iterations() / 1e6,
-                                                     benchmark::Counter::kIsRate);
+    state.counters["Mtexels/s"] = benchmark::Counter(
+        static_cast<double>(image.pixels.size()) * state.iterations() / 1e6, benchmark::Counter::kIsRate);
 }
 
 // What a renderer's hot loop calls: the guided sampler through its view (EnvMap's own
@@ -82,16 +82,16 @@ void sample_batch(benchmark::State& state) {
     static const std::vector<float> ux = coordinate(&envmis::Vec2::x), uy = coordinate(&envmis::Vec2::y);
     std::vector<float> out(7 * kBatch);
     float* o = out.data();
-    const envmis::SampleArrays arrays{o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch, o + 4 * kBatch, o + 5 * kBatch,
-                                      o + 6 * kBatch};
+    const envmis::SampleArrays arrays{
+        o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch, o + 4 * kBatch, o + 5 * kBatch, o + 6 * kBatch};
     size_t first = 0;
     for (auto _ : state) {
         envmis::sample_many(view, {ux.data() + first, uy.data() + first}, arrays, kBatch);
         benchmark::DoNotOptimize(o);
         first = (first + kBatch) & (ux.size() - 1);
     }
-    state.counters["per_sample"] = benchmark::Counter(static_cast<double>(kBatch),
-                                                      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+    state.counters["per_sample"] = benchmark::Counter(
+        static_cast<double>(kBatch), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 // Uniformly distributed directions, made before timing: the pdf benchmark times the
@@ -150,9 +150,18 @@ BENCHMARK(sample<TextbookEnvMap>)->Name("sample/textbook")->Apply(sizes_ns);
 BENCHMARK(sample_batch)->Name("sample/guided-many")->Apply(sizes_ns);
 BENCHMARK(pdf<EnvMap>)->Name("pdf/guided")->Apply(sizes_ns);
 BENCHMARK(pdf<TextbookEnvMap>)->Name("pdf/textbook")->Apply(sizes_ns);
-BENCHMARK_CAPTURE(estimate, mis_balance_lambert, "mis-balance", envmis::Bsdf::lambert())->Name("estimate/mis-balance/lambert")->Args({1024, 1})->Args({1024, 64});
-BENCHMARK_CAPTURE(estimate, mis_balance_comp_lambert, "mis-balance-comp", envmis::Bsdf::lambert())->Name("estimate/mis-balance-comp/lambert")->Args({1024, 1})->Args({1024, 64});
-BENCHMARK_CAPTURE(estimate, mis_balance_ggx, "mis-balance", envmis::Bsdf::ggx(0.1f))->Name("estimate/mis-balance/ggx:0.1")->Args({1024, 1})->Args({1024, 64});
+BENCHMARK_CAPTURE(estimate, mis_balance_lambert, "mis-balance", envmis::Bsdf::lambert())
+    ->Name("estimate/mis-balance/lambert")
+    ->Args({1024, 1})
+    ->Args({1024, 64});
+BENCHMARK_CAPTURE(estimate, mis_balance_comp_lambert, "mis-balance-comp", envmis::Bsdf::lambert())
+    ->Name("estimate/mis-balance-comp/lambert")
+    ->Args({1024, 1})
+    ->Args({1024, 64});
+BENCHMARK_CAPTURE(estimate, mis_balance_ggx, "mis-balance", envmis::Bsdf::ggx(0.1f))
+    ->Name("estimate/mis-balance/ggx:0.1")
+    ->Args({1024, 1})
+    ->Args({1024, 64});
 
 }  // namespace
 

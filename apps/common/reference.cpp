@@ -43,7 +43,8 @@ RgbImage synthetic_sky(uint32_t w, uint32_t h) {
     RgbImage sky{w, h, std::vector<Rgb>(size_t{w} * h)};
     const double sun_theta = kPi / 4, sun_phi = kPi / 3, sun_radius = 0.25 * kPi / 180;
     const Vec3 sun{static_cast<float>(std::sin(sun_theta) * std::cos(sun_phi)),
-                   static_cast<float>(std::sin(sun_theta) * std::sin(sun_phi)), static_cast<float>(std::cos(sun_theta))};
+                   static_cast<float>(std::sin(sun_theta) * std::sin(sun_phi)),
+                   static_cast<float>(std::cos(sun_theta))};
     const float cos_radius = static_cast<float>(std::cos(sun_radius));
     for (uint32_t y = 0; y < h; ++y)
         for (uint32_t x = 0; x < w; ++x) {

@@ -39,7 +39,8 @@ void add_map_flags(CLI::App& app, MapFlags& flags) {
         ->type_name("ALPHA|auto")
         ->default_str("1")
         ->check(alpha_value);
-    app.add_option("--mapping", flags.mapping, "Image mapping: equirect (latitude-longitude) or equal-area (octahedral, square)")
+    app.add_option("--mapping", flags.mapping,
+                   "Image mapping: equirect (latitude-longitude) or equal-area (octahedral, square)")
         ->capture_default_str()
         ->check(CLI::IsMember({"equirect", "equal-area"}));
     app.add_option("--colorspace", flags.colorspace, "Input colour space (default: from the file's metadata)");
@@ -134,8 +135,8 @@ void print_summary(std::ostream& out, const LoadedMap& loaded) {
     const double texels = static_cast<double>(m.width()) * m.height();
     const auto flags = out.flags();
     out << std::setprecision(4);
-    out << "  source        " << loaded.source.name << " (" << loaded.format << ", hash " << std::hex
-        << std::setw(16) << std::setfill('0') << loaded.source.content_hash << std::dec << std::setfill(' ') << ")\n";
+    out << "  source        " << loaded.source.name << " (" << loaded.format << ", hash " << std::hex << std::setw(16)
+        << std::setfill('0') << loaded.source.content_hash << std::dec << std::setfill(' ') << ")\n";
     out << "  size          " << m.width() << " x " << m.height() << "\n";
     out << "  colour        " << loaded.source.input_colorspace << " -> " << loaded.source.working_colorspace
         << ", luma (" << o.luma.r << ", " << o.luma.g << ", " << o.luma.b << ")\n";
@@ -154,12 +155,12 @@ void print_summary(std::ostream& out, const LoadedMap& loaded) {
         out << "  alpha auto    " << c->alpha << " of " << c->candidates.size()
             << " candidates, by the exact variance of mis-balance-comp over mis-balance on a " << c->width << "x"
             << c->height << " copy (" << std::setprecision(3) << 1e3 * c->seconds << std::setprecision(4) << " ms)\n";
-    out << "  bad pixels    " << s.bad_pixels.nan << " NaN, " << s.bad_pixels.infinite << " Inf, " << s.bad_pixels.negative
-        << " negative channel values (replaced by 0)\n";
+    out << "  bad pixels    " << s.bad_pixels.nan << " NaN, " << s.bad_pixels.infinite << " Inf, "
+        << s.bad_pixels.negative << " negative channel values (replaced by 0)\n";
     out << "  fallback      " << to_string(s.fallback) << "\n";
     out << "  complete pdf  " << (m.complete() ? "yes" : "no: combine with BSDF sampling through MIS") << "\n";
-    out << "  memory        " << std::setprecision(3) << m.distribution().bytes() / texels << " bytes/texel (distribution) + "
-        << sizeof(Rgb) << " (radiance)\n";
+    out << "  memory        " << std::setprecision(3) << m.distribution().bytes() / texels
+        << " bytes/texel (distribution) + " << sizeof(Rgb) << " (radiance)\n";
     out.flags(flags);
 }
 

@@ -12,8 +12,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "envmis/study/comparison/alpha.h"
 #include "envmis/sampling/envmap.h"
+#include "envmis/study/comparison/alpha.h"
 #include "envmis/table/table.h"
 
 namespace envmis::cli {
@@ -23,7 +23,7 @@ struct MapFlags {
     bool no_compensate = false;
     float alpha = 1.0f;
     bool alpha_auto = false;  // --alpha auto: choose_alpha() (alpha.h) picks it, map-wide
-    std::string colorspace;                 // input colour space; empty: from the file
+    std::string colorspace;   // input colour space; empty: from the file
     std::string working_space = "lin_rec709";
     std::string axes = "z-up";
     std::string mapping = "equirect";  // or "equal-area" (a square image)
@@ -35,7 +35,7 @@ struct LoadedMap {
     EnvMap map;
     TableSource source;
     bool from_table = false;
-    std::string format;  // "envmis table", "openexr", "hdr", ...
+    std::string format;          // "envmis table", "openexr", "hdr", ...
     uint32_t table_version = 0;  // the table file's format version
     bool mapped = false;         // the map borrows its radiance from a mapping of the table file
     uint32_t channels = 3;

@@ -64,7 +64,8 @@ struct BatchInputs {
     double sample_cost(const EnvMapView& view) {
         return ns_per_item(ux.size(), [&](size_t first, uint32_t n, float* o) {
             sample_many(view, {ux.data() + first, uy.data() + first},
-                        {o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch, o + 4 * kBatch, o + 5 * kBatch, o + 6 * kBatch}, n);
+                        {o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch, o + 4 * kBatch, o + 5 * kBatch, o + 6 * kBatch},
+                        n);
         });
     }
     double lookup_cost(const EnvMapView& view) {
@@ -106,114 +107,118 @@ Subcommand add_bench(CLI::App& app) {
         "bench", "Time building and sampling, guided-CDF sampler versus the textbook sampler (medians of repeats)");
     sub->add_option("input", args->input, "HDR image or table (default: a synthetic sky with a small sun)");
     sub->add_option("--size", args->size, "Size of the synthetic sky, WxH")->capture_default_str();
-    sub->add_option("--repeats", args->repeats, "Repeats of each measurement")->capture_default_str()->check(CLI::PositiveNumber);
-    sub->add_option("--samples", args->samples, "Samples and pdf evaluations per repeat")->capture_default_str()->check(CLI::PositiveNumber);
+    sub->add_option("--repeats", args->repeats, "Repeats of each measurement")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    sub->add_option("--samples", args->samples, "Samples and pdf evaluations per repeat")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
     sub->add_flag("--no-compensate", args->no_compensate, "Measure the uncompensated density");
     sub->add_flag("--json", args->json, "Print one JSON object instead of text lines");
-    return {sub, [args] {
-                RgbImage image;
-                std::string map_name;
-                if (args->input.empty()) {
-                    unsigned w = 0, h = 0;
-                    char x = 0;
-                    if (std::sscanf(args->size.c_str(), "%u%c%u", &w, &x, &h) != 3 || x != 'x' || !w || !h ||
-                        w > kMaxCells1D || h > kMaxCells1D)
-                        throw std::runtime_error("--size '" + args->size + "': expected WxH, each 1 to 65536");
-                    image = reference::synthetic_sky(w, h);
-                    map_name = "synthetic-sky";
-                } else {
-                    MapFlags flags;
-                    flags.no_compensate = true;
-                    image = to_image(load_map(args->input, flags).map.radiance());
-                    map_name = args->input;
-                }
-                EnvMapOptions options;
-                options.compensation.enabled = !args->no_compensate;
+    return {
+        sub, [args] {
+            RgbImage image;
+            std::string map_name;
+            if (args->input.empty()) {
+                unsigned w = 0, h = 0;
+                char x = 0;
+                if (std::sscanf(args->size.c_str(), "%u%c%u", &w, &x, &h) != 3 || x != 'x' || !w || !h ||
+                    w > kMaxCells1D || h > kMaxCells1D)
+                    throw std::runtime_error("--size '" + args->size + "': expected WxH, each 1 to 65536");
+                image = reference::synthetic_sky(w, h);
+                map_name = "synthetic-sky";
+            } else {
+                MapFlags flags;
+                flags.no_compensate = true;
+                image = to_image(load_map(args->input, flags).map.radiance());
+                map_name = args->input;
+            }
+            EnvMapOptions options;
+            options.compensation.enabled = !args->no_compensate;
 
-                std::mt19937_64 rng(7);
-                auto uniform = [&rng] { return static_cast<float>(rng() >> 40) * 0x1p-24f; };
-                std::vector<Vec2> us(args->samples);
-                for (Vec2& u : us) u = {uniform(), uniform()};
-                std::vector<Vec3> directions(args->samples);
-                for (Vec3& d : directions) {
-                    const float z = 1 - 2 * uniform(), phi = 2 * kPiF * uniform(), r = std::sqrt(std::max(0.0f, 1 - z * z));
-                    d = {r * std::cos(phi), r * std::sin(phi), z};
-                }
+            std::mt19937_64 rng(7);
+            auto uniform = [&rng] { return static_cast<float>(rng() >> 40) * 0x1p-24f; };
+            std::vector<Vec2> us(args->samples);
+            for (Vec2& u : us) u = {uniform(), uniform()};
+            std::vector<Vec3> directions(args->samples);
+            for (Vec3& d : directions) {
+                const float z = 1 - 2 * uniform(), phi = 2 * kPiF * uniform(), r = std::sqrt(std::max(0.0f, 1 - z * z));
+                d = {r * std::cos(phi), r * std::sin(phi), z};
+            }
 
-                Progress progress("bench", 3 * args->repeats);
-                int step = 0;
-                const auto [guided, guided_build] = build_repeatedly<EnvMap>(
-                    image, args->repeats, [&](RgbImage& copy) { return EnvMap(std::move(copy), options); }, progress, step);
-                const auto [textbook, textbook_build] = build_repeatedly<reference::TextbookEnvMap>(
-                    image, args->repeats, [&](RgbImage&) { return reference::TextbookEnvMap(image, options); }, progress,
-                    step);
-                // Sampling and pdf times: the two samplers back to back in each repeat, so
-                // that the ratios compare like with like on a machine whose speed drifts.
-                const auto sample_cost = [&](const auto& sampler) {
-                    return ns_per_call(us, [&](Vec2 u) {
-                        const EnvSample s = sampler.sample(u);
-                        return s.pdf + s.direction.x + s.radiance.r;
-                    });
-                };
-                const auto pdf_cost = [&](const auto& sampler) {
-                    return ns_per_call(directions, [&](Vec3 d) { return sampler.pdf(d); });
-                };
-                // The guided sampler through its view, as a renderer's hot loop uses it: the
-                // view's flat arrays are read once, not rebuilt from the map at every call.
-                // guided-batch is the same sampler through sample_many and lookup_many (the
-                // latter finds the radiance too), as a wavefront renderer would call it.
-                const EnvMapView view = guided->view();
-                BatchInputs batch(us, directions);
-                std::vector<double> times[6], ratios[4];
-                for (int r = 0; r < args->repeats; ++r) {
-                    const double t[6] = {sample_cost(view),        sample_cost(*textbook),   pdf_cost(view),
-                                         pdf_cost(*textbook),      batch.sample_cost(view), batch.lookup_cost(view)};
-                    for (int k = 0; k < 6; ++k) times[k].push_back(t[k]);
-                    ratios[0].push_back(t[1] / t[0]);
-                    ratios[1].push_back(t[3] / t[2]);
-                    ratios[2].push_back(t[1] / t[4]);
-                    ratios[3].push_back(t[3] / t[5]);
-                    progress.update(++step);
-                }
-                const double texels = static_cast<double>(image.width) * image.height;
-                const double guided_bytes = guided->distribution().bytes() / texels;
-                const std::vector<Timing> timings = {
-                    {"guided", guided_build, median(times[0]), median(times[2]), guided_bytes},
-                    {"guided-batch", guided_build, median(times[4]), median(times[5]), guided_bytes},
-                    {"textbook", textbook_build, median(times[1]), median(times[3]), textbook->distribution_bytes() / texels}};
-                const double build_speedup = textbook_build / guided_build, sample_speedup = median(ratios[0]),
-                             pdf_speedup = median(ratios[1]), batch_sample_speedup = median(ratios[2]),
-                             batch_pdf_speedup = median(ratios[3]);
-                if (args->json) {
-                    nlohmann::json j = {{"map", map_name},
-                                        {"width", image.width},
-                                        {"height", image.height},
-                                        {"compensated", !args->no_compensate},
-                                        {"repeats", args->repeats},
-                                        {"samples", args->samples}};
-                    for (const Timing& t : timings)
-                        j["samplers"].push_back({{"sampler", t.sampler},
-                                                 {"build_ms", t.build_ms},
-                                                 {"ns_per_sample", t.ns_per_sample},
-                                                 {"ns_per_pdf", t.ns_per_pdf},
-                                                 {"bytes_per_texel", t.bytes_per_texel}});
-                    j["speedup_vs_textbook"] = {{"build", build_speedup},
-                                                {"sample", sample_speedup},
-                                                {"pdf", pdf_speedup},
-                                                {"batch_sample", batch_sample_speedup},
-                                                {"batch_pdf", batch_pdf_speedup}};
-                    std::cout << j.dump(2) << "\n";
-                    return;
-                }
-                std::printf("map=%s size=%ux%u compensated=%d repeats=%d samples=%u (medians)\n", map_name.c_str(),
-                            image.width, image.height, !args->no_compensate, args->repeats, args->samples);
+            Progress progress("bench", 3 * args->repeats);
+            int step = 0;
+            const auto [guided, guided_build] = build_repeatedly<EnvMap>(
+                image, args->repeats, [&](RgbImage& copy) { return EnvMap(std::move(copy), options); }, progress, step);
+            const auto [textbook, textbook_build] = build_repeatedly<reference::TextbookEnvMap>(
+                image, args->repeats, [&](RgbImage&) { return reference::TextbookEnvMap(image, options); }, progress,
+                step);
+            // Sampling and pdf times: the two samplers back to back in each repeat, so
+            // that the ratios compare like with like on a machine whose speed drifts.
+            const auto sample_cost = [&](const auto& sampler) {
+                return ns_per_call(us, [&](Vec2 u) {
+                    const EnvSample s = sampler.sample(u);
+                    return s.pdf + s.direction.x + s.radiance.r;
+                });
+            };
+            const auto pdf_cost = [&](const auto& sampler) {
+                return ns_per_call(directions, [&](Vec3 d) { return sampler.pdf(d); });
+            };
+            // The guided sampler through its view, as a renderer's hot loop uses it: the
+            // view's flat arrays are read once, not rebuilt from the map at every call.
+            // guided-batch is the same sampler through sample_many and lookup_many (the
+            // latter finds the radiance too), as a wavefront renderer would call it.
+            const EnvMapView view = guided->view();
+            BatchInputs batch(us, directions);
+            std::vector<double> times[6], ratios[4];
+            for (int r = 0; r < args->repeats; ++r) {
+                const double t[6] = {sample_cost(view),   sample_cost(*textbook),  pdf_cost(view),
+                                     pdf_cost(*textbook), batch.sample_cost(view), batch.lookup_cost(view)};
+                for (int k = 0; k < 6; ++k) times[k].push_back(t[k]);
+                ratios[0].push_back(t[1] / t[0]);
+                ratios[1].push_back(t[3] / t[2]);
+                ratios[2].push_back(t[1] / t[4]);
+                ratios[3].push_back(t[3] / t[5]);
+                progress.update(++step);
+            }
+            const double texels = static_cast<double>(image.width) * image.height;
+            const double guided_bytes = guided->distribution().bytes() / texels;
+            const std::vector<Timing> timings = {
+                {"guided", guided_build, median(times[0]), median(times[2]), guided_bytes},
+                {"guided-batch", guided_build, median(times[4]), median(times[5]), guided_bytes},
+                {"textbook", textbook_build, median(times[1]), median(times[3]),
+                 textbook->distribution_bytes() / texels}};
+            const double build_speedup = textbook_build / guided_build, sample_speedup = median(ratios[0]),
+                         pdf_speedup = median(ratios[1]), batch_sample_speedup = median(ratios[2]),
+                         batch_pdf_speedup = median(ratios[3]);
+            if (args->json) {
+                nlohmann::json j = {{"map", map_name},          {"width", image.width},
+                                    {"height", image.height},   {"compensated", !args->no_compensate},
+                                    {"repeats", args->repeats}, {"samples", args->samples}};
                 for (const Timing& t : timings)
-                    std::printf("sampler=%s build_ms=%.1f ns_per_sample=%.1f ns_per_pdf=%.1f bytes_per_texel=%.2f\n",
-                                t.sampler.c_str(), t.build_ms, t.ns_per_sample, t.ns_per_pdf, t.bytes_per_texel);
-                std::printf("speedup_vs_textbook build=%.2fx sample=%.2fx pdf=%.2fx batch_sample=%.2fx "
-                            "batch_pdf=%.2fx (sample, pdf: median of the ratios within each repeat)\n",
-                            build_speedup, sample_speedup, pdf_speedup, batch_sample_speedup, batch_pdf_speedup);
-            }};
+                    j["samplers"].push_back({{"sampler", t.sampler},
+                                             {"build_ms", t.build_ms},
+                                             {"ns_per_sample", t.ns_per_sample},
+                                             {"ns_per_pdf", t.ns_per_pdf},
+                                             {"bytes_per_texel", t.bytes_per_texel}});
+                j["speedup_vs_textbook"] = {{"build", build_speedup},
+                                            {"sample", sample_speedup},
+                                            {"pdf", pdf_speedup},
+                                            {"batch_sample", batch_sample_speedup},
+                                            {"batch_pdf", batch_pdf_speedup}};
+                std::cout << j.dump(2) << "\n";
+                return;
+            }
+            std::printf("map=%s size=%ux%u compensated=%d repeats=%d samples=%u (medians)\n", map_name.c_str(),
+                        image.width, image.height, !args->no_compensate, args->repeats, args->samples);
+            for (const Timing& t : timings)
+                std::printf("sampler=%s build_ms=%.1f ns_per_sample=%.1f ns_per_pdf=%.1f bytes_per_texel=%.2f\n",
+                            t.sampler.c_str(), t.build_ms, t.ns_per_sample, t.ns_per_pdf, t.bytes_per_texel);
+            std::printf(
+                "speedup_vs_textbook build=%.2fx sample=%.2fx pdf=%.2fx batch_sample=%.2fx "
+                "batch_pdf=%.2fx (sample, pdf: median of the ratios within each repeat)\n",
+                build_speedup, sample_speedup, pdf_speedup, batch_sample_speedup, batch_pdf_speedup);
+        }};
 }
 
 }  // namespace envmis::cli

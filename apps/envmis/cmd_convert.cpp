@@ -6,28 +6,29 @@
 #include <memory>
 
 #include "cli.h"
-#include "envmis/io/image_io.h"
 #include "envmis/image/remap.h"
+#include "envmis/io/image_io.h"
 
 namespace envmis::cli {
 
 Subcommand add_convert(CLI::App& app) {
     struct Args {
-        std::string input, output, from = "equirect", to = "equal-area", size, colorspace,
-                                   working_space = "lin_rec709";
+        std::string input, output, from = "equirect", to = "equal-area", size, colorspace, working_space = "lin_rec709";
         uint32_t supersampling = 0;
     };
     auto args = std::make_shared<Args>();
-    CLI::App* sub = app.add_subcommand(
-        "convert", "Remap an environment image between equirect and equal-area octahedral (pbrt-v4) mappings, "
-                   "conserving power");
+    CLI::App* sub =
+        app.add_subcommand("convert",
+                           "Remap an environment image between equirect and equal-area octahedral (pbrt-v4) mappings, "
+                           "conserving power");
     sub->add_option("input", args->input, "HDR image")->required();
     sub->add_option("-o,--output", args->output, "OpenEXR file to write (float RGB)")->required();
     const auto mappings = CLI::IsMember({"equirect", "equal-area"});
     sub->add_option("--from", args->from, "Mapping of the input")->capture_default_str()->check(mappings);
     sub->add_option("--to", args->to, "Mapping of the output")->capture_default_str()->check(mappings);
-    sub->add_option("--size", args->size,
-                    "Output size: N (equal-area N x N, equirect 2N x N) or WxH (default: about the input's texel count)");
+    sub->add_option(
+        "--size", args->size,
+        "Output size: N (equal-area N x N, equirect 2N x N) or WxH (default: about the input's texel count)");
     sub->add_option("--supersampling", args->supersampling,
                     "Sub-samples per input texel side (default 0: automatic, at least 16 per output texel)")
         ->check(CLI::Range(0u, 64u));

@@ -25,8 +25,8 @@ Subcommand add_info(CLI::App& app) {
                 else
                     std::cout << "image, " << loaded.channels << " channels\n";
                 print_summary(std::cout, loaded);
-                std::cout << std::fixed << std::setprecision(1) << "  time          load " << loaded.load_ms
-                          << " ms" << (loaded.from_table ? " (includes rebuilding the sampler)" : "") << ", build "
+                std::cout << std::fixed << std::setprecision(1) << "  time          load " << loaded.load_ms << " ms"
+                          << (loaded.from_table ? " (includes rebuilding the sampler)" : "") << ", build "
                           << loaded.build_ms << " ms\n";
                 if (const std::string memory = resident_memory(); !memory.empty())
                     std::cout << "  process       " << memory << "\n";

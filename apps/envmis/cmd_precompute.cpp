@@ -41,8 +41,9 @@ Subcommand add_precompute(CLI::App& app) {
     CLI::App* sub = app.add_subcommand("precompute", "Build the sampling table of an HDR map and save it");
     sub->add_option("input", args->input, "HDR image (EXR, .hdr, .pfm, TIFF, ...)")->required();
     sub->add_option("-o,--output", args->output, "Table file to write (.envmis)")->required();
-    sub->add_flag("--compact", args->compact,
-                  "Store the radiance in RGBE (4 bytes/texel instead of 16; density rebuilt on load); prints the error");
+    sub->add_flag(
+        "--compact", args->compact,
+        "Store the radiance in RGBE (4 bytes/texel instead of 16; density rebuilt on load); prints the error");
     add_map_flags(*sub, args->map);
     return {sub, [args] {
                 const LoadedMap loaded = load_map(args->input, args->map);

@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -31,7 +31,8 @@ json read_results(const std::string& path) {
     } catch (const json::exception& e) {
         throw std::runtime_error(path + ": not JSON (" + e.what() + ")");
     }
-    const bool measured = (j.contains("results") && j["results"].is_array()) || j.contains("sweep") || j.contains("allocation");
+    const bool measured =
+        (j.contains("results") && j["results"].is_array()) || j.contains("sweep") || j.contains("allocation");
     if (!j.contains("inputs") || !measured)
         throw std::runtime_error(path + ": not the JSON of envmis compare (no inputs and results)");
     return j;
@@ -55,7 +56,8 @@ struct Case {
 // logarithm (from the points' relative standard errors); nullopt without per-point data.
 std::optional<std::pair<double, double>> paired_ratio(const Case& c, const std::string& a, const std::string& b) {
     const auto pa = c.points.find(a), pb = c.points.find(b);
-    if (pa == c.points.end() || pb == c.points.end() || pa->second.first.size() != pb->second.first.size()) return std::nullopt;
+    if (pa == c.points.end() || pb == c.points.end() || pa->second.first.size() != pb->second.first.size())
+        return std::nullopt;
     double log_sum = 0, se2 = 0;
     size_t n = 0;
     for (size_t p = 0; p < pa->second.first.size(); ++p) {
@@ -84,7 +86,8 @@ void write_strength(std::ostream& out, const std::vector<json>& runs) {
         if (!run.contains("sweep_best")) continue;
         if (!header) {
             out << "## Compensation strength: `--alpha auto` against the sweep\n\n"
-                << "Variance of mis-balance-comp relative to mis-balance at each alpha of the sweep (exact, by quadrature, "
+                << "Variance of mis-balance-comp relative to mis-balance at each alpha of the sweep (exact, by "
+                   "quadrature, "
                    "when the sweep ran with `--exact`); auto's choice (exact variances on a 128-wide copy of the map) "
                    "against the sweep's best alpha and against alpha = 0 (no compensation).\n\n"
                 << "| map | bsdf | best alpha | best ratio | auto alpha | auto / best | auto / alpha 0 |\n"
@@ -97,8 +100,8 @@ void write_strength(std::ostream& out, const std::vector<json>& runs) {
             within += vs_best <= 1.05, never_worse += vs_zero <= 1.05, ++total;
             out << "| " << run["inputs"].value("map", "?") << " | " << b["bsdf"].get<std::string>() << " | "
                 << number(b["best_alpha"], "%.3g") << " | " << number(b["best_ratio"], "%.3f") << " | "
-                << number(b["auto_alpha"], "%.3g") << " | " << number(vs_best, "%.3f") << " | " << number(vs_zero, "%.3f")
-                << " |\n";
+                << number(b["auto_alpha"], "%.3g") << " | " << number(vs_best, "%.3f") << " | "
+                << number(vs_zero, "%.3f") << " |\n";
         }
     }
     if (total)
@@ -114,9 +117,11 @@ void write_allocation(std::ostream& out, const std::vector<json>& runs) {
         if (!header) {
             out << "## Sample allocation\n\n"
                 << "For a fixed number of samples per estimate, every split between environment and BSDF samples; "
-                   "efficiency = 1 / (variance x time per estimate). The best split, and its efficiency relative to the "
+                   "efficiency = 1 / (variance x time per estimate). The best split, and its efficiency relative to "
+                   "the "
                    "even (or nearest to even) split.\n\n"
-                << "| map | bsdf | technique | best env:bsdf | efficiency | vs even split |\n|---|---|---|---:|---:|---:|\n";
+                << "| map | bsdf | technique | best env:bsdf | efficiency | vs even split "
+                   "|\n|---|---|---|---:|---:|---:|\n";
             header = true;
         }
         std::map<std::pair<std::string, std::string>, std::vector<const json*>> groups;
@@ -127,7 +132,8 @@ void write_allocation(std::ostream& out, const std::vector<json>& runs) {
             for (const json* r : rows) {
                 if (!best || (*r)["efficiency"].get<double>() > (*best)["efficiency"].get<double>()) best = r;
                 const int gap = std::abs((*r)["env_samples"].get<int>() - (*r)["bsdf_samples"].get<int>());
-                if (!even || gap < std::abs((*even)["env_samples"].get<int>() - (*even)["bsdf_samples"].get<int>())) even = r;
+                if (!even || gap < std::abs((*even)["env_samples"].get<int>() - (*even)["bsdf_samples"].get<int>()))
+                    even = r;
             }
             out << "| " << run["inputs"].value("map", "?") << " | " << key.first << " | " << key.second << " | "
                 << (*best)["env_samples"].get<int>() << ":" << (*best)["bsdf_samples"].get<int>() << " | "
@@ -138,16 +144,18 @@ void write_allocation(std::ostream& out, const std::vector<json>& runs) {
     if (header) out << "\n";
 }
 
-void write_report(std::ostream& out, const std::vector<json>& runs, const std::string& title, const std::string& command,
-                  const std::string& plots) {
+void write_report(std::ostream& out, const std::vector<json>& runs, const std::string& title,
+                  const std::string& command, const std::string& plots) {
     std::vector<std::string> techniques;  // in the order of the first run that has them
     std::vector<Case> cases;
     for (const json& run : runs) {
         const std::string map = run["inputs"].value("map", "?");
         for (const json& r : run.value("results", json::array())) {
             const std::string bsdf = r["bsdf"], technique = r["technique"];
-            if (std::find(techniques.begin(), techniques.end(), technique) == techniques.end()) techniques.push_back(technique);
-            auto it = std::find_if(cases.begin(), cases.end(), [&](const Case& c) { return c.map == map && c.bsdf == bsdf; });
+            if (std::find(techniques.begin(), techniques.end(), technique) == techniques.end())
+                techniques.push_back(technique);
+            auto it =
+                std::find_if(cases.begin(), cases.end(), [&](const Case& c) { return c.map == map && c.bsdf == bsdf; });
             if (it == cases.end()) it = cases.insert(cases.end(), Case{map, bsdf, {}, {}});
             it->ratio[technique] = r["variance_ratio_vs_mis"];
             if (r.contains("point_variances") && r.contains("point_variance_rel_se"))
@@ -159,10 +167,12 @@ void write_report(std::ostream& out, const std::vector<json>& runs, const std::s
 
     out << "# " << title << "\n\n";
     if (!command.empty()) out << "Made by `" << command << "`.\n\n";
-    const auto with_results = std::find_if(runs.begin(), runs.end(), [](const json& r) { return r.contains("results"); });
+    const auto with_results =
+        std::find_if(runs.begin(), runs.end(), [](const json& r) { return r.contains("results"); });
     const json& first = (with_results != runs.end() ? *with_results : runs.front())["inputs"];
-    out << "Every technique spends the same number of samples per estimate (" << first.value("env_samples", 1) << " environment + "
-        << first.value("bsdf_samples", 1) << " BSDF for MIS). Figures are variances of one estimate relative to balance "
+    out << "Every technique spends the same number of samples per estimate (" << first.value("env_samples", 1)
+        << " environment + " << first.value("bsdf_samples", 1)
+        << " BSDF for MIS). Figures are variances of one estimate relative to balance "
         << "MIS over the plain density (`mis-balance`), as the geometric mean over " << first.value("points_done", 0)
         << " shading points of the per-point ratios; " << first.value("spp", 0)
         << " estimates per point. Below 1 is better than balance MIS.\n\n";
@@ -198,13 +208,15 @@ void write_report(std::ostream& out, const std::vector<json>& runs, const std::s
     }
     out << "\n\n";
     if (!best.empty())
-        out << "**Lowest variance of the MIS techniques across the table: `" << best << "`, " << number(1 / best_ratio, "%.2f")
-            << "x lower variance than balance MIS (geometric mean over " << cases.size() << " cases).**\n\n";
+        out << "**Lowest variance of the MIS techniques across the table: `" << best << "`, "
+            << number(1 / best_ratio, "%.2f") << "x lower variance than balance MIS (geometric mean over "
+            << cases.size() << " cases).**\n\n";
 
     // Optimal MIS against balance MIS over the same density, case by case, with the
     // noise of the measured variances.
-    const std::pair<const char*, const char*> pairs[] = {
-        {"mis-optimal", "mis-balance"}, {"mis-optimal-comp", "mis-balance-comp"}, {"mis-optimal-all", "mis-balance-all"}};
+    const std::pair<const char*, const char*> pairs[] = {{"mis-optimal", "mis-balance"},
+                                                         {"mis-optimal-comp", "mis-balance-comp"},
+                                                         {"mis-optimal-all", "mis-balance-all"}};
     bool header = false;
     size_t cases_within = 0, cases_total = 0;
     for (const Case& c : cases)
@@ -213,18 +225,21 @@ void write_report(std::ostream& out, const std::vector<json>& runs, const std::s
             if (!r) continue;
             if (!header) {
                 out << "## Optimal weights against balance weights over the same density\n\n"
-                    << "Variance of optimal MIS over that of balance MIS sampling the same densities: geometric mean over the "
-                       "points, with the standard error of its logarithm (from 8 interleaved batches per point). Within "
+                    << "Variance of optimal MIS over that of balance MIS sampling the same densities: geometric mean "
+                       "over the "
+                       "points, with the standard error of its logarithm (from 8 interleaved batches per point). "
+                       "Within "
                        "error: at most 2 standard errors above 1.\n\n"
-                    << "| map | bsdf | optimal | balance | variance optimal / balance | log std. error | <= 1 within error |\n"
+                    << "| map | bsdf | optimal | balance | variance optimal / balance | log std. error | <= 1 within "
+                       "error |\n"
                     << "|---|---|---|---|---:|---:|---|\n";
                 header = true;
             }
             const bool within = std::log(r->first) <= 2 * r->second;
             cases_within += within, ++cases_total;
             out << "| " << c.map << " | " << c.bsdf << " | " << optimal << " | " << balance << " | "
-                << number(r->first, "%.3f") << " | " << number(r->second, "%.3f") << " | " << (within ? "yes" : "**no**")
-                << " |\n";
+                << number(r->first, "%.3f") << " | " << number(r->second, "%.3f") << " | "
+                << (within ? "yes" : "**no**") << " |\n";
         }
     if (header)
         out << "\nOptimal MIS is at most balance MIS within error in " << cases_within << " of " << cases_total
@@ -249,9 +264,10 @@ void write_report(std::ostream& out, const std::vector<json>& runs, const std::s
     for (const json& run : runs) {
         if (!run.contains("results")) continue;
         const json& in = run["inputs"];
-        out << "## " << in.value("map", "?") << " (" << in.value("width", 0) << "x" << in.value("height", 0) << "), alpha "
-            << number(in.value("alpha", 1.0), "%.3g") << "\n\n"
-            << "| bsdf | technique | mean | reference | variance | std_error | rel_mse | ns/estimate | efficiency | var/mis |\n"
+        out << "## " << in.value("map", "?") << " (" << in.value("width", 0) << "x" << in.value("height", 0)
+            << "), alpha " << number(in.value("alpha", 1.0), "%.3g") << "\n\n"
+            << "| bsdf | technique | mean | reference | variance | std_error | rel_mse | ns/estimate | efficiency | "
+               "var/mis |\n"
             << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
         for (const json& r : run["results"])
             out << "| " << r["bsdf"].get<std::string>() << " | " << r["technique"].get<std::string>() << " | "
@@ -281,8 +297,9 @@ Subcommand add_report(CLI::App& app) {
     return {sub, [args] {
                 std::vector<json> runs;
                 for (const std::string& path : args->inputs) runs.push_back(read_results(path));
-                write_file_atomically(args->output,
-                                      [&](std::ostream& out) { write_report(out, runs, args->title, args->command, args->plots); });
+                write_file_atomically(args->output, [&](std::ostream& out) {
+                    write_report(out, runs, args->title, args->command, args->plots);
+                });
                 std::cout << "report: " << args->output << " (" << runs.size() << " runs)\n";
             }};
 }

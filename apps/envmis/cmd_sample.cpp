@@ -55,7 +55,8 @@ Subcommand add_sample(CLI::App& app) {
     };
     auto args = std::make_shared<Args>();
     CLI::App* sub = app.add_subcommand(
-        "sample", "Draw directions from a map's sampler: CSV u,v,x,y,z,pdf (image point, world direction, solid-angle pdf)");
+        "sample",
+        "Draw directions from a map's sampler: CSV u,v,x,y,z,pdf (image point, world direction, solid-angle pdf)");
     sub->add_option("input", args->input, "Table (.envmis) or HDR image")->required();
     sub->add_option("-n,--count", args->count, "Number of samples")->capture_default_str();
     sub->add_option("--seed", args->seed, "Random seed")->capture_default_str();

@@ -46,7 +46,8 @@ Subcommand add_visualize(CLI::App& app) {
                 EnvMapOptions other_options = loaded.map.options();
                 other_options.compensation.enabled = !loaded_compensated;
                 const EnvMap other(to_image(loaded.map.radiance()), other_options);
-                const EnvMap* maps[2] = {loaded_compensated ? &other : &loaded.map, loaded_compensated ? &loaded.map : &other};
+                const EnvMap* maps[2] = {loaded_compensated ? &other : &loaded.map,
+                                         loaded_compensated ? &loaded.map : &other};
                 const EnvMapOptions& plain = maps[0]->options();
                 const EnvMapOptions& compensated = maps[1]->options();
 
@@ -58,11 +59,14 @@ Subcommand add_visualize(CLI::App& app) {
                 const pictures::ColourScale scale = pictures::shared_log_scale({pdfs[0], pdfs[1]});
 
                 char caption[256];
-                std::snprintf(caption, sizeof caption, "%s  %ux%u  mean luminance %.3g  alpha %.3g: compensation zeroes %.1f%% of texels",
-                              loaded.source.name.c_str(), w, h, maps[1]->stats().mean_luminance, compensated.compensation.alpha,
+                std::snprintf(caption, sizeof caption,
+                              "%s  %ux%u  mean luminance %.3g  alpha %.3g: compensation zeroes %.1f%% of texels",
+                              loaded.source.name.c_str(), w, h, maps[1]->stats().mean_luminance,
+                              compensated.compensation.alpha,
                               100.0 * maps[1]->stats().zeroed_texels / (static_cast<double>(w) * h));
                 const pictures::Panel panels[] = {
-                    {pictures::tonemap(pictures::resize(loaded.map.radiance(), pw, ph), 0, plain.luma), "radiance (tone-mapped)", false},
+                    {pictures::tonemap(pictures::resize(loaded.map.radiance(), pw, ph), 0, plain.luma),
+                     "radiance (tone-mapped)", false},
                     {pictures::false_colour(pdfs[0], pw, ph, scale), "pdf without compensation", true},
                     {pictures::false_colour(pdfs[1], pw, ph, scale), "pdf with compensation", true}};
                 const io::Image8 bar = pictures::colour_bar(scale, "solid-angle pdf [1/sr]", 2 * pw);

@@ -10,8 +10,9 @@ int main(int argc, char** argv) {
     CLI::App app{"envmis: importance sampling of HDR environment maps, with and without MIS compensation"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "envmis 0.1.0");
-    const std::vector<Subcommand> subcommands = {add_compare(app), add_report(app),    add_precompute(app), add_info(app),
-                                                 add_sample(app),  add_visualize(app), add_bench(app), add_convert(app)};
+    const std::vector<Subcommand> subcommands = {add_compare(app), add_report(app), add_precompute(app),
+                                                 add_info(app),    add_sample(app), add_visualize(app),
+                                                 add_bench(app),   add_convert(app)};
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -30,8 +30,8 @@ struct Scene {
 };
 
 // Renders one technique: each pixel the mean of `spp` estimates, rows shared among threads.
-RgbImage render(const Scene& scene, const DirectLightingEstimator& estimator, const std::vector<Bsdf>& bsdfs, uint32_t spp,
-                uint64_t seed, uint32_t threads, const std::atomic<bool>* stop) {
+RgbImage render(const Scene& scene, const DirectLightingEstimator& estimator, const std::vector<Bsdf>& bsdfs,
+                uint32_t spp, uint64_t seed, uint32_t threads, const std::atomic<bool>* stop) {
     RgbImage image{scene.w, scene.h, std::vector<Rgb>(size_t{scene.w} * scene.h)};
     std::atomic<uint32_t> next_row{0};
     auto work = [&] {
@@ -73,7 +73,8 @@ io::Image8 crop(const io::Image8& image, uint32_t x0, uint32_t width) {
 }
 
 io::Image8 stack(const io::Image8& top, const io::Image8& bottom) {
-    io::Image8 out = pictures::make_image(std::max(top.width, bottom.width), top.height + bottom.height, pictures::Style{}.background);
+    io::Image8 out = pictures::make_image(std::max(top.width, bottom.width), top.height + bottom.height,
+                                          pictures::Style{}.background);
     pictures::blit(out, top, 0, 0);
     pictures::blit(out, bottom, 0, static_cast<int>(top.height));
     return out;
@@ -81,26 +82,28 @@ io::Image8 stack(const io::Image8& top, const io::Image8& bottom) {
 
 }  // namespace
 
-std::filesystem::path render_comparison(const EnvMap& plain, const EnvMap& compensated, const ComparisonOptions& options,
-                                        const RenderOptions& render_options, const std::filesystem::path& folder,
-                                        const std::string& map_name, const std::atomic<bool>* stop) {
+std::filesystem::path render_comparison(const EnvMap& plain, const EnvMap& compensated,
+                                        const ComparisonOptions& options, const RenderOptions& render_options,
+                                        const std::filesystem::path& folder, const std::string& map_name,
+                                        const std::atomic<bool>* stop) {
     unsigned w = 0, h = 0;
     char x = 0;
-    if (std::sscanf(render_options.size.c_str(), "%u%c%u", &w, &x, &h) != 3 || x != 'x' || w < 16 || h < 16 || w > 8192 ||
-        h > 8192)
+    if (std::sscanf(render_options.size.c_str(), "%u%c%u", &w, &x, &h) != 3 || x != 'x' || w < 16 || h < 16 ||
+        w > 8192 || h > 8192)
         throw std::runtime_error("--image '" + render_options.size + "': expected WxH, each 16 to 8192");
     std::filesystem::create_directories(folder);
     const auto spheres = static_cast<uint32_t>(options.bsdfs.size());
     const Scene scene{w, h, spheres, 0.45f * std::min(static_cast<float>(w) / spheres, static_cast<float>(h))};
 
-    const RgbImage reference = render(scene, DirectLightingEstimator(plain, Technique::parse("mis-power"), options.allocation),
-                                      options.bsdfs, render_options.reference_spp, options.seed ^ 0x5eed, options.threads, stop);
+    const RgbImage reference =
+        render(scene, DirectLightingEstimator(plain, Technique::parse("mis-power"), options.allocation), options.bsdfs,
+               render_options.reference_spp, options.seed ^ 0x5eed, options.threads, stop);
     io::write_exr(folder / "reference.exr", reference);
     std::vector<std::pair<std::string, RgbImage>> renders;
     for (const Technique& t : options.techniques) {
         const DirectLightingEstimator estimator(plain, compensated, t, options.allocation);
-        renders.emplace_back(t.name(), render(scene, estimator, options.bsdfs, render_options.spp, options.seed,
-                                              options.threads, stop));
+        renders.emplace_back(
+            t.name(), render(scene, estimator, options.bsdfs, render_options.spp, options.seed, options.threads, stop));
         io::write_exr(folder / (t.name() + ".exr"), renders.back().second);
     }
 
@@ -115,7 +118,8 @@ std::filesystem::path render_comparison(const EnvMap& plain, const EnvMap& compe
     for (uint32_t i = 0; i < renders.size(); ++i) place(renders[i].second, i + 1);
     const io::Image8 shown = pictures::tonemap(wide, 0, plain.options().luma);
 
-    std::vector<pictures::Panel> top = {{crop(shown, 0, w), "reference (" + std::to_string(render_options.reference_spp) + " spp)"}};
+    std::vector<pictures::Panel> top = {
+        {crop(shown, 0, w), "reference (" + std::to_string(render_options.reference_spp) + " spp)"}};
     io::write_png(folder / "reference.png", top[0].image);
     std::vector<std::vector<float>> errors;
     std::vector<double> mean_errors;
@@ -139,9 +143,9 @@ std::filesystem::path render_comparison(const EnvMap& plain, const EnvMap& compe
     std::string bsdf_names;
     for (const Bsdf& b : options.bsdfs) bsdf_names += (bsdf_names.empty() ? "" : ", ") + b.name();
     char caption[256];
-    std::snprintf(caption, sizeof caption, "%s: %s at %u spp (%u env + %u BSDF samples each), alpha %.3g", map_name.c_str(),
-                  bsdf_names.c_str(), render_options.spp, options.allocation.env, options.allocation.bsdf,
-                  compensated.options().compensation.alpha);
+    std::snprintf(caption, sizeof caption, "%s: %s at %u spp (%u env + %u BSDF samples each), alpha %.3g",
+                  map_name.c_str(), bsdf_names.c_str(), render_options.spp, options.allocation.env,
+                  options.allocation.bsdf, compensated.options().compensation.alpha);
     const io::Image8 montage = stack(pictures::montage(top, caption), pictures::montage(bottom, "", &bar));
     const std::filesystem::path path = folder / "montage.png";
     io::write_png(path, montage);

@@ -19,8 +19,9 @@ struct RenderOptions {
 
 // Writes reference.{exr,png}, <technique>.{exr,png}, <technique>-relmse.png and
 // montage.png into `folder` (created if missing). Returns the montage's path.
-std::filesystem::path render_comparison(const EnvMap& plain, const EnvMap& compensated, const ComparisonOptions& options,
-                                        const RenderOptions& render, const std::filesystem::path& folder,
-                                        const std::string& map_name, const std::atomic<bool>* stop);
+std::filesystem::path render_comparison(const EnvMap& plain, const EnvMap& compensated,
+                                        const ComparisonOptions& options, const RenderOptions& render,
+                                        const std::filesystem::path& folder, const std::string& map_name,
+                                        const std::atomic<bool>* stop);
 
 }  // namespace envmis::cli

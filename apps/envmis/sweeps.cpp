@@ -136,9 +136,7 @@ nlohmann::json alpha_choice_json(const AlphaChoice& choice, std::span<const Bsdf
 }
 
 std::vector<float> parse_alpha_sweep(const std::string& text) {
-    auto fail = [&](const std::string& why) {
-        return std::runtime_error("--alpha-sweep '" + text + "': " + why);
-    };
+    auto fail = [&](const std::string& why) { return std::runtime_error("--alpha-sweep '" + text + "': " + why); };
     double a0 = 0, a1 = 0, step = 0;
     char tail = 0;
     if (std::sscanf(text.c_str(), "%lf:%lf:%lf%c", &a0, &a1, &step, &tail) != 3 || !std::isfinite(a0) ||
@@ -193,8 +191,8 @@ AlphaSweep run_alpha_sweep(const EnvMap& plain, std::span<const float> alphas, s
     if (exact) baseline = exact_variances(plain, kBalance, options.allocation, options.bsdfs, points, 1);
     for (size_t i = 0; i < alphas.size(); ++i) {
         const EnvMap compensated = compensated_map(plain, alphas[i]);
-        Comparison c = compare(plain, compensated, points, sweep_options(options), stop,
-                               run_progress(progress, i, points.size()));
+        Comparison c =
+            compare(plain, compensated, points, sweep_options(options), stop, run_progress(progress, i, points.size()));
         if (c.points_done < points.size() || (stop && stop->load())) {
             sweep.interrupted = true;
             break;
@@ -211,8 +209,8 @@ AlphaSweep run_alpha_sweep(const EnvMap& plain, std::span<const float> alphas, s
 
 void print_alpha_sweep(std::ostream& out, const AlphaSweep& sweep, const std::vector<float>* auto_alphas) {
     char line[256];
-    std::snprintf(line, sizeof line, "%-8s %-10s %-17s %11s %8s %8s %8s %11s\n", "alpha", "bsdf", "technique", "variance",
-                  "var/mis", "exact", "ns/est", "efficiency");
+    std::snprintf(line, sizeof line, "%-8s %-10s %-17s %11s %8s %8s %8s %11s\n", "alpha", "bsdf", "technique",
+                  "variance", "var/mis", "exact", "ns/est", "efficiency");
     out << line;
     for (size_t i = 0; i < sweep.alphas.size(); ++i)
         for (size_t b = 0; b < sweep.comparisons[i].bsdfs.size(); ++b) {
@@ -268,10 +266,12 @@ nlohmann::json alpha_sweep_summary_json(const AlphaSweep& sweep, const std::vect
 }
 
 pictures::LinePlot alpha_sweep_plot(const AlphaSweep& sweep, const std::string& map_name) {
-    pictures::LinePlot plot{"Compensation strength: " + map_name, "alpha",
-                      std::string("var(mis-balance-comp) / var(mis-balance), ") +
-                          (sweep.exact.empty() ? "measured" : "exact"),
-                      {}, true};
+    pictures::LinePlot plot{
+        "Compensation strength: " + map_name,
+        "alpha",
+        std::string("var(mis-balance-comp) / var(mis-balance), ") + (sweep.exact.empty() ? "measured" : "exact"),
+        {},
+        true};
     for (size_t b = 0; !sweep.alphas.empty() && b < sweep.comparisons.front().bsdfs.size(); ++b) {
         pictures::Series series{sweep.comparisons.front().bsdfs[b].bsdf.name(), {}, {}};
         for (size_t i = 0; i < sweep.alphas.size(); ++i) {
@@ -298,7 +298,8 @@ std::vector<Technique> allocation_sweep_techniques(std::span<const Technique> re
     for (const Technique& t : requested)
         if (t.strategy == Strategy::mis || t.strategy == Strategy::one_sample) add_unique(list, t);
     if (list.empty())
-        throw std::runtime_error("--allocation-sweep: none of --techniques combines environment and BSDF samples (mis-*, one-sample*)");
+        throw std::runtime_error(
+            "--allocation-sweep: none of --techniques combines environment and BSDF samples (mis-*, one-sample*)");
     return list;
 }
 
@@ -310,7 +311,8 @@ AllocationSweep run_allocation_sweep(const EnvMap& plain, const CompensatedMaps&
     ComparisonOptions run = sweep_options(options);
     for (uint32_t k = 1; k < total; ++k) {
         run.allocation = {k, total - k};
-        Comparison c = compare_each(plain, compensated, points, run, stop, run_progress(progress, k - 1, points.size()));
+        Comparison c =
+            compare_each(plain, compensated, points, run, stop, run_progress(progress, k - 1, points.size()));
         if (c.points_done < points.size() || (stop && stop->load())) {
             sweep.interrupted = true;
             break;
@@ -323,8 +325,8 @@ AllocationSweep run_allocation_sweep(const EnvMap& plain, const CompensatedMaps&
 
 void print_allocation_sweep(std::ostream& out, const AllocationSweep& sweep) {
     char line[256];
-    std::snprintf(line, sizeof line, "%-8s %-10s %-17s %11s %8s %8s %11s\n", "env:bsdf", "bsdf", "technique", "variance",
-                  "var/mis", "ns/est", "efficiency");
+    std::snprintf(line, sizeof line, "%-8s %-10s %-17s %11s %8s %8s %11s\n", "env:bsdf", "bsdf", "technique",
+                  "variance", "var/mis", "ns/est", "efficiency");
     out << line;
     for (size_t i = 0; i < sweep.allocations.size(); ++i)
         for (const BsdfComparison& b : sweep.comparisons[i].bsdfs)
@@ -352,12 +354,16 @@ void print_allocation_sweep(std::ostream& out, const AllocationSweep& sweep) {
 pictures::LinePlot allocation_plot(const AllocationSweep& sweep, const std::string& map_name) {
     const uint32_t total = sweep.allocations.empty() ? 0 : sweep.allocations.front().total();
     pictures::LinePlot plot{"Sample allocation (" + std::to_string(total) + " per estimate): " + map_name,
-                      "environment samples per estimate", "efficiency, 1 / (variance x seconds per estimate)", {}, true};
+                            "environment samples per estimate",
+                            "efficiency, 1 / (variance x seconds per estimate)",
+                            {},
+                            true};
     if (sweep.allocations.empty()) return plot;
     const Comparison& first = sweep.comparisons.front();
     for (size_t b = 0; b < first.bsdfs.size(); ++b)
         for (size_t t = 0; t < first.bsdfs[b].techniques.size(); ++t) {
-            pictures::Series series{first.bsdfs[b].bsdf.name() + " " + first.bsdfs[b].techniques[t].technique.name(), {}, {}};
+            pictures::Series series{
+                first.bsdfs[b].bsdf.name() + " " + first.bsdfs[b].techniques[t].technique.name(), {}, {}};
             for (size_t i = 0; i < sweep.allocations.size(); ++i) {
                 series.x.push_back(sweep.allocations[i].env);
                 series.y.push_back(sweep.comparisons[i].bsdfs[b].techniques[t].efficiency);
@@ -368,12 +374,18 @@ pictures::LinePlot allocation_plot(const AllocationSweep& sweep, const std::stri
 }
 
 pictures::BarChart variance_chart(const Comparison& comparison, const std::string& map_name) {
-    pictures::BarChart chart{"Variance relative to mis-balance: " + map_name, "var / var(mis-balance), geometric mean over points",
-                       {}, {}, {}, true, 1.0};
+    pictures::BarChart chart{"Variance relative to mis-balance: " + map_name,
+                             "var / var(mis-balance), geometric mean over points",
+                             {},
+                             {},
+                             {},
+                             true,
+                             1.0};
     for (const BsdfComparison& b : comparison.bsdfs) {
         chart.groups.push_back(b.bsdf.name());
         std::vector<double> values;
-        for (const TechniqueStats& t : b.techniques) values.push_back(t.variance_ratio_vs_mis > 0 ? t.variance_ratio_vs_mis : kNaN);
+        for (const TechniqueStats& t : b.techniques)
+            values.push_back(t.variance_ratio_vs_mis > 0 ? t.variance_ratio_vs_mis : kNaN);
         chart.values.push_back(std::move(values));
     }
     if (!comparison.bsdfs.empty())
@@ -401,8 +413,8 @@ std::vector<SweepRow> sweep_rows(const AllocationSweep& sweep, const Compensated
         for (size_t b = 0; b < sweep.comparisons[i].bsdfs.size(); ++b) {
             const BsdfComparison& bc = sweep.comparisons[i].bsdfs[b];
             for (size_t t = 0; t < bc.techniques.size(); ++t)
-                rows.push_back({"allocation", compensated.alpha_of(b), sweep.allocations[i], &bc.bsdf, &bc.techniques[t],
-                                kNaN, sweep.best(b, t) == i});
+                rows.push_back({"allocation", compensated.alpha_of(b), sweep.allocations[i], &bc.bsdf,
+                                &bc.techniques[t], kNaN, sweep.best(b, t) == i});
         }
     return rows;
 }

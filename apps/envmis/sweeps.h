@@ -20,9 +20,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "envmis/pictures/plot.h"
 #include "envmis/study/comparison/alpha.h"
 #include "envmis/study/comparison/comparison.h"
-#include "envmis/pictures/plot.h"
 
 namespace envmis::cli {
 

@@ -35,12 +35,12 @@
 #include <thread>
 #include <vector>
 
-#include "envmis/study/shading/bsdf.h"
-#include "envmis/sampling/envmap.h"
-#include "envmis/study/shading/frame.h"
 #include "envmis/io/image_io.h"
-#include "envmis/pictures/picture.h"
 #include "envmis/math/random.h"
+#include "envmis/pictures/picture.h"
+#include "envmis/sampling/envmap.h"
+#include "envmis/study/shading/bsdf.h"
+#include "envmis/study/shading/frame.h"
 #include "envmis/table/table.h"
 
 namespace {
@@ -166,8 +166,7 @@ Rgb direct_lighting(const envmis::EnvMapView& env, const Scene& scene, const Hit
 }
 
 // Radiance along a camera ray: the map where it escapes, else the lit surface.
-Rgb trace(const envmis::EnvMapView& env, const Scene& scene, const Ray& ray, Technique technique,
-          envmis::Pcg32& rng) {
+Rgb trace(const envmis::EnvMapView& env, const Scene& scene, const Ray& ray, Technique technique, envmis::Pcg32& rng) {
     const std::optional<Hit> hit = scene.intersect(ray);
     if (!hit) return env.eval(ray.direction);
     return direct_lighting(env, scene, *hit, ray.direction * -1.0f, technique, rng);
@@ -186,7 +185,8 @@ struct Options {
 
 envmis::RgbImage render(const envmis::EnvMapView& env, const Options& o) {
     const Scene scene = make_scene();
-    const Camera camera({0, -7.5f, 2.2f}, {0, 0, 0.55f}, 30, static_cast<float>(o.width) / static_cast<float>(o.height));
+    const Camera camera({0, -7.5f, 2.2f}, {0, 0, 0.55f}, 30,
+                        static_cast<float>(o.width) / static_cast<float>(o.height));
     envmis::RgbImage image{o.width, o.height, std::vector<Rgb>(size_t{o.width} * o.height)};
     std::atomic<uint32_t> next_row{0};
     auto work = [&] {
@@ -305,8 +305,8 @@ uint64_t parse_number(std::string_view flag, const std::string& text, uint64_t l
         used = 0;
     }
     if (used != text.size() || text.empty() || text[0] == '-' || value < lo || value > hi)
-        throw UsageError(std::string(flag) + " '" + text + "': expected an integer from " +
-                                    std::to_string(lo) + " to " + std::to_string(hi));
+        throw UsageError(std::string(flag) + " '" + text + "': expected an integer from " + std::to_string(lo) +
+                         " to " + std::to_string(hi));
     return value;
 }
 
@@ -343,10 +343,14 @@ int main(int argc, char** argv) {
                 o.threads = static_cast<uint32_t>(parse_number(arg, value(), 1, 1024));
             } else if (arg == "--technique") {
                 const std::string t = value();
-                if (t == "mis") o.technique = Technique::mis;
-                else if (t == "env") o.technique = Technique::env;
-                else if (t == "bsdf") o.technique = Technique::bsdf;
-                else throw UsageError("--technique '" + t + "': expected mis, env or bsdf");
+                if (t == "mis")
+                    o.technique = Technique::mis;
+                else if (t == "env")
+                    o.technique = Technique::env;
+                else if (t == "bsdf")
+                    o.technique = Technique::bsdf;
+                else
+                    throw UsageError("--technique '" + t + "': expected mis, env or bsdf");
             } else if (arg == "--compare") {
                 compare = true;
             } else if (arg == "--expect-ratio") {
@@ -366,8 +370,7 @@ int main(int argc, char** argv) {
                 throw UsageError("--compare takes a reference and one or two images");
             return run_compare(positional, expect_ratio);
         }
-        if (positional.size() != 1 || o.output.extension() != ".exr")
-            throw UsageError("expected TABLE and -o OUT.exr");
+        if (positional.size() != 1 || o.output.extension() != ".exr") throw UsageError("expected TABLE and -o OUT.exr");
         o.table = positional[0];
         return run_render(o);
     } catch (const UsageError& e) {

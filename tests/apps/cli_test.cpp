@@ -67,7 +67,8 @@ struct Result {
 // Describes a run for failure messages.
 std::ostream& operator<<(std::ostream& os, const Result& r) {
     return os << "\n$ " << r.command << "\nexit code " << r.exit_code << "\n--- stdout:\n"
-              << r.out.substr(0, 2000) << "--- stderr:\n" << r.err;
+              << r.out.substr(0, 2000) << "--- stderr:\n"
+              << r.err;
 }
 
 // A regex search, case-insensitive, across lines.
@@ -105,7 +106,8 @@ Pixels constant(int w, int h, float r, float g, float b) {
 void write_exr(const fs::path& path, const Pixels& p) {
     OIIO::ImageSpec spec(p.w, p.h, 3, OIIO::TypeDesc::FLOAT);
     auto out = OIIO::ImageOutput::create("openexr");
-    if (!out || !out->open(path.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, p.rgb.data()) || !out->close())
+    if (!out || !out->open(path.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, p.rgb.data()) ||
+        !out->close())
         throw std::runtime_error("test setup: cannot write " + path.string());
 }
 
@@ -138,7 +140,8 @@ public:
             r.command.append(" ").append(a);
         }
         const fs::path out = dir_ / "..stdout", err = dir_ / "..stderr";
-        const int status = std::system((command + " > " + quoted(out.string()) + " 2> " + quoted(err.string())).c_str());
+        const int status =
+            std::system((command + " > " + quoted(out.string()) + " 2> " + quoted(err.string())).c_str());
         r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
         r.out = read_file(out);
         r.err = read_file(err);
@@ -231,11 +234,13 @@ INSTANTIATE_TEST_SUITE_P(
 TEST_F(Cli, TopLevelHelpListsEverySubcommand) {
     const Result r = envmis({"--help"});
     EXPECT_EQ(r.exit_code, 0) << r;
-    for (const char* s : {"precompute", "info", "sample", "visualize", "bench"}) EXPECT_TRUE(contains(r.out, s)) << s << r;
+    for (const char* s : {"precompute", "info", "sample", "visualize", "bench"})
+        EXPECT_TRUE(contains(r.out, s)) << s << r;
 }
 
 TEST_F(Cli, UsageErrorsExitNonZeroWithAMessage) {
-    for (const Result& r : {envmis({}), envmis({"frobnicate"}), envmis({"sample"}), envmis({"sample", "x.exr", "-n", "many"})}) {
+    for (const Result& r :
+         {envmis({}), envmis({"frobnicate"}), envmis({"sample"}), envmis({"sample", "x.exr", "-n", "many"})}) {
         EXPECT_NE(r.exit_code, 0) << r;
         EXPECT_FALSE(r.err.empty()) << r;
     }
@@ -246,13 +251,11 @@ TEST_F(Cli, UsageErrorsExitNonZeroWithAMessage) {
 
 // The summary that precompute and info print, for studio.exr.
 void expect_studio_summary(const Result& r) {
-    for (const char* line : {R"(size +1024 x 512\n)",
-                             R"(dynamic range [0-9.e+]+ \([0-9.]+ decades\))",
-                             R"(mean \(Lbar\) +[0-9.e+-]+ \(solid-angle weighted\))",
-                             R"(compensation +alpha 1, threshold [0-9.e+-]+, zeroed [0-9]+ texels .*\([0-9.]+%\))",
-                             R"(bad pixels +0 NaN, 0 Inf, 3 negative)",
-                             R"(fallback +none)",
-                             R"(time +load [0-9.]+ ms.*build [0-9.]+ ms)"})
+    for (const char* line :
+         {R"(size +1024 x 512\n)", R"(dynamic range [0-9.e+]+ \([0-9.]+ decades\))",
+          R"(mean \(Lbar\) +[0-9.e+-]+ \(solid-angle weighted\))",
+          R"(compensation +alpha 1, threshold [0-9.e+-]+, zeroed [0-9]+ texels .*\([0-9.]+%\))",
+          R"(bad pixels +0 NaN, 0 Inf, 3 negative)", R"(fallback +none)", R"(time +load [0-9.]+ ms.*build [0-9.]+ ms)"})
         EXPECT_TRUE(contains(r.out, line)) << "missing /" << line << "/" << r;
 }
 
@@ -268,8 +271,8 @@ TEST_F(Cli, PrecomputeWritesATableAndPrintsTheSummary) {
 // convert makes a square equal-area map with the same power; precompute samples it as
 // such when told, and says so; converting back gives the latitude-longitude size.
 TEST_F(Cli, ConvertToEqualAreaAndBack) {
-    const Result to = envmis({"convert", (kBundled / "studio.exr").string(), "-o", "square.exr", "--to", "equal-area",
-                              "--size", "128"});
+    const Result to = envmis(
+        {"convert", (kBundled / "studio.exr").string(), "-o", "square.exr", "--to", "equal-area", "--size", "128"});
     ASSERT_EQ(to.exit_code, 0) << to;
     EXPECT_TRUE(contains(to.out, R"(\(1024x512 equirect\) -> square.exr \(128x128 equal-area\))")) << to;
     const Result table = envmis({"precompute", "square.exr", "-o", "square.envmis", "--mapping", "equal-area"});
@@ -279,14 +282,14 @@ TEST_F(Cli, ConvertToEqualAreaAndBack) {
     EXPECT_TRUE(contains(info.out, R"(mapping +equal-area)")) << info;
     const Result square_as_equirect = envmis({"info", "square.exr"});
     EXPECT_TRUE(contains(square_as_equirect.err, "is square; it is read as equirect")) << square_as_equirect;
-    const Result back = envmis({"convert", "square.exr", "-o", "back.exr", "--from", "equal-area", "--to", "equirect",
-                                "--size", "64"});
+    const Result back =
+        envmis({"convert", "square.exr", "-o", "back.exr", "--from", "equal-area", "--to", "equirect", "--size", "64"});
     ASSERT_EQ(back.exit_code, 0) << back;
     EXPECT_TRUE(contains(back.out, R"(-> back.exr \(128x64 equirect\))")) << back;
     expect_one_line_error(envmis({"convert", "missing.exr", "-o", "x.exr"}), "missing.exr", "");
-    expect_one_line_error(envmis({"precompute", (kBundled / "studio.exr").string(), "-o", "x.envmis", "--mapping",
-                                  "equal-area"}),
-                          "studio.exr", "must be square");
+    expect_one_line_error(
+        envmis({"precompute", (kBundled / "studio.exr").string(), "-o", "x.envmis", "--mapping", "equal-area"}),
+        "studio.exr", "must be square");
 }
 
 TEST_F(Cli, InfoDescribesATableAndTheImageItCameFrom) {
@@ -319,7 +322,8 @@ TEST_F(Cli, SampleWritesTheHeaderAndOneRowPerSampleToStdoutOrAFile) {
     for (const auto& row : rows) EXPECT_EQ(row.size(), 6u);
 
     // The same seed gives the same samples, whether to stdout or to a file.
-    const Result to_file = envmis({"sample", (kBundled / "studio.exr").string(), "-n", "17", "--seed", "3", "-o", "s.csv"});
+    const Result to_file =
+        envmis({"sample", (kBundled / "studio.exr").string(), "-n", "17", "--seed", "3", "-o", "s.csv"});
     ASSERT_EQ(to_file.exit_code, 0) << to_file;
     EXPECT_EQ(to_file.out, "");
     EXPECT_EQ(read_file(file("s.csv")), r.out);
@@ -345,11 +349,13 @@ TEST_F(Cli, BenchPrintsOneLinePerSamplerWithTheDocumentedFields) {
     EXPECT_TRUE(contains(r.out, R"((^|\n)map=synthetic-sky size=256x128 compensated=1 repeats=1 samples=10000)")) << r;
     const std::string number = "[0-9]+(\\.[0-9]+)?";
     for (const char* sampler : {"guided", "guided-batch", "textbook"})
-        EXPECT_TRUE(contains(r.out, std::string("(^|\\n)sampler=") + sampler + " build_ms=" + number + " ns_per_sample=" +
-                                        number + " ns_per_pdf=" + number + " bytes_per_texel=" + number + "\\n"))
+        EXPECT_TRUE(contains(r.out, std::string("(^|\\n)sampler=") + sampler + " build_ms=" + number +
+                                        " ns_per_sample=" + number + " ns_per_pdf=" + number +
+                                        " bytes_per_texel=" + number + "\\n"))
             << sampler << r;
     EXPECT_TRUE(contains(r.out, "\\nspeedup_vs_textbook build=" + number + "x sample=" + number + "x pdf=" + number +
-                                    "x batch_sample=" + number + "x batch_pdf=" + number + "x ")) << r;
+                                    "x batch_sample=" + number + "x batch_pdf=" + number + "x "))
+        << r;
 }
 
 TEST_F(Cli, BenchJsonIsOneObjectWithTheSameFields) {
@@ -402,37 +408,38 @@ TEST_P(CliBadInput, EverySubcommandFailsWithOneLineNamingTheFileAndLeavesNoFiles
 
 INSTANTIATE_TEST_SUITE_P(
     Files, CliBadInput,
-    testing::Values(
-        BadInput{"MissingFile", "missing.exr", "no such file", [](Cli&, const fs::path&) {}},
-        BadInput{"TextFileNamedExr", "x.exr", "not (a|an) .*(image|openexr)",
-                 [](Cli&, const fs::path& p) { write_file(p, "this is not an image\n"); }},
-        BadInput{"TruncatedExr", "half.exr", "truncated|corrupt",
-                 [](Cli&, const fs::path& p) {
-                     const std::string bytes = read_file(kBundled / "city.exr");
-                     write_file(p, bytes.substr(0, bytes.size() / 2));
-                 }},
-        BadInput{"CorruptedTable", "corrupt.envmis", "corrupt",
-                 [](Cli& t, const fs::path& p) {
-                     // A byte of the radiance, before the final checksum.
-                     t.damaged_table(p, [](std::string& bytes) { bytes[bytes.size() - 100] ^= 0x5a; });
-                 }},
-        BadInput{"TruncatedTable", "half.envmis", "truncated",
-                 [](Cli& t, const fs::path& p) {
-                     t.damaged_table(p, [](std::string& bytes) { bytes.resize(bytes.size() / 2); });
-                 }},
-        BadInput{"RandomBytesNamedEnvmis", "random.envmis", "not (a|an) ",
-                 [](Cli&, const fs::path& p) {
-                     std::string bytes(5000, '\0');
-                     uint32_t x = 12345;
-                     for (char& b : bytes) b = static_cast<char>((x = x * 1664525u + 1013904223u) >> 24);
-                     write_file(p, bytes);
-                 }},
-        BadInput{"TableOfANewerVersion", "newer.envmis", "version 4.*newer",
-                 [](Cli& t, const fs::path& p) {
-                     // The format version: uint32, little-endian, at byte 8.
-                     t.damaged_table(p, [](std::string& bytes) { bytes.replace(8, 4, std::string("\x04\0\0\0", 4)); });
-                 }},
-        BadInput{"Folder", "folder.exr", "directory", [](Cli&, const fs::path& p) { fs::create_directory(p); }}),
+    testing::Values(BadInput{"MissingFile", "missing.exr", "no such file", [](Cli&, const fs::path&) {}},
+                    BadInput{"TextFileNamedExr", "x.exr", "not (a|an) .*(image|openexr)",
+                             [](Cli&, const fs::path& p) { write_file(p, "this is not an image\n"); }},
+                    BadInput{"TruncatedExr", "half.exr", "truncated|corrupt",
+                             [](Cli&, const fs::path& p) {
+                                 const std::string bytes = read_file(kBundled / "city.exr");
+                                 write_file(p, bytes.substr(0, bytes.size() / 2));
+                             }},
+                    BadInput{"CorruptedTable", "corrupt.envmis", "corrupt",
+                             [](Cli& t, const fs::path& p) {
+                                 // A byte of the radiance, before the final checksum.
+                                 t.damaged_table(p, [](std::string& bytes) { bytes[bytes.size() - 100] ^= 0x5a; });
+                             }},
+                    BadInput{"TruncatedTable", "half.envmis", "truncated",
+                             [](Cli& t, const fs::path& p) {
+                                 t.damaged_table(p, [](std::string& bytes) { bytes.resize(bytes.size() / 2); });
+                             }},
+                    BadInput{"RandomBytesNamedEnvmis", "random.envmis", "not (a|an) ",
+                             [](Cli&, const fs::path& p) {
+                                 std::string bytes(5000, '\0');
+                                 uint32_t x = 12345;
+                                 for (char& b : bytes) b = static_cast<char>((x = x * 1664525u + 1013904223u) >> 24);
+                                 write_file(p, bytes);
+                             }},
+                    BadInput{"TableOfANewerVersion", "newer.envmis", "version 4.*newer",
+                             [](Cli& t, const fs::path& p) {
+                                 // The format version: uint32, little-endian, at byte 8.
+                                 t.damaged_table(
+                                     p, [](std::string& bytes) { bytes.replace(8, 4, std::string("\x04\0\0\0", 4)); });
+                             }},
+                    BadInput{"Folder", "folder.exr", "directory",
+                             [](Cli&, const fs::path& p) { fs::create_directory(p); }}),
     [](const testing::TestParamInfo<BadInput>& info) { return info.param.name; });
 
 TEST_F(Cli, PrecomputeRefusesATableWithOneLine) {
@@ -486,7 +493,8 @@ TEST_F(Cli, AFailedRunLeavesAnExistingDestinationUntouched) {
 TEST_F(Cli, AnInterruptedSampleLeavesNoFiles) {
     write_exr(file("map.exr"), gradient(16, 8));
     const std::string cli = ENVMIS_CLI, out = file("out.csv").string(), map = file("map.exr").string();
-    std::vector<const char*> argv = {cli.c_str(), "sample", map.c_str(), "-n", "1000000000", "-o", out.c_str(), nullptr};
+    std::vector<const char*> argv = {cli.c_str(),  "sample", map.c_str(), "-n",
+                                     "1000000000", "-o",     out.c_str(), nullptr};
     pid_t pid = 0;
     ASSERT_EQ(posix_spawn(&pid, cli.c_str(), nullptr, nullptr, const_cast<char* const*>(argv.data()), environ), 0);
     // Interrupt once it is writing: when its temporary file has appeared (or after 10 s).
@@ -567,13 +575,15 @@ TEST_P(CliOddMap, PrecomputeReportsItAndEverySubcommandWorks) {
 INSTANTIATE_TEST_SUITE_P(
     Maps, CliOddMap,
     testing::Values(
-        OddMap{"NanInfAndNegativePixels", bad_values(),
+        OddMap{"NanInfAndNegativePixels",
+               bad_values(),
                {R"(bad pixels +2 NaN, 3 Inf, 4 negative channel values \(replaced by 0\))", "fallback +none"}},
         OddMap{"OneTexel", constant(1, 1, 1.0f, 2.0f, 3.0f), {R"(size +1 x 1\n)", "fallback +uncompensated"}},
         OddMap{"OddSize7x3", odd_size(), {R"(size +7 x 3\n)", "fallback +none"}},
         OddMap{"AllBlack", constant(32, 16, 0, 0, 0), {"fallback +uniform"}},
         OddMap{"Constant", constant(32, 16, 0.7f, 0.7f, 0.7f), {"fallback +uncompensated"}},
-        OddMap{"DynamicRange1e16", extreme_range(),
+        OddMap{"DynamicRange1e16",
+               extreme_range(),
                {R"(dynamic range 1(\.0+)?e\+16 \(16(\.0+)? decades\))", "fallback +none"}}),
     [](const testing::TestParamInfo<OddMap>& info) { return info.param.name; });
 

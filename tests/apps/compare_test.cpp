@@ -39,8 +39,8 @@ TEST(Compare, SinglePointVariancesMatchTheExactVariances) {
     ASSERT_EQ(results["results"].size(), 10u);
     for (const auto& r : results["results"]) {
         const Technique t = Technique::parse(r["technique"].get<std::string>());
-        const double exact = exact_variance(t.compensated ? compensated : plain, t, {}, Bsdf::parse(r["bsdf"].get<std::string>()),
-                                            point, 8);
+        const double exact = exact_variance(t.compensated ? compensated : plain, t, {},
+                                            Bsdf::parse(r["bsdf"].get<std::string>()), point, 8);
         // 200000 estimates of a map spanning two decades: the sample variance is within a
         // few percent; 8% is several of its standard errors.
         EXPECT_NEAR(r["variance"].get<double>(), exact, 0.08 * exact) << r["bsdf"] << " " << r["technique"];

@@ -129,7 +129,8 @@ Reference reference_distribution(const Luminance& l, bool compensated, const Rul
         double total = 0;
         for (uint32_t y = 0; y < l.h; ++y)
             for (uint32_t x = 0; x < l.w; ++x)
-                total += r.mass[r.texel(x, y)] = q_of(l.values[r.texel(x, y)]) * (rules.sin_theta ? row_sin_theta(y, l.h) : 1.0);
+                total += r.mass[r.texel(x, y)] =
+                    q_of(l.values[r.texel(x, y)]) * (rules.sin_theta ? row_sin_theta(y, l.h) : 1.0);
         return total;
     };
     double total = compensated ? fill([&](double v) { return std::max(v - lbar, 0.0); }) : 0.0;
@@ -193,8 +194,8 @@ std::string run_sample(const fs::path& map, bool compensated, uint64_t seed, con
     const int status = std::system(command.c_str());
     if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return {};
     std::ifstream in(err);
-    return command + " failed (status " + std::to_string(status) + "): " +
-           std::string{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    return command + " failed (status " + std::to_string(status) +
+           "): " + std::string{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 // ---------------------------------------------------------------------------------
@@ -347,24 +348,23 @@ bool same_bytes(const fs::path& a, const fs::path& b) {
 // that is byte-identical to a bundled one is tested once.
 const std::vector<Case>& all_cases() {
     static const std::vector<Case> cases = [] {
-    std::vector<fs::path> maps = maps_in(fs::path(ENVMIS_DATA_DIR) / "envmaps");
-    const size_t bundled = maps.size();
-    for (const fs::path& shared : maps_in(ENVMIS_SHARED_MAPS)) {
-        const bool duplicate = std::any_of(maps.begin(), maps.begin() + static_cast<std::ptrdiff_t>(bundled),
-                                           [&](const fs::path& b) {
-                                               return b.filename() == shared.filename() && same_bytes(b, shared);
-                                           });
-        if (!duplicate) maps.push_back(shared);
-    }
-    std::vector<Case> cases;
-    for (size_t i = 0; i < maps.size(); ++i)
-        for (bool compensated : {true, false}) {
-            std::string name = (i >= bundled ? "shared_" : "bundled_") + maps[i].filename().string();
-            for (char& ch : name)
-                if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
-            cases.push_back({name + (compensated ? "_compensated" : "_uncompensated"), maps[i], compensated});
+        std::vector<fs::path> maps = maps_in(fs::path(ENVMIS_DATA_DIR) / "envmaps");
+        const size_t bundled = maps.size();
+        for (const fs::path& shared : maps_in(ENVMIS_SHARED_MAPS)) {
+            const bool duplicate = std::any_of(
+                maps.begin(), maps.begin() + static_cast<std::ptrdiff_t>(bundled),
+                [&](const fs::path& b) { return b.filename() == shared.filename() && same_bytes(b, shared); });
+            if (!duplicate) maps.push_back(shared);
         }
-    return cases;
+        std::vector<Case> cases;
+        for (size_t i = 0; i < maps.size(); ++i)
+            for (bool compensated : {true, false}) {
+                std::string name = (i >= bundled ? "shared_" : "bundled_") + maps[i].filename().string();
+                for (char& ch : name)
+                    if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+                cases.push_back({name + (compensated ? "_compensated" : "_uncompensated"), maps[i], compensated});
+            }
+        return cases;
     }();
     return cases;
 }
@@ -408,8 +408,8 @@ TEST_P(SampleFollowsTheDocumentedDistribution, DirectionsPdfsAndFrequencies) {
     const RowChecks checks = check_rows(sampled.rows, ref);
     EXPECT_EQ(checks.range.count, 0u) << checks.range.describe("(u, v) in [0,1)^2");
     EXPECT_EQ(checks.direction.count, 0u) << checks.direction.describe("(a) direction of (u, v)");
-    EXPECT_EQ(checks.pdf.count, 0u) << checks.pdf.describe("(b) pdf of the texel")
-                                    << "\n  largest error " << checks.worst_pdf_excess << " times the tolerance";
+    EXPECT_EQ(checks.pdf.count, 0u) << checks.pdf.describe("(b) pdf of the texel") << "\n  largest error "
+                                    << checks.worst_pdf_excess << " times the tolerance";
     EXPECT_EQ(checks.zero_mass.count, 0u) << checks.zero_mass.describe("(d) no sample in a zero-mass texel");
 
     const double level = sidak_level(kFamilyLevel, static_cast<int>(all_cases().size()));

@@ -39,16 +39,17 @@ struct Result {
 };
 
 std::ostream& operator<<(std::ostream& os, const Result& r) {
-    return os << "\nexit code " << r.exit_code << "\n--- stdout:\n" << r.out.substr(0, 3000) << "--- stderr:\n" << r.err;
+    return os << "\nexit code " << r.exit_code << "\n--- stdout:\n"
+              << r.out.substr(0, 3000) << "--- stderr:\n"
+              << r.err;
 }
 
 // Each test works in a folder of its own holding map.exr (64 x 32 sky with a sun).
 class Sweep : public testing::Test {
 public:
     void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               ("envmis_sweep_test_" + std::to_string(::getpid()) + "_" +
-                testing::UnitTest::GetInstance()->current_test_info()->name());
+        dir_ = fs::temp_directory_path() / ("envmis_sweep_test_" + std::to_string(::getpid()) + "_" +
+                                            testing::UnitTest::GetInstance()->current_test_info()->name());
         fs::remove_all(dir_);
         fs::create_directories(dir_);
         io::write_exr(dir_ / "map.exr", test::sun_sky_map(64, 32));
@@ -63,7 +64,8 @@ public:
     // `envmis compare map.exr` with a small study and `args` (no quoting needed).
     Result compare(const std::string& args) const {
         const std::string command = "cd '" + dir_.string() + "' && '" + ENVMIS_CLI +
-                                    "' compare map.exr --points 4 --spp 64 --threads 2 " + args + " > out.txt 2> err.txt";
+                                    "' compare map.exr --points 4 --spp 64 --threads 2 " + args +
+                                    " > out.txt 2> err.txt";
         const int status = std::system(command.c_str());
         Result r{WIFEXITED(status) ? WEXITSTATUS(status) : 128, read_file(file("out.txt")), read_file(file("err.txt"))};
         return r;
@@ -127,12 +129,13 @@ TEST_F(Sweep, AlphaAutoPrintsItsCandidatesAndRecordsTheChoiceInJson) {
 }
 
 TEST_F(Sweep, AlphaSweepReportsEveryAlphaBsdfAndTechniqueWithExactRatios) {
-    const Result r = compare("--alpha-sweep 0:1:0.5 --exact --techniques mis-balance,mis-balance-comp --json r.json --csv r.csv");
+    const Result r =
+        compare("--alpha-sweep 0:1:0.5 --exact --techniques mis-balance,mis-balance-comp --json r.json --csv r.csv");
     ASSERT_EQ(r.exit_code, 0) << r;
     const nlohmann::json j = json("r.json");
     EXPECT_FALSE(j.contains("results")) << "a sweep replaces the normal table";
     const nlohmann::json& sweep = j["sweep"];
-    ASSERT_EQ(sweep.size(), 3u * 3u * 2u);  // alphas x BSDFs x techniques
+    ASSERT_EQ(sweep.size(), 3u * 3u * 2u);                  // alphas x BSDFs x techniques
     std::map<std::string, std::map<double, double>> exact;  // bsdf -> alpha -> exact ratio
     std::map<std::string, int> best;
     for (const auto& row : sweep) {
@@ -198,7 +201,8 @@ TEST_F(Sweep, AllocationSweepMarksTheMostEfficientSplit) {
         ASSERT_EQ(list.size(), 3u) << name;
         std::set<int> env;
         double highest = 0;
-        for (const auto& row : list) env.insert(row["env_samples"].get<int>()), highest = std::max(highest, row["efficiency"].get<double>());
+        for (const auto& row : list)
+            env.insert(row["env_samples"].get<int>()), highest = std::max(highest, row["efficiency"].get<double>());
         EXPECT_EQ(env, (std::set<int>{1, 2, 3})) << name;
         int marked = 0;
         for (const auto& row : list)
@@ -226,14 +230,16 @@ TEST_F(Sweep, PlotsAreWrittenAsPngsOfTheDocumentedSize) {
 }
 
 TEST_F(Sweep, MalformedSweepsFailWithOneLineNamingTheFlag) {
-    for (const char* sweep : {"x", "0:1", "0:1:0", "0:1:-0.5", "1:0:0.5", "-1:1:0.5", "0:200:1", "0:1:0.5:2", "0:nan:1"}) {
+    for (const char* sweep :
+         {"x", "0:1", "0:1:0", "0:1:-0.5", "1:0:0.5", "-1:1:0.5", "0:200:1", "0:1:0.5:2", "0:nan:1"}) {
         const Result r = compare(std::string("--alpha-sweep ") + sweep);
         EXPECT_NE(r.exit_code, 0) << sweep << r;
         EXPECT_EQ(r.out, "") << sweep << r;
         EXPECT_NE(r.err.find("--alpha-sweep"), std::string::npos) << sweep << r;
         EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << sweep << r;
     }
-    for (const char* args : {"--allocation-sweep 1", "--exact", "--alpha often", "--allocation-sweep 4 --techniques bsdf"}) {
+    for (const char* args :
+         {"--allocation-sweep 1", "--exact", "--alpha often", "--allocation-sweep 4 --techniques bsdf"}) {
         const Result r = compare(args);
         EXPECT_NE(r.exit_code, 0) << args << r;
         EXPECT_FALSE(r.err.empty()) << args << r;

@@ -46,7 +46,8 @@ void check_normalised(const envmis::EnvMap& map) {
     double total = 0;
     for (uint32_t y = 0; y < h; ++y) {
         const double v = (y + 0.5) / h;
-        const double texel_solid_angle = 2 * envmis::kPi * envmis::kPi * std::sin(envmis::kPi * v) / (static_cast<double>(w) * h);
+        const double texel_solid_angle =
+            2 * envmis::kPi * envmis::kPi * std::sin(envmis::kPi * v) / (static_cast<double>(w) * h);
         for (uint32_t x = 0; x < w; ++x)
             total += map.pdf_uv({static_cast<float>((x + 0.5) / w), static_cast<float>(v)}) * texel_solid_angle;
     }
@@ -75,8 +76,8 @@ void check_samples(const envmis::EnvMap& map, const envmis::EnvMap& loaded) {
         check(t.pdf == s.pdf && t.uv.x == s.uv.x && t.uv.y == s.uv.y, at + ": the loaded table samples differently");
         edge_cases += std::abs(map.pdf(s.direction) - s.pdf) > 1e-3f * s.pdf;
     }
-    check(edge_cases < n / 500, std::to_string(edge_cases) + " of " + std::to_string(n) +
-                                    " samples disagree with pdf(direction)");
+    check(edge_cases < n / 500,
+          std::to_string(edge_cases) + " of " + std::to_string(n) + " samples disagree with pdf(direction)");
 }
 
 void check_map(const envmis::EnvMap& map, const std::filesystem::path& table_file) {

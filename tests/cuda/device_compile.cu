@@ -3,12 +3,12 @@
 // the BSDFs, the shading frame and the random number generator, all from the same
 // headers the CPU tests use. Built by tests/cuda/cuda.cmake when nvcc is present; it
 // need not run.
-#include "envmis/study/shading/bsdf.h"
+#include "envmis/math/random.h"
 #include "envmis/sampling/distribution.h"
 #include "envmis/sampling/envmap.h"
+#include "envmis/study/shading/bsdf.h"
 #include "envmis/study/shading/frame.h"
 #include "envmis/study/weights/mis_weights.h"
-#include "envmis/math/random.h"
 
 namespace {
 

@@ -101,10 +101,10 @@ TEST(ShippedConfig, SceneLinearAndDataRolesAreLinRec709AndRaw) {
 TEST(ColourConfig, ResolvesFileMetadataNamesCaseInsensitively) {
     const ColourConfig config = shipped();
     const std::pair<const char*, const char*> cases[] = {
-        {"Linear", "lin_rec709"},  {"linear", "lin_rec709"},  {"scene_linear", "lin_rec709"},
+        {"Linear", "lin_rec709"},   {"linear", "lin_rec709"},     {"scene_linear", "lin_rec709"},
         {"lin_srgb", "lin_rec709"}, {"LIN_REC709", "lin_rec709"}, {"sRGB", "sRGB"},
-        {"srgb", "sRGB"},          {"sRGB - Texture", "sRGB"}, {"ACEScg", "ACEScg"},
-        {"acescg", "ACEScg"},      {"lin_ap1", "ACEScg"},      {"ACES - ACES2065-1", "ACES2065-1"},
+        {"srgb", "sRGB"},           {"sRGB - Texture", "sRGB"},   {"ACEScg", "ACEScg"},
+        {"acescg", "ACEScg"},       {"lin_ap1", "ACEScg"},        {"ACES - ACES2065-1", "ACES2065-1"},
         {"XYZ", "CIE-XYZ-D65"},
     };
     for (const auto& [metadata, canonical] : cases) EXPECT_EQ(config.resolve(metadata), canonical) << metadata;

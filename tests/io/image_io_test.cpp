@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "envmis/math/hash.h"
 #include "envmis/io/colour.h"
+#include "envmis/math/hash.h"
 #include "errors.h"
 
 namespace envmis::io {
@@ -402,10 +402,20 @@ TEST_F(ImageIo, AnImageWithoutPixelsIsAnErrorNamingIt) {
 TEST(SharedMaps, AllLoadAsRgbAt1024x512AndNegativeExrValuesAreKept) {
     const fs::path dir = ENVMIS_SHARED_MAPS;
     if (!fs::is_directory(dir)) GTEST_SKIP() << dir << " not found";
-    const char* maps[] = {"rooitou_park_1k.hdr", "kloofendal_overcast_1k.hdr", "potsdamer_platz_1k.hdr",
-                          "lebombo_1k.hdr", "empty_warehouse_01_1k.hdr", "studio_small_03_1k.hdr",
-                          "dikhololo_night_1k.hdr", "city.exr", "interior.exr", "night.exr", "studio.exr",
-                          "pedestrian_overpass_1k.hdr", "esplanade.hdr", "st_fagans_interior_1k.hdr"};
+    const char* maps[] = {"rooitou_park_1k.hdr",
+                          "kloofendal_overcast_1k.hdr",
+                          "potsdamer_platz_1k.hdr",
+                          "lebombo_1k.hdr",
+                          "empty_warehouse_01_1k.hdr",
+                          "studio_small_03_1k.hdr",
+                          "dikhololo_night_1k.hdr",
+                          "city.exr",
+                          "interior.exr",
+                          "night.exr",
+                          "studio.exr",
+                          "pedestrian_overpass_1k.hdr",
+                          "esplanade.hdr",
+                          "st_fagans_interior_1k.hdr"};
     for (const char* name : maps) {
         const LoadedImage loaded = load_image(dir / name);
         EXPECT_EQ(loaded.image.width, 1024u) << name;

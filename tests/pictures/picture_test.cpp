@@ -58,13 +58,14 @@ TEST(Srgb, PiecewiseTransferFunction) {
     EXPECT_EQ(srgb_encode(1), 1);
     EXPECT_NEAR(srgb_encode(0.0031308f), 0.04045f, 1e-5);
     EXPECT_NEAR(srgb_encode(0.0031309f), 0.04045f, 1e-5);  // continuous at the breakpoint
-    EXPECT_NEAR(srgb_encode(0.001f), 0.01292f, 1e-6);       // linear segment
+    EXPECT_NEAR(srgb_encode(0.001f), 0.01292f, 1e-6);      // linear segment
     EXPECT_NEAR(srgb_encode(0.5f), 0.735357f, 1e-5);
     EXPECT_NEAR(srgb_encode(0.18f), 0.461356f, 1e-5);
     EXPECT_EQ(srgb_encode(kNaN), 0);
     EXPECT_EQ(srgb_encode(-1), 0);
     EXPECT_EQ(srgb_encode(kInf), 1);
-    for (float v : {0.0f, 0.002f, 0.0031308f, 0.01f, 0.2f, 0.7f, 1.0f}) EXPECT_NEAR(srgb_decode(srgb_encode(v)), v, 1e-6);
+    for (float v : {0.0f, 0.002f, 0.0031308f, 0.01f, 0.2f, 0.7f, 1.0f})
+        EXPECT_NEAR(srgb_decode(srgb_encode(v)), v, 1e-6);
 }
 
 TEST(Tonemap, BlackStaysBlackAndBrighterNeverGetsDarker) {

@@ -91,8 +91,7 @@ void expect_rising_diagonal(const Image8& image, Rgb8 colour) {
 // No pixel of `colour` left of, right of or above the plot area (the legend is below it).
 void expect_only_inside_or_legend(const Image8& image, Rgb8 colour) {
     const Area area = plot_area(image);
-    for (Point p : pixels_of(image, colour))
-        EXPECT_TRUE(inside(p, area) || p.y > area.y1) << p.x << "," << p.y;
+    for (Point p : pixels_of(image, colour)) EXPECT_TRUE(inside(p, area) || p.y > area.y1) << p.x << "," << p.y;
 }
 
 Series series(std::vector<double> x, std::vector<double> y, std::string name = "s") {

@@ -22,7 +22,8 @@ inline RgbImage sun_sky_map(uint32_t w, uint32_t h, float sun_radiance = 5e4f) {
         }
     const uint32_t sx = w / 3, sy = h / 4;
     for (uint32_t y = sy; y < sy + std::max(1u, h / 64); ++y)
-        for (uint32_t x = sx; x < sx + std::max(1u, w / 128); ++x) m.pixels[size_t{y} * w + x] = {sun_radiance, sun_radiance, sun_radiance};
+        for (uint32_t x = sx; x < sx + std::max(1u, w / 128); ++x)
+            m.pixels[size_t{y} * w + x] = {sun_radiance, sun_radiance, sun_radiance};
     return m;
 }
 

@@ -80,8 +80,8 @@ inline ChiSquare chi_square(std::span<const double> expected, std::span<const do
     double pool_e = 0, pool_o = 0;
     for (size_t i = 0; i < expected.size(); ++i) {
         if (expected[i] == 0 && observed[i] > 0) {
-            r.problem = "cell " + std::to_string(i) + " has zero expectation but " +
-                        std::to_string(observed[i]) + " samples";
+            r.problem =
+                "cell " + std::to_string(i) + " has zero expectation but " + std::to_string(observed[i]) + " samples";
             r.p_value = 0;
             return r;
         }

@@ -8,9 +8,9 @@
 #include <fstream>
 #include <span>
 
-#include "envmis/table/atomic_file.h"
-#include "envmis/math/hash.h"
 #include "envmis/io/colour.h"
+#include "envmis/math/hash.h"
+#include "envmis/table/atomic_file.h"
 
 namespace envmis::io {
 namespace {

@@ -58,8 +58,8 @@ std::vector<Footprint> footprints(uint32_t from, uint32_t to) {
 }
 
 // Separable box resampling of `channels` interleaved floats per pixel.
-std::vector<float> resample(const float* src, uint32_t width, uint32_t height, uint32_t channels,
-                            uint32_t new_width, uint32_t new_height) {
+std::vector<float> resample(const float* src, uint32_t width, uint32_t height, uint32_t channels, uint32_t new_width,
+                            uint32_t new_height) {
     std::vector<float> out(static_cast<size_t>(new_width) * new_height * channels);
     if (width == 0 || height == 0 || out.empty()) return out;
     const auto fx = footprints(width, new_width), fy = footprints(height, new_height);
@@ -168,7 +168,8 @@ RgbImage resize(RgbImageView image, uint32_t new_width, uint32_t new_height) {
     const auto values = resample(reinterpret_cast<const float*>(image.pixels.data()), image.width, image.height, 3,
                                  new_width, new_height);
     RgbImage out{new_width, new_height, std::vector<Rgb>(values.size() / 3)};
-    for (size_t i = 0; i < out.pixels.size(); ++i) out.pixels[i] = {values[3 * i], values[3 * i + 1], values[3 * i + 2]};
+    for (size_t i = 0; i < out.pixels.size(); ++i)
+        out.pixels[i] = {values[3 * i], values[3 * i + 1], values[3 * i + 2]};
     return out;
 }
 
@@ -215,8 +216,8 @@ Image8 tonemap(RgbImageView image, float exposure_stops, LumaCoefficients luma) 
 }
 
 float ColourScale::position(float value) const {
-    const float t = log ? (value > 0 && lo > 0 ? std::log(value / lo) / std::log(hi / lo) : 0.0f)
-                        : (value - lo) / (hi - lo);
+    const float t =
+        log ? (value > 0 && lo > 0 ? std::log(value / lo) / std::log(hi / lo) : 0.0f) : (value - lo) / (hi - lo);
     return std::isnan(t) ? 0.0f : clamp(t, 0.0f, 1.0f);
 }
 
@@ -317,8 +318,8 @@ Image8 colour_bar(const ColourScale& scale, std::string_view label, uint32_t len
     const int end_room = (horizontal ? widest / 2 : cap / 2) + s;
     const int swatch_to_strip = scale.log ? std::max(thickness, horizontal ? widest + 2 * s : 0) + thickness / 2 : 0;
     const int strip_begin = end_room + swatch_to_strip;
-    const int strip_length = std::max(static_cast<int>(length) - (horizontal ? 0 : head) - end_room, strip_begin + 8 * s) -
-                             strip_begin;
+    const int strip_length =
+        std::max(static_cast<int>(length) - (horizontal ? 0 : head) - end_room, strip_begin + 8 * s) - strip_begin;
     const int along = strip_begin + strip_length + end_room;
     const int across = 1 + thickness + tick + 3 * s + widest;
     const int strip_across = horizontal ? head + 1 : 1;
@@ -373,10 +374,10 @@ Image8 montage(std::span<const Panel> panels, std::string_view caption, const Im
     const int bar_width = colour_bar ? static_cast<int>(colour_bar->width) : 0;
     const int bar_height = colour_bar ? static_cast<int>(colour_bar->height) : 0;
     const int top = margin + (caption.empty() ? 0 : th + gap) + (titled ? th + s : 0);
-    const int content_width = std::max({row_width + (tall_bar ? gap + bar_width : 0), text_width(caption, s),
-                                        tall_bar ? 0 : bar_width});
-    const int content_height = tall_bar ? std::max(row_height, bar_height)
-                                        : row_height + (colour_bar ? gap + bar_height : 0);
+    const int content_width =
+        std::max({row_width + (tall_bar ? gap + bar_width : 0), text_width(caption, s), tall_bar ? 0 : bar_width});
+    const int content_height =
+        tall_bar ? std::max(row_height, bar_height) : row_height + (colour_bar ? gap + bar_height : 0);
 
     Image8 out = make_image(2 * margin + content_width, top + content_height + margin, style.background);
     draw_text(out, margin, margin, caption, style.text, s);

@@ -140,14 +140,11 @@ enum class Marker { circle, square, diamond, triangle };
 int marker_half_width(Marker marker, int dy) {
     constexpr int r = kMarkerRadius;
     switch (marker) {
-    case Marker::circle:
-        return dy * dy <= r * r ? static_cast<int>(std::sqrt(r * r + r - dy * dy)) : -1;  // + r: rounder when small
-    case Marker::square:
-        return std::abs(dy) < r ? r - 1 : -1;
-    case Marker::diamond:
-        return r + 1 - std::abs(dy);
-    case Marker::triangle:
-        return dy >= -r && dy <= r ? (dy + r + 1) / 2 : -1;
+        case Marker::circle:
+            return dy * dy <= r * r ? static_cast<int>(std::sqrt(r * r + r - dy * dy)) : -1;  // + r: rounder when small
+        case Marker::square: return std::abs(dy) < r ? r - 1 : -1;
+        case Marker::diamond: return r + 1 - std::abs(dy);
+        case Marker::triangle: return dy >= -r && dy <= r ? (dy + r + 1) / 2 : -1;
     }
     return -1;
 }
@@ -178,9 +175,7 @@ struct LegendEntry {
 };
 
 int key_width(const LegendEntry& entry) { return entry.marker ? kLegendLine : text_height(kScale) - 4; }
-int entry_width(const LegendEntry& entry) {
-    return key_width(entry) + kLegendKeyGap + text_width(entry.name, kScale);
-}
+int entry_width(const LegendEntry& entry) { return key_width(entry) + kLegendKeyGap + text_width(entry.name, kScale); }
 int legend_row_height() { return text_height(kScale) + kGap / 2; }
 
 // Entries flow left to right in rows, in a box centred under the axes.
@@ -315,13 +310,13 @@ Image8 draw(const LinePlot& plot) {
         if (!plot.series[i].name.empty()) entries.push_back({plot.series[i].name, colour(i), marker(i)});
     // Room for half a tick label centred at the right end of the axis.
     const int right_room = kMargin + text_width("0.000", kScale) / 2;
-    Chart chart = start_chart(plot.width, plot.height, plot.title, plot.y_label, plot.x_label, y, std::move(entries),
-                              right_room);
+    Chart chart =
+        start_chart(plot.width, plot.height, plot.title, plot.y_label, plot.x_label, y, std::move(entries), right_room);
     Image8& image = chart.image;
     const Area& area = chart.area;
 
-    const auto ticks = labelled_ticks(x, area.width(), 80,
-                                      [](const std::string& label) { return text_width(label, kScale); });
+    const auto ticks =
+        labelled_ticks(x, area.width(), 80, [](const std::string& label) { return text_width(label, kScale); });
     for (const Tick& t : ticks) {
         const int column = area.column(t.position);
         fill_clipped(image, area, column, area.y0, 1, area.height(), kGrid);

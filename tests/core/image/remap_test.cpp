@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "envmis/image/remap.h"
 #include "envmis/sampling/distribution.h"
 #include "envmis/study/reference/quadrature.h"
-#include "envmis/image/remap.h"
 #include "maps.h"
 
 namespace envmis {

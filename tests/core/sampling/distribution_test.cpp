@@ -184,9 +184,10 @@ TEST(Distribution2D, BuildDoesNotDependOnThreads) {
 }
 
 TEST(Distribution2D, RowFunctionExceptionsReachTheCaller) {
-    EXPECT_THROW(Distribution2D(8, 64, [](uint32_t y, std::span<float>) {
-                     if (y == 40) throw std::runtime_error("row 40");
-                 }),
+    EXPECT_THROW(Distribution2D(8, 64,
+                                [](uint32_t y, std::span<float>) {
+                                    if (y == 40) throw std::runtime_error("row 40");
+                                }),
                  std::runtime_error);
 }
 

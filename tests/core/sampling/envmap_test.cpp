@@ -55,7 +55,8 @@ void expect_directions_follow(const EnvMap& map, const std::vector<double>& mass
     std::vector<double> observed(mass.size()), expected(mass.size());
     for (size_t i = 0; i < mass.size(); ++i) expected[i] = n * mass[i] / total;
     Rng rng(seed);
-    for (size_t i = 0; i < n; ++i) observed[texel_of(map.sample(rng.uniform2()).direction, map.width(), map.height())] += 1;
+    for (size_t i = 0; i < n; ++i)
+        observed[texel_of(map.sample(rng.uniform2()).direction, map.width(), map.height())] += 1;
     const auto chi = test::chi_square(expected, observed);
     EXPECT_GT(chi.p_value, kLevel) << map.width() << "x" << map.height() << ": " << chi.describe();
 }
@@ -136,7 +137,8 @@ TEST(EnvMap, EqualAreaMapsFollowTheirDensity) {
             for (uint32_t j = 0; j < n4; ++j)
                 for (uint32_t i = 0; i < n4; ++i)
                     integral += map.pdf(equal_area_direction({(i + 0.5f) / n4, (j + 0.5f) / n4}));
-            EXPECT_NEAR(integral * 4 * kPi / (static_cast<double>(n4) * n4), 1.0, 1e-3) << w << "x" << h << " compensate=" << compensate;
+            EXPECT_NEAR(integral * 4 * kPi / (static_cast<double>(n4) * n4), 1.0, 1e-3)
+                << w << "x" << h << " compensate=" << compensate;
         }
     EnvMapOptions o;
     o.mapping = Mapping::equal_area;
@@ -166,7 +168,8 @@ TEST(EnvMap, CompensationStrengthAlphaIsHonoured) {
 }
 
 TEST(EnvMap, SolidAnglePdfIntegratesToOne) {
-    for (const RgbImage& image : {test::sun_sky_map(64, 32), test::random_map(9, 5, 4), test::constant_map(1, 1, {1, 1, 1})})
+    for (const RgbImage& image :
+         {test::sun_sky_map(64, 32), test::random_map(9, 5, 4), test::constant_map(1, 1, {1, 1, 1})})
         for (bool compensate : {false, true}) {
             const EnvMap map(image, options(compensate));
             // Midpoint rule in (theta, phi) on a grid aligned with, and 4x finer than, the texels.
@@ -177,7 +180,8 @@ TEST(EnvMap, SolidAnglePdfIntegratesToOne) {
                 for (uint32_t j = 0; j < np; ++j) {
                     const double phi = 2 * kPi * (j + 0.5) / np;
                     const Vec3 d{static_cast<float>(std::sin(theta) * std::cos(phi)),
-                                 static_cast<float>(std::sin(theta) * std::sin(phi)), static_cast<float>(std::cos(theta))};
+                                 static_cast<float>(std::sin(theta) * std::sin(phi)),
+                                 static_cast<float>(std::cos(theta))};
                     integral += map.pdf(d) * std::sin(theta);
                 }
             }
@@ -288,7 +292,8 @@ TEST(EnvMap, BadPixelsAreRepairedAndCounted) {
     EXPECT_EQ(map.stats().bad_pixels.nan, 1u);
     EXPECT_EQ(map.stats().bad_pixels.infinite, 2u);
     EXPECT_EQ(map.stats().bad_pixels.negative, 2u);
-    for (const Rgb& p : map.radiance().pixels) EXPECT_TRUE(p.r >= 0 && p.g >= 0 && p.b >= 0 && std::isfinite(p.r + p.g + p.b));
+    for (const Rgb& p : map.radiance().pixels)
+        EXPECT_TRUE(p.r >= 0 && p.g >= 0 && p.b >= 0 && std::isfinite(p.r + p.g + p.b));
 }
 
 TEST(EnvMap, AbsurdDynamicRangeStillSamplesCorrectly) {
@@ -348,9 +353,9 @@ uint32_t bits(float f) { return bit_cast<uint32_t>(f); }
 // lookup_many's SIMD path repeats lookup's arithmetic: every lane must give lookup's
 // exact bits, on every path.
 TEST(EnvMap, LookupManyIsBitIdenticalToLookup) {
-    std::vector<Vec3> directions = {{0, 0, 1},  {0, 0, -1}, {1, 0, 0},     {-1, 0, 0},        {0, 1, 0},
-                                    {0, -1, 0}, {1, -0.0f, 0}, {-1, -0.0f, 0}, {1e-20f, 0, 1}, {0, -1e-20f, -1},
-                                    {0.6f, -0.8f, 0}, {0, 0, 0}};
+    std::vector<Vec3> directions = {{0, 0, 1},      {0, 0, -1},       {1, 0, 0},        {-1, 0, 0},
+                                    {0, 1, 0},      {0, -1, 0},       {1, -0.0f, 0},    {-1, -0.0f, 0},
+                                    {1e-20f, 0, 1}, {0, -1e-20f, -1}, {0.6f, -0.8f, 0}, {0, 0, 0}};
     Rng rng(17);
     while (directions.size() < 1003) {  // not a multiple of the SIMD width
         const Vec2 u = rng.uniform2();
@@ -395,12 +400,12 @@ TEST(EnvMap, SampleManyIsBitIdenticalToSample) {
         const size_t n = points.size();
         std::vector<float> x(n), y(n), z(n), pdf(n), r(n), g(n), b(n);
         const EnvMapView view = map.view();
-        sample_many(view, {ux.data(), uy.data()}, {x.data(), y.data(), z.data(), pdf.data(), r.data(), g.data(), b.data()},
-                    static_cast<uint32_t>(n));
+        sample_many(view, {ux.data(), uy.data()},
+                    {x.data(), y.data(), z.data(), pdf.data(), r.data(), g.data(), b.data()}, static_cast<uint32_t>(n));
         for (size_t i = 0; i < n; ++i) {
             const EnvSample e = view.sample(points[i]);
             const float expected[] = {e.direction.x, e.direction.y, e.direction.z, e.pdf,
-                                      e.radiance.r, e.radiance.g,  e.radiance.b};
+                                      e.radiance.r,  e.radiance.g,  e.radiance.b};
             const float got[] = {x[i], y[i], z[i], pdf[i], r[i], g[i], b[i]};
             for (int k = 0; k < 7; ++k)
                 ASSERT_EQ(bits(got[k]), bits(expected[k]))

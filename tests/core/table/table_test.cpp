@@ -21,8 +21,9 @@ namespace fs = std::filesystem;
 class TableTest : public ::testing::Test {
 protected:
     void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("envmis_table_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        dir_ = fs::temp_directory_path() /
+               ("envmis_table_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
         fs::remove_all(dir_);
         fs::create_directories(dir_);
     }
@@ -198,7 +199,7 @@ TEST_F(TableTest, EqualAreaTablesRoundTrip) {
 // Offsets in a table file (docs/table-format.md).
 constexpr size_t kPreamble = 32, kVersionAt = 8, kTotalSizeAt = 16, kMetadataSizeAt = 24;
 constexpr size_t kMappingByte = kPreamble + 5 * 4 + 3 * 4 + 3;  // after size, kind, flags, alpha, luma, axes
-constexpr size_t kFixedMetadata = 100;                           // the fields before the three strings
+constexpr size_t kFixedMetadata = 100;                          // the fields before the three strings
 
 uint32_t u32_at(const std::vector<char>& bytes, size_t offset) {
     uint32_t v = 0;

@@ -7,8 +7,8 @@
 #include <limits>
 #include <vector>
 
-#include "envmis/study/comparison/alpha.h"
 #include "envmis/compensation/compensation.h"
+#include "envmis/study/comparison/alpha.h"
 #include "envmis/study/reference/quadrature.h"
 #include "maps.h"
 
@@ -69,11 +69,12 @@ TEST(ChooseAlpha, AlwaysTriesAlphaZeroWhoseCriterionIsExactlyOne) {
     EXPECT_EQ(c.candidates[0].criterion, 1.0);
     for (double r : c.candidates[0].per_bsdf) EXPECT_EQ(r, 1.0);
     EXPECT_EQ(c.bsdf_alphas.size(), 2u);
-    EXPECT_THROW(choose_alpha(test::sun_sky_map(16, 8), {}, [] {
-                     AlphaOptions bad;
-                     bad.candidates = {-0.5f};
-                     return bad;
-                 }()),
+    EXPECT_THROW(choose_alpha(test::sun_sky_map(16, 8), {},
+                              [] {
+                                  AlphaOptions bad;
+                                  bad.candidates = {-0.5f};
+                                  return bad;
+                              }()),
                  std::invalid_argument);
 }
 
@@ -128,9 +129,9 @@ TEST(ChooseAlpha, CriterionIsTheExactVarianceRatioOnTheDownsampledMap) {
     plain_options.compensation.enabled = false;
     comp_options.compensation.alpha = 0.5f;
     const EnvMap plain(image, plain_options), comp(image, comp_options);
-    const auto ratios = geometric_mean_ratios(
-        exact_variances(comp, Technique::parse("mis-balance-comp"), {}, o.bsdfs, o.points, 1),
-        exact_variances(plain, Technique::parse("mis-balance"), {}, o.bsdfs, o.points, 1), 1);
+    const auto ratios =
+        geometric_mean_ratios(exact_variances(comp, Technique::parse("mis-balance-comp"), {}, o.bsdfs, o.points, 1),
+                              exact_variances(plain, Technique::parse("mis-balance"), {}, o.bsdfs, o.points, 1), 1);
     ASSERT_EQ(c.candidates.size(), 2u);
     EXPECT_DOUBLE_EQ(c.candidates[1].per_bsdf[0], ratios[0]);
     EXPECT_DOUBLE_EQ(c.candidates[1].criterion, ratios[0]);  // one BSDF: the same mean

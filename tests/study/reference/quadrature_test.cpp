@@ -4,9 +4,9 @@
 
 #include <cmath>
 
-#include "envmis/study/techniques/estimator.h"
 #include "envmis/study/reference/quadrature.h"
 #include "envmis/study/statistics/statistics.h"
+#include "envmis/study/techniques/estimator.h"
 #include "maps.h"
 
 namespace envmis {

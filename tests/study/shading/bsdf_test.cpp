@@ -5,8 +5,8 @@
 #include <cmath>
 #include <vector>
 
-#include "envmis/study/shading/bsdf.h"
 #include "envmis/math/random.h"
+#include "envmis/study/shading/bsdf.h"
 #include "stats.h"
 
 namespace envmis {
@@ -14,8 +14,12 @@ namespace {
 
 const double kLevel = test::sidak_level(0.01, 12);
 
-std::vector<Bsdf> bsdfs() { return {Bsdf::lambert(), Bsdf::phong(5), Bsdf::phong(50), Bsdf::ggx(0.5f), Bsdf::ggx(0.1f)}; }
-std::vector<Vec3> views() { return {normalize(Vec3{0, 0, 1}), normalize(Vec3{0.6f, 0.1f, 0.5f}), normalize(Vec3{-0.9f, 0.2f, 0.15f})}; }
+std::vector<Bsdf> bsdfs() {
+    return {Bsdf::lambert(), Bsdf::phong(5), Bsdf::phong(50), Bsdf::ggx(0.5f), Bsdf::ggx(0.1f)};
+}
+std::vector<Vec3> views() {
+    return {normalize(Vec3{0, 0, 1}), normalize(Vec3{0.6f, 0.1f, 0.5f}), normalize(Vec3{-0.9f, 0.2f, 0.15f})};
+}
 
 // Direction at the centre of cell (i, j) of an nz x nphi grid equal-area in (z, phi).
 constexpr int kZ = 48, kPhi = 96, kSub = 6;
@@ -37,7 +41,8 @@ std::vector<double> cell_probabilities(const Bsdf& bsdf, Vec3 wo) {
         for (int pj = 0; pj < kPhi; ++pj)
             for (int a = 0; a < kSub; ++a)
                 for (int b = 0; b < kSub; ++b)
-                    p[zi * kPhi + pj] += bsdf.pdf(wo, grid_direction(zi + (a + 0.5) / kSub, pj + (b + 0.5) / kSub)) * sub_area;
+                    p[zi * kPhi + pj] +=
+                        bsdf.pdf(wo, grid_direction(zi + (a + 0.5) / kSub, pj + (b + 0.5) / kSub)) * sub_area;
     return p;
 }
 
@@ -69,8 +74,8 @@ TEST(Bsdf, PdfIntegratesToOneOverTheSphere) {
                 const double z = -1 + 2 * (i + 0.5) / nz, r = std::sqrt(1 - z * z);
                 for (int j = 0; j < nphi; ++j) {
                     const double phi = 2 * kPi * (j + 0.5) / nphi;
-                    integral += bsdf.pdf(wo, {static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
-                                              static_cast<float>(z)});
+                    integral += bsdf.pdf(wo, {static_cast<float>(r * std::cos(phi)),
+                                              static_cast<float>(r * std::sin(phi)), static_cast<float>(z)});
                 }
             }
             integral *= 4 * kPi / (double{nz} * nphi);
@@ -100,7 +105,8 @@ TEST(Bsdf, SampleReturnsEvalAndPdfOfItsDirection) {
 
 TEST(Bsdf, WhiteFurnaceAlbedoIsAtMostOne) {
     const Rgb white{1, 1, 1};
-    for (Bsdf bsdf : {Bsdf::lambert(white), Bsdf::phong(1, white), Bsdf::phong(50, white), Bsdf::ggx(0.1f, white), Bsdf::ggx(0.3f, white), Bsdf::ggx(1, white)})
+    for (Bsdf bsdf : {Bsdf::lambert(white), Bsdf::phong(1, white), Bsdf::phong(50, white), Bsdf::ggx(0.1f, white),
+                      Bsdf::ggx(0.3f, white), Bsdf::ggx(1, white)})
         for (Vec3 wo : views()) {
             // Importance-sampled estimate of the directional albedo, integral of f cos.
             Pcg32 rng(5);

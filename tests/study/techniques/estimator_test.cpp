@@ -7,12 +7,12 @@
 #include <cstring>
 #include <filesystem>
 
-#include "envmis/study/comparison/comparison.h"
-#include "envmis/study/techniques/estimator.h"
-#include "envmis/study/shading/frame.h"
 #include "envmis/io/image_io.h"
+#include "envmis/study/comparison/comparison.h"
 #include "envmis/study/reference/quadrature.h"
+#include "envmis/study/shading/frame.h"
 #include "envmis/study/statistics/statistics.h"
+#include "envmis/study/techniques/estimator.h"
 #include "maps.h"
 
 namespace envmis {
@@ -46,7 +46,8 @@ std::vector<Technique> valid_techniques() {
 }
 
 std::vector<ShadingPoint> points() {
-    return {{{0, 0, 1}, normalize(Vec3{0.3f, 0.2f, 1})}, {normalize(Vec3{0.7f, -0.2f, 0.3f}), normalize(Vec3{0.4f, 0.5f, 0.6f})}};
+    return {{{0, 0, 1}, normalize(Vec3{0.3f, 0.2f, 1})},
+            {normalize(Vec3{0.7f, -0.2f, 0.3f}), normalize(Vec3{0.4f, 0.5f, 0.6f})}};
 }
 
 // The standard error of the mean of n estimates. The exact variance gives a trustworthy
@@ -54,11 +55,14 @@ std::vector<ShadingPoint> points() {
 // variance unreliable. Adaptive and mixture techniques have no exact variance: the
 // larger of their sample variance and balance MIS's exact variance over the same
 // (compensated, for the mixture) density stands in.
-double standard_error(const Maps& maps, Technique t, const Bsdf& bsdf, const ShadingPoint& p, const RunningStats& stats) {
+double standard_error(const Maps& maps, Technique t, const Bsdf& bsdf, const ShadingPoint& p,
+                      const RunningStats& stats) {
     const double n = static_cast<double>(stats.count());
-    if (!t.adaptive() && !t.mixture) return std::sqrt(exact_variance(t.compensated ? maps.compensated : maps.plain, t, {}, bsdf, p, 4) / n);
+    if (!t.adaptive() && !t.mixture)
+        return std::sqrt(exact_variance(t.compensated ? maps.compensated : maps.plain, t, {}, bsdf, p, 4) / n);
     const Technique balance{Strategy::mis, Heuristic::balance, t.compensated};
-    const double balance_variance = exact_variance(t.compensated ? maps.compensated : maps.plain, balance, {}, bsdf, p, 4);
+    const double balance_variance =
+        exact_variance(t.compensated ? maps.compensated : maps.plain, balance, {}, bsdf, p, 4);
     return std::sqrt(std::max(stats.variance(), balance_variance) / n);
 }
 
@@ -94,7 +98,8 @@ TEST(Estimator, CompensationLowersLambertVarianceUnderASunnyMap) {
     const double k = static_cast<double>(normals.size());
     for (const ShadingPoint& p : normals) {
         const double plain = exact_variance(maps.plain, Technique::parse("mis-balance"), {}, lambert, p, 2);
-        const double compensated = exact_variance(maps.compensated, Technique::parse("mis-balance-comp"), {}, lambert, p, 2);
+        const double compensated =
+            exact_variance(maps.compensated, Technique::parse("mis-balance-comp"), {}, lambert, p, 2);
         log_ratio += std::log(compensated / plain) / k;
     }
     EXPECT_LT(std::exp(log_ratio), 0.9);
@@ -190,7 +195,8 @@ TEST(Estimator, MultiSampleBalanceMisBeatsOneSampleMis) {
 TEST(Estimator, MixtureNeedsBothMaps) {
     const Maps maps = make_maps("sun", test::sun_sky_map(64, 32));
     EXPECT_THROW(DirectLightingEstimator(maps.compensated, Technique::parse("mis-optimal-all")), std::invalid_argument);
-    EXPECT_THROW(exact_variance(maps.plain, Technique::parse("mis-optimal"), {}, Bsdf::lambert(), {}, 1), std::invalid_argument);
+    EXPECT_THROW(exact_variance(maps.plain, Technique::parse("mis-optimal"), {}, Bsdf::lambert(), {}, 1),
+                 std::invalid_argument);
 }
 
 // The random numbers' order is part of the estimator's contract (results are
@@ -212,8 +218,10 @@ TEST(Estimator, FixedWeightEstimatesUseTheRandomNumbersInTheirDocumentedOrder) {
                 const DirectLightingEstimator estimator(maps.plain, maps.compensated, t, a);
                 const EnvMap& sampled = t.compensated && !t.mixture ? maps.compensated : maps.plain;
                 const bool power = t.strategy == Strategy::mis && t.heuristic == Heuristic::power;
-                const uint32_t n_env = t.strategy == Strategy::env ? a.total() : (t.strategy == Strategy::bsdf ? 0 : a.env);
-                const uint32_t n_bsdf = t.strategy == Strategy::bsdf ? a.total() : (t.strategy == Strategy::env ? 0 : a.bsdf);
+                const uint32_t n_env =
+                    t.strategy == Strategy::env ? a.total() : (t.strategy == Strategy::bsdf ? 0 : a.env);
+                const uint32_t n_bsdf =
+                    t.strategy == Strategy::bsdf ? a.total() : (t.strategy == Strategy::env ? 0 : a.bsdf);
                 // Density of the environment technique at a direction: the mixture's is
                 // the mean of both maps'.
                 const auto env_pdf = [&](Vec3 w) {
@@ -237,8 +245,9 @@ TEST(Estimator, FixedWeightEstimatesUseTheRandomNumbersInTheirDocumentedOrder) {
                         const Vec3 wi = frame.to_local(e.direction);
                         const Rgb f = bsdf.eval(wo, wi);
                         // The sampled density's pdf is the one the sample returned.
-                        const float p_env = !t.mixture ? e.pdf
-                                            : 0.5f * (e.pdf + (from_plain ? maps.compensated : maps.plain).pdf(e.direction));
+                        const float p_env =
+                            !t.mixture ? e.pdf
+                                       : 0.5f * (e.pdf + (from_plain ? maps.compensated : maps.plain).pdf(e.direction));
                         add(0, {e.radiance.r * f.r, e.radiance.g * f.g, e.radiance.b * f.b}, p_env, bsdf.pdf(wo, wi));
                     }
                     for (uint32_t i = 0; i < n_bsdf; ++i) {
@@ -248,12 +257,14 @@ TEST(Estimator, FixedWeightEstimatesUseTheRandomNumbersInTheirDocumentedOrder) {
                         const Rgb l = sampled.eval(wi);
                         add(1, {l.r * b.value.r, l.g * b.value.g, l.b * b.value.b}, env_pdf(wi), b.pdf);
                     }
-                    const float expected[3] = {static_cast<float>(sum[0]), static_cast<float>(sum[1]), static_cast<float>(sum[2])};
+                    const float expected[3] = {static_cast<float>(sum[0]), static_cast<float>(sum[1]),
+                                               static_cast<float>(sum[2])};
                     const float actual[3] = {got.r, got.g, got.b};
                     for (int c = 0; c < 3; ++c)
                         ASSERT_NEAR(actual[c], expected[c], 1e-4f * std::abs(expected[c]) + 1e-30f)
                             << name << " " << a.env << "+" << a.bsdf << " seed " << seed << " channel " << c;
-                    ASSERT_EQ(rng.uniform(), mine.uniform()) << name << ": the generator is not exactly past the numbers used";
+                    ASSERT_EQ(rng.uniform(), mine.uniform())
+                        << name << ": the generator is not exactly past the numbers used";
                 }
             }
 }
@@ -290,9 +301,9 @@ TEST(Technique, NamesRoundTrip) {
         names.push_back(t.name());
     }
     EXPECT_EQ(names.size(), 15u);
-    for (const char* name : {"env", "env-comp", "bsdf", "mis-balance", "mis-power", "mis-balance-comp", "mis-power-comp",
-                             "mis-optimal", "mis-optimal-comp", "mis-balance-all", "mis-optimal-all", "mis-var",
-                             "mis-var-comp", "one-sample", "one-sample-comp"})
+    for (const char* name : {"env", "env-comp", "bsdf", "mis-balance", "mis-power", "mis-balance-comp",
+                             "mis-power-comp", "mis-optimal", "mis-optimal-comp", "mis-balance-all", "mis-optimal-all",
+                             "mis-var", "mis-var-comp", "one-sample", "one-sample-comp"})
         EXPECT_EQ(Technique::parse(name).name(), name);
     EXPECT_THROW(Technique::parse("mis"), std::invalid_argument);
     EXPECT_THROW(Technique::parse("mis-power-all"), std::invalid_argument);

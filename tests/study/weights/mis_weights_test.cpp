@@ -11,8 +11,8 @@
 namespace envmis {
 namespace {
 
-const std::vector<std::vector<float>> kDensities = {
-    {1, 3}, {0.2f, 0}, {5, 5}, {1e-23f, 0}, {1e20f, 2}, {0.5f, 2, 7}, {0, 0, 4}};
+const std::vector<std::vector<float>> kDensities = {{1, 3},     {0.2f, 0},    {5, 5},   {1e-23f, 0},
+                                                    {1e20f, 2}, {0.5f, 2, 7}, {0, 0, 4}};
 
 TEST(MisWeights, BalancePowerAndVarianceAwareWeightsSumToOne) {
     for (const auto& q : kDensities) {
@@ -81,7 +81,8 @@ TEST(OptimalAlpha, SolvesThreeTechniques) {
     const double x[3] = {0.3, -0.7, 1.1};
     double b[9];
     for (int i = 0; i < 3; ++i)
-        for (int c = 0; c < 3; ++c) b[i * 3 + c] = (a[i * 3] * x[0] + a[i * 3 + 1] * x[1] + a[i * 3 + 2] * x[2]) * (c + 1);
+        for (int c = 0; c < 3; ++c)
+            b[i * 3 + c] = (a[i * 3] * x[0] + a[i * 3 + 1] * x[1] + a[i * 3 + 2] * x[2]) * (c + 1);
     const OptimalAlpha s = solve_optimal_alpha(a, b, 3);
     ASSERT_TRUE(s.solved);
     for (int k = 0; k < 3; ++k)
@@ -90,8 +91,8 @@ TEST(OptimalAlpha, SolvesThreeTechniques) {
 
 TEST(OptimalAlpha, SingularOrBrokenSystemsFallBackToBalance) {
     const double b[9] = {1, 1, 1, 1, 1, 1, 1, 1, 1};
-    const double identical_techniques[4] = {1, 1, 1, 1};     // two copies of one density
-    const double unused_technique[4] = {1, 0, 0, 0};         // a density that is 0 everywhere
+    const double identical_techniques[4] = {1, 1, 1, 1};  // two copies of one density
+    const double unused_technique[4] = {1, 0, 0, 0};      // a density that is 0 everywhere
     const double nearly_singular[4] = {1, 1, 1, 1 + 1e-12};
     const double nan[4] = {1, 0, 0, std::numeric_limits<double>::quiet_NaN()};
     for (const double* a : {identical_techniques, unused_technique, nearly_singular, nan}) {

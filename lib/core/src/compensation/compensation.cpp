@@ -10,9 +10,8 @@ namespace envmis {
 
 double solid_angle_mean(std::span<const float> luminance, uint32_t w, uint32_t h, Mapping mapping) {
     if (w == 0 || h == 0 || luminance.size() != size_t{w} * h)
-        throw std::invalid_argument("solid_angle_mean: " + std::to_string(luminance.size()) +
-                                    " values do not make a " + std::to_string(w) + "x" + std::to_string(h) +
-                                    " image");
+        throw std::invalid_argument("solid_angle_mean: " + std::to_string(luminance.size()) + " values do not make a " +
+                                    std::to_string(w) + "x" + std::to_string(h) + " image");
     std::vector<double> rows(h, 0.0);
     for (uint32_t y = 0; y < h; ++y)
         for (uint32_t x = 0; x < w; ++x) rows[y] += luminance[size_t{y} * w + x];

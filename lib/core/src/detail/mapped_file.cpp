@@ -25,7 +25,8 @@ std::shared_ptr<const MappedFile> MappedFile::map(const std::filesystem::path& p
     ::close(fd);  // the mapping keeps the file open
     if (p == MAP_FAILED) return nullptr;
     try {
-        return std::shared_ptr<const MappedFile>(new MappedFile(static_cast<const std::byte*>(p), static_cast<size_t>(st.st_size)));
+        return std::shared_ptr<const MappedFile>(
+            new MappedFile(static_cast<const std::byte*>(p), static_cast<size_t>(st.st_size)));
     } catch (...) {
         ::munmap(p, static_cast<size_t>(st.st_size));
         return nullptr;

@@ -113,16 +113,19 @@ RemapResult remap(const RgbImage& in, Mapping from, Mapping to, uint32_t width, 
                                                                static_cast<float>((y + (b + 0.5) / s) / in.height)})
                                        : Vec3{sub_r[b] * cos_phi[i], sub_r[b] * sin_phi[i], sub_z[b]};
                     const Vec2 uv = image_uv(to, d);
-                    const double px = uv.x * static_cast<double>(width) - 0.5, py = uv.y * static_cast<double>(height) - 0.5;
+                    const double px = uv.x * static_cast<double>(width) - 0.5,
+                                 py = uv.y * static_cast<double>(height) - 0.5;
                     const double fx = std::floor(px), fy = std::floor(py), tx = px - fx, ty = py - fy;
                     const auto ix = static_cast<int64_t>(fx), iy = static_cast<int64_t>(fy);
                     const double weights[4] = {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty};
                     const bool inside = ix >= 0 && iy >= 0 && ix + 1 < width && iy + 1 < height;
                     for (int k = 0; k < 4; ++k) {
-                        const size_t texel = inside ? static_cast<size_t>(iy + (k >> 1)) * width + static_cast<size_t>(ix + (k & 1))
-                                                    : wrap(to, ix + (k & 1), iy + (k >> 1), width, height);
+                        const size_t texel =
+                            inside ? static_cast<size_t>(iy + (k >> 1)) * width + static_cast<size_t>(ix + (k & 1))
+                                   : wrap(to, ix + (k & 1), iy + (k >> 1), width, height);
                         double* p = &power[4 * texel];
-                        p[0] += weights[k] * pr, p[1] += weights[k] * pg, p[2] += weights[k] * pb, p[3] += weights[k] * area;
+                        p[0] += weights[k] * pr, p[1] += weights[k] * pg, p[2] += weights[k] * pb,
+                            p[3] += weights[k] * area;
                     }
                 }
         }
@@ -155,7 +158,9 @@ RemapResult remap(const RgbImage& in, Mapping from, Mapping to, uint32_t width, 
     result.image = {width, height, std::vector<Rgb>(size_t{width} * height)};
     for (size_t i = 0; i < result.image.pixels.size(); ++i) {
         const double* p = &power[4 * i];
-        const auto scaled = [&](int c) { return static_cast<float>(received[c] > 0 ? p[c] * sent[c] / received[c] : 0.0); };
+        const auto scaled = [&](int c) {
+            return static_cast<float>(received[c] > 0 ? p[c] * sent[c] / received[c] : 0.0);
+        };
         result.image.pixels[i] = {scaled(0), scaled(1), scaled(2)};
     }
     return result;

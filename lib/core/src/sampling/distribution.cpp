@@ -193,8 +193,8 @@ namespace {
 
 void check_size(const char* what, uint32_t n) {
     if (n == 0 || n > kMaxCells1D)
-        throw std::invalid_argument(std::string(what) + ": " + std::to_string(n) + " cells per dimension, expected 1 to " +
-                                    std::to_string(kMaxCells1D));
+        throw std::invalid_argument(std::string(what) + ": " + std::to_string(n) +
+                                    " cells per dimension, expected 1 to " + std::to_string(kMaxCells1D));
 }
 
 // Rows per task of the parallel build: enough to amortise a task's scratch rows.
@@ -215,7 +215,8 @@ void check_invalid(size_t invalid, const char* what) {
 Distribution2D::RowFunction copy_rows(std::span<const float> func, uint32_t w, uint32_t h) {
     if (func.size() != size_t{w} * h)
         throw std::invalid_argument("Distribution2D: expected " + std::to_string(size_t{w} * h) + " values for " +
-                                    std::to_string(w) + "x" + std::to_string(h) + ", got " + std::to_string(func.size()));
+                                    std::to_string(w) + "x" + std::to_string(h) + ", got " +
+                                    std::to_string(func.size()));
     return [func, w](uint32_t y, std::span<float> row) { std::copy_n(func.data() + size_t{y} * w, w, row.data()); };
 }
 

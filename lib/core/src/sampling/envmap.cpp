@@ -32,9 +32,11 @@ constexpr uint32_t kRowsPerChunk = 8;
 
 void check_image(RgbImageView image, Mapping mapping) {
     const size_t n = size_t{image.width} * image.height;
-    if (image.width == 0 || image.height == 0 || image.width > kMaxCells1D || image.height > kMaxCells1D || n > kMaxTexels)
+    if (image.width == 0 || image.height == 0 || image.width > kMaxCells1D || image.height > kMaxCells1D ||
+        n > kMaxTexels)
         throw std::invalid_argument("environment map size " + std::to_string(image.width) + "x" +
-                                    std::to_string(image.height) + " is empty, above 65536 on a side or above 2^31 texels");
+                                    std::to_string(image.height) +
+                                    " is empty, above 65536 on a side or above 2^31 texels");
     if (image.pixels.size() != n)
         throw std::invalid_argument("environment map: " + std::to_string(image.pixels.size()) +
                                     " pixels do not make a " + std::to_string(image.width) + "x" +
@@ -165,7 +167,7 @@ bool scan_row(const Rgb* pixels, uint32_t w, const LumaCoefficients& luma, uint3
 // Pass 2: row y of the density q w_y (mapping.h: row_weight) from its luminance bits; returns the
 // number of texels with L > 0 that compensation zeroes.
 uint32_t fill_density_row(const uint32_t* luminance, uint32_t w, float weight, float threshold, bool uniform,
-                     float* row) noexcept {
+                          float* row) noexcept {
     if (uniform) {
         std::fill_n(row, w, weight);
         return 0;
@@ -220,7 +222,7 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : options_(options)
         stats_.threshold = compensation_threshold(stats_.mean_luminance, options_.compensation.alpha);
     const auto density = [&](uint32_t y, std::span<const uint32_t> cells, std::span<float> row) {
         rows[y].zeroed = fill_density_row(cells.data(), w, row_weight(options_.mapping, y, h), stats_.threshold,
-                                     stats_.fallback == DensityFallback::uniform, row.data());
+                                          stats_.fallback == DensityFallback::uniform, row.data());
     };
     distribution_ = Distribution2D(w, h, std::move(luminance_bits), density);
     if (stats_.threshold > 0 && distribution_.uniform_fallback()) {
@@ -295,7 +297,8 @@ void density_row(std::span<const Rgb> radiance_row, uint32_t y, uint32_t h, cons
     const auto w = static_cast<uint32_t>(radiance_row.size());
     if (out.size() != w || y >= h)
         throw std::invalid_argument("density_row: " + std::to_string(out.size()) + " outputs for a row of " +
-                                    std::to_string(w) + " (row " + std::to_string(y) + " of " + std::to_string(h) + ")");
+                                    std::to_string(w) + " (row " + std::to_string(y) + " of " + std::to_string(h) +
+                                    ")");
     // scan_row repairs nothing: a map's radiance is clean, and so is a decoded table's.
     std::vector<uint32_t> luminance(w);
     RowStats unused;

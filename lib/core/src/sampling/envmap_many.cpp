@@ -106,9 +106,11 @@ ENVMIS_AVX2 SinCos8 sincos_steps8(const SinCos* turns, F8 x) noexcept {
     constexpr float c = 2 * kPiF / kTurnSteps;
     const F8 rounded = _mm256_add_ps(x, splat(kRound));
     const F8 f = _mm256_sub_ps(x, _mm256_sub_ps(rounded, splat(kRound))), f2 = _mm256_mul_ps(f, f);
-    const F8 sin_d = _mm256_sub_ps(_mm256_mul_ps(splat(c), f), _mm256_mul_ps(f2, _mm256_mul_ps(splat(c * c * c / 6), f)));
+    const F8 sin_d =
+        _mm256_sub_ps(_mm256_mul_ps(splat(c), f), _mm256_mul_ps(f2, _mm256_mul_ps(splat(c * c * c / 6), f)));
     const F8 cos_d = _mm256_sub_ps(splat(1.0f), _mm256_mul_ps(splat(c * c / 2), f2));
-    const I8 k = _mm256_slli_epi32(_mm256_and_si256(_mm256_castps_si256(rounded), _mm256_set1_epi32(kTurnSteps - 1)), 1);
+    const I8 k =
+        _mm256_slli_epi32(_mm256_and_si256(_mm256_castps_si256(rounded), _mm256_set1_epi32(kTurnSteps - 1)), 1);
     const F8 s = _mm256_i32gather_ps(&turns->sin, k, 4), co = _mm256_i32gather_ps(&turns->sin + 1, k, 4);
     return {_mm256_add_ps(_mm256_mul_ps(s, cos_d), _mm256_mul_ps(co, sin_d)),
             _mm256_sub_ps(_mm256_mul_ps(co, cos_d), _mm256_mul_ps(s, sin_d))};
@@ -126,8 +128,8 @@ ENVMIS_AVX2 SinCos8 sincos_half_turns8(const SinCos* turns, F8 t) noexcept {
 ENVMIS_AVX2 F8 solid_angle_pdf8(const Distribution2DView& d, I8 x, I8 y, I8 row, F8 sin_theta) noexcept {
     const I8 row_width = width8(d.marginal.start, _mm256_setzero_si256(), y, d.h);
     const I8 cell_width = width8(d.start, row, x, d.w);
-    const F8 image_pdf = _mm256_mul_ps(_mm256_mul_ps(width_to_float(row_width), width_to_float(cell_width)),
-                                       splat(d.pdf_scale));
+    const F8 image_pdf =
+        _mm256_mul_ps(_mm256_mul_ps(width_to_float(row_width), width_to_float(cell_width)), splat(d.pdf_scale));
     const F8 pdf = _mm256_div_ps(image_pdf, _mm256_mul_ps(splat(kTwoPiSquared), sin_theta));
     return select(_mm256_cmp_ps(sin_theta, splat(0.0f), _CMP_GT_OQ), pdf, splat(0.0f));
 }
@@ -223,7 +225,8 @@ struct Hit8 {
     I8 index;
     F8 offset;
 };
-ENVMIS_AVX2 Hit8 search8(const uint32_t* start, const uint16_t* guide, I8 base, uint32_t n, const Unit8& unit) noexcept {
+ENVMIS_AVX2 Hit8 search8(const uint32_t* start, const uint16_t* guide, I8 base, uint32_t n,
+                         const Unit8& unit) noexcept {
     const F8 x = unit.x;
     const I8 t = unit.t, k = unit.k, last = _mm256_set1_epi32(static_cast<int>(n - 1));
     // guide[k] and guide[k + 1] (or n - 1 after the last bucket) from one 32-bit gather of

@@ -13,7 +13,8 @@ AtomicFile::AtomicFile(std::filesystem::path destination) : destination_(std::mo
     const std::filesystem::path folder = destination_.has_parent_path() ? destination_.parent_path() : ".";
     std::error_code ec;
     if (!std::filesystem::is_directory(folder, ec))
-        throw std::runtime_error(destination_.string() + ": cannot create: folder " + folder.string() + " does not exist");
+        throw std::runtime_error(destination_.string() + ": cannot create: folder " + folder.string() +
+                                 " does not exist");
     // Hidden, unique per process and attempt, and ending in the destination's extension.
     temporary_ = folder / ("." + destination_.stem().string() + ".tmp" + std::to_string(std::random_device{}()) +
                            destination_.extension().string());

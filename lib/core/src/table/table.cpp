@@ -8,10 +8,10 @@
 #include <optional>
 #include <vector>
 
-#include "envmis/table/atomic_file.h"
-#include "envmis/math/hash.h"
 #include "detail/mapped_file.h"
 #include "detail/parallel.h"
+#include "envmis/math/hash.h"
+#include "envmis/table/atomic_file.h"
 
 namespace envmis {
 namespace {
@@ -43,7 +43,7 @@ uint32_t rgbe_encode(Rgb c) noexcept {
     // m = f 2^e with f in [0.5, 1) (m is a normal float): the largest mantissa is 128..255.
     int e = static_cast<int>((std::bit_cast<uint32_t>(m) >> 23) & 0xff) - 126;
     if (m * power_of_two(8 - e) + 0.5 >= 256) ++e;  // rounds up to 256: one more bit of exponent
-    e = std::min(e, 127);  // above 2^127 (1.7e38) the largest channel saturates at 255 2^119
+    e = std::min(e, 127);                           // above 2^127 (1.7e38) the largest channel saturates at 255 2^119
     const double scale = power_of_two(8 - e);
     const auto byte = [&](float v) { return static_cast<uint32_t>(std::min(v * scale + 0.5, 255.0)); };
     return byte(c.r) | byte(c.g) << 8 | byte(c.b) << 16 | static_cast<uint32_t>(e + 128) << 24;
@@ -53,7 +53,9 @@ Rgb rgbe_decode(uint32_t v) noexcept {
     const int e = static_cast<int>(v >> 24);
     if (e == 0) return {};
     const double scale = power_of_two(e - 128 - 8);
-    const auto channel = [&](int shift) { return static_cast<float>(static_cast<double>((v >> shift) & 0xff) * scale); };
+    const auto channel = [&](int shift) {
+        return static_cast<float>(static_cast<double>((v >> shift) & 0xff) * scale);
+    };
     return {channel(0), channel(8), channel(16)};
 }
 
@@ -77,9 +79,7 @@ class Cursor {
 public:
     Cursor(std::span<const std::byte> bytes, std::string_view name) : bytes_(bytes), name_(name) {}
 
-    [[noreturn]] void fail(const std::string& problem) const {
-        throw TableError(std::string(name_) + ": " + problem);
-    }
+    [[noreturn]] void fail(const std::string& problem) const { throw TableError(std::string(name_) + ": " + problem); }
     void need(uint64_t size, const char* what) const {
         if (size > bytes_.size() - pos_)
             fail(std::string("truncated: ") + what + " needs " + std::to_string(size) + " bytes, " +
@@ -208,7 +208,8 @@ void write_table(const std::filesystem::path& path, const EnvMap& map, const Tab
                  TableEncoding encoding) {
     for (const std::string* s : {&source.name, &source.input_colorspace, &source.working_colorspace})
         if (s->size() > kMaxStringSize)
-            throw TableError(path.string() + ": metadata string longer than " + std::to_string(kMaxStringSize) + " bytes");
+            throw TableError(path.string() + ": metadata string longer than " + std::to_string(kMaxStringSize) +
+                             " bytes");
     const auto& radiance = map.radiance().pixels;
     if (encoding == TableEncoding::compact) {
         // The table holds the rounded map: its statistics (Lbar, threshold) are the
@@ -229,8 +230,8 @@ void write_table(const std::filesystem::path& path, const EnvMap& map, const Tab
     // The density is computed a row at a time, twice (for the checksum, then to write):
     // cheaper than holding a copy of the map's size.
     std::vector<float> row(map.width());
-    write_file(path, metadata_block(map, map.stats(), source, encoding), radiance.size() * (sizeof(float) + sizeof(Rgb)),
-               [&](auto&& use) {
+    write_file(path, metadata_block(map, map.stats(), source, encoding),
+               radiance.size() * (sizeof(float) + sizeof(Rgb)), [&](auto&& use) {
                    for (uint32_t y = 0; y < map.height(); ++y) {
                        map.density_row(y, row);
                        use(as_bytes_of<float>(row));
@@ -275,7 +276,8 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
                                         std::to_string(file_size) + " (trailing data)");
     const auto metadata_size = in.take<uint32_t>("metadata size");
     in.take<uint32_t>("reserved");
-    if (metadata_size > kMaxMetadataSize) in.fail("metadata block of " + std::to_string(metadata_size) + " bytes is too large");
+    if (metadata_size > kMaxMetadataSize)
+        in.fail("metadata block of " + std::to_string(metadata_size) + " bytes is too large");
     in.need(uint64_t{metadata_size} + 8, "metadata and header checksum");
     const uint64_t header_digest = hash64(head.first(kPreambleSize + metadata_size));
 
@@ -314,7 +316,8 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
     if (in.take<uint64_t>("header checksum") != header_digest) in.fail("corrupted header (checksum mismatch)");
     // Version 3 pads the block to a multiple of kMetadataAlignment with zeros; older
     // versions have no padding.
-    const std::span<const std::byte> rest = head.subspan(kPreambleSize + meta.position(), metadata_size - meta.position());
+    const std::span<const std::byte> rest =
+        head.subspan(kPreambleSize + meta.position(), metadata_size - meta.position());
     const bool padded = version >= 3 && metadata_size % kMetadataAlignment == 0 && rest.size() < kMetadataAlignment &&
                         std::all_of(rest.begin(), rest.end(), [](std::byte b) { return b == std::byte{0}; });
     if (!rest.empty() && !padded) in.fail("metadata block has " + std::to_string(rest.size()) + " unexpected bytes");
@@ -328,7 +331,8 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
     options.mapping = mapping == 2 ? Mapping::equal_area : Mapping::equirect;
     if (options.mapping == Mapping::equal_area && w != h)
         in.fail("equal-area table of size " + std::to_string(w) + "x" + std::to_string(h) + " is not square");
-    if (fallback > static_cast<uint32_t>(DensityFallback::uniform)) in.fail("unknown fallback " + std::to_string(fallback));
+    if (fallback > static_cast<uint32_t>(DensityFallback::uniform))
+        in.fail("unknown fallback " + std::to_string(fallback));
     stats.fallback = static_cast<DensityFallback>(fallback);
 
     // The payload's size, checked against the file before anything is allocated for it.
@@ -338,8 +342,7 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
     const uint64_t left = file_size - out.payload_offset;
     if (payload > left)
         in.fail("truncated: payload needs " + std::to_string(payload) + " bytes, " + std::to_string(left) + " left");
-    if (payload < left)
-        in.fail(std::to_string(left - payload) + " bytes of trailing data after the payload");
+    if (payload < left) in.fail(std::to_string(left - payload) + " bytes of trailing data after the payload");
     return out;
 }
 
@@ -384,7 +387,8 @@ Table read_payload(Header header, Read&& read, std::string_view name) {
             for (uint32_t y = lo; y < hi; ++y) {
                 const size_t offset = size_t{y} * w;
                 for (uint32_t x = 0; x < w; ++x) radiance.pixels[offset + x] = rgbe_decode(density[offset + x]);
-                density_row(std::span(radiance.pixels).subspan(offset, w), y, header.h, header.options, header.stats, row);
+                density_row(std::span(radiance.pixels).subspan(offset, w), y, header.h, header.options, header.stats,
+                            row);
                 std::memcpy(density.data() + offset, row.data(), row.size() * sizeof(float));
             }
         });
@@ -420,8 +424,9 @@ std::optional<Table> read_mapped_payload(Header header, const std::shared_ptr<co
     uint64_t digest = 0;
     std::memcpy(&digest, payload.data() + density_bytes.size() + radiance_bytes.size(), sizeof digest);
     if (digest != payload_hash.digest()) fail(name, "corrupted payload (checksum mismatch)");
-    const RgbImageView radiance{header.w, header.h,
-                                std::span(reinterpret_cast<const Rgb*>(radiance_bytes.data()), static_cast<size_t>(texels))};
+    const RgbImageView radiance{
+        header.w, header.h,
+        std::span(reinterpret_cast<const Rgb*>(radiance_bytes.data()), static_cast<size_t>(texels))};
     Table table = checked_table(name, header.version, std::move(header.source), [&] {
         return EnvMap(radiance, file, std::move(density), header.options, header.stats);
     });

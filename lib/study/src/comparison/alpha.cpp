@@ -6,8 +6,8 @@
 #include <optional>
 #include <stdexcept>
 
-#include "envmis/study/reference/quadrature.h"
 #include "detail/parallel.h"
+#include "envmis/study/reference/quadrature.h"
 
 namespace envmis {
 namespace {
@@ -102,7 +102,8 @@ AlphaChoice choose_alpha(RgbImageView radiance, const EnvMapOptions& map, const 
     std::vector<float> alphas = options.candidates;
     for (float a : alphas)
         if (!(a >= 0 && std::isfinite(a)))
-            throw std::invalid_argument("choose_alpha: candidate alpha " + std::to_string(a) + " is not a finite number >= 0");
+            throw std::invalid_argument("choose_alpha: candidate alpha " + std::to_string(a) +
+                                        " is not a finite number >= 0");
     alphas.push_back(0);
     std::sort(alphas.begin(), alphas.end());
     alphas.erase(std::unique(alphas.begin(), alphas.end()), alphas.end());

@@ -56,7 +56,8 @@ std::vector<ShadingPoint> sphere_points(uint32_t k) {
     std::vector<ShadingPoint> points(k);
     for (uint32_t i = 0; i < k; ++i) {
         const double z = 1 - (2 * i + 1.0) / k, r = std::sqrt(1 - z * z), phi = kGoldenAngle * i;
-        const Vec3 n{static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z)};
+        const Vec3 n{static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
+                     static_cast<float>(z)};
         points[i] = {n, n};
     }
     return points;
@@ -82,8 +83,7 @@ Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<con
     if (options.bsdfs.empty() || options.techniques.empty() || options.spp == 0 || points.empty())
         throw std::invalid_argument("compare: needs at least one BSDF, technique, shading point and sample");
     std::vector<DirectLightingEstimator> estimators;
-    for (const Technique& t : options.techniques)
-        estimators.emplace_back(plain, compensated, t, options.allocation);
+    for (const Technique& t : options.techniques) estimators.emplace_back(plain, compensated, t, options.allocation);
     const size_t nb = options.bsdfs.size(), nt = options.techniques.size();
     const uint32_t threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
     const LumaCoefficients luma = plain.options().luma;
@@ -116,7 +116,9 @@ Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<con
                         const double x = luminance(chunk[i - begin], luma);
                         cell.estimates.add(x);
                         cell.batches[i % kBatches].add(x);
-                        if (reference > 0) cell.squared_relative_error.add((x - reference) * (x - reference) / (reference * reference));
+                        if (reference > 0)
+                            cell.squared_relative_error.add((x - reference) * (x - reference) /
+                                                            (reference * reference));
                     }
                 }
                 cell.ill_conditioned = options.techniques[t].heuristic == Heuristic::optimal && state.estimates >= 8 &&

@@ -4,8 +4,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "envmis/study/shading/frame.h"
 #include "detail/parallel.h"
+#include "envmis/study/shading/frame.h"
 
 namespace envmis {
 namespace {
@@ -45,7 +45,8 @@ Acc integrate(const EnvMap& map, const ShadingPoint& point, int s, Fn&& fn) {
                     if (!(luminance(l, luma) > 0)) continue;
                     for (int b = 0; b < s; ++b)
                         for (int a = 0; a < s; ++a) {
-                            const Vec2 uv{static_cast<float>((x + (a + 0.5) / s) / w), static_cast<float>((y + (b + 0.5) / s) / h)};
+                            const Vec2 uv{static_cast<float>((x + (a + 0.5) / s) / w),
+                                          static_cast<float>((y + (b + 0.5) / s) / h)};
                             const Vec3 wi = frame.to_local(to_world(map.options().axes, equal_area_direction(uv)));
                             if (wi.z > 0) fn(rows[y], Node{wi, solid_angle, l, uv});
                         }
@@ -124,8 +125,9 @@ double exact_variance(const EnvMap& env, Technique technique, Allocation allocat
     };
     if (technique.adaptive() || technique.mixture)
         throw std::invalid_argument("exact_variance: " + technique.name() +
-                                    (technique.adaptive() ? " learns its weights from its own samples; its variance has no closed form"
-                                                          : " samples two maps; pass one technique of one map"));
+                                    (technique.adaptive()
+                                         ? " learns its weights from its own samples; its variance has no closed form"
+                                         : " samples two maps; pass one technique of one map"));
     const Strategy strategy = technique.strategy;
     const bool both = strategy == Strategy::mis || strategy == Strategy::one_sample;
     const double n_env = strategy == Strategy::env ? allocation.total() : (both ? allocation.env : 0);
@@ -147,9 +149,10 @@ double exact_variance(const EnvMap& env, Technique technique, Allocation allocat
         // One technique's contribution: weight against the other, first and second moments.
         auto add = [&](double n_self, double p_self, double n_other, double p_other, double& first, double& second) {
             if (!(n_self > 0 && p_self > 0)) return;
-            const double w = strategy == Strategy::mis ? mis_weight(technique.heuristic, static_cast<float>(n_self * p_self),
-                                                                    static_cast<float>(n_other * p_other))
-                                                       : 1.0;
+            const double w = strategy == Strategy::mis
+                                 ? mis_weight(technique.heuristic, static_cast<float>(n_self * p_self),
+                                              static_cast<float>(n_other * p_other))
+                                 : 1.0;
             first += f * w * n.solid_angle;
             second += f * f * w * w / p_self * n.solid_angle;
         };

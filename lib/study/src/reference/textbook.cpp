@@ -37,8 +37,8 @@ TextbookDistribution2D::TextbookDistribution2D(std::span<const float> func, uint
     : func_(func.begin(), func.end()), w_(w), h_(h) {
     const size_t n = size_t{w} * h;
     if (w == 0 || h == 0 || w > kMaxCells1D || h > kMaxCells1D || func.size() != n)
-        throw std::invalid_argument("TextbookDistribution2D: " + std::to_string(func.size()) +
-                                    " values for a " + std::to_string(w) + "x" + std::to_string(h) + " grid");
+        throw std::invalid_argument("TextbookDistribution2D: " + std::to_string(func.size()) + " values for a " +
+                                    std::to_string(w) + "x" + std::to_string(h) + " grid");
     if (std::any_of(func.begin(), func.end(), [](float f) { return !(f >= 0 && std::isfinite(f)); }))
         throw std::invalid_argument("TextbookDistribution2D: negative, NaN or infinite function values");
     uniform_ = std::all_of(func.begin(), func.end(), [](float f) { return f == 0; });

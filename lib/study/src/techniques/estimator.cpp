@@ -12,9 +12,7 @@ namespace envmis {
 namespace {
 
 Rgb operator*(Rgb a, Rgb b) noexcept { return {a.r * b.r, a.g * b.g, a.b * b.b}; }
-void add(Rgb& sum, Rgb v, float s) noexcept {
-    sum.r += v.r * s, sum.g += v.g * s, sum.b += v.b * s;
-}
+void add(Rgb& sum, Rgb v, float s) noexcept { sum.r += v.r * s, sum.g += v.g * s, sum.b += v.b * s; }
 
 constexpr Technique kAll[] = {
     {Strategy::env},
@@ -218,8 +216,10 @@ template <uint32_t kMaxLanes>
 void estimate_lanes(const EnvMapView& env, const Technique& t, const Allocation& a, const Frame& frame, Vec3 wo,
                     const Bsdf& bsdf, Pcg32& rng, std::span<Rgb> out) noexcept {
     switch (bsdf.kind) {
-        case BsdfKind::lambert: return estimate_lanes_of<kMaxLanes, BsdfKind::lambert>(env, t, a, frame, wo, bsdf, rng, out);
-        case BsdfKind::phong: return estimate_lanes_of<kMaxLanes, BsdfKind::phong>(env, t, a, frame, wo, bsdf, rng, out);
+        case BsdfKind::lambert:
+            return estimate_lanes_of<kMaxLanes, BsdfKind::lambert>(env, t, a, frame, wo, bsdf, rng, out);
+        case BsdfKind::phong:
+            return estimate_lanes_of<kMaxLanes, BsdfKind::phong>(env, t, a, frame, wo, bsdf, rng, out);
         case BsdfKind::ggx: return estimate_lanes_of<kMaxLanes, BsdfKind::ggx>(env, t, a, frame, wo, bsdf, rng, out);
     }
 }
@@ -264,7 +264,8 @@ DirectLightingEstimator::DirectLightingEstimator(const EnvMap& plain, const EnvM
                                     std::to_string(allocation.bsdf) + " does not fit in 32 bits");
     const bool both = technique.strategy == Strategy::mis || technique.strategy == Strategy::one_sample;
     if (both && (allocation.env == 0 || allocation.bsdf == 0))
-        throw std::invalid_argument(technique.name() + " needs at least one environment and one BSDF sample per estimate");
+        throw std::invalid_argument(technique.name() +
+                                    " needs at least one environment and one BSDF sample per estimate");
     const EnvMap& sampled = technique.compensated ? compensated : plain;
     if (technique.strategy == Strategy::env && !sampled.complete())
         throw std::invalid_argument(
@@ -363,7 +364,8 @@ Rgb DirectLightingEstimator::estimate(const ShadingPoint& point, const Bsdf& bsd
     }
 
     if (optimal)
-        for (int i = 0; i < m; ++i) add(sum, {state.optimal.alpha[i][0], state.optimal.alpha[i][1], state.optimal.alpha[i][2]}, 1);
+        for (int i = 0; i < m; ++i)
+            add(sum, {state.optimal.alpha[i][0], state.optimal.alpha[i][1], state.optimal.alpha[i][2]}, 1);
     if (t.adaptive() && ++state.estimates == state.next_update) {
         update(state, t.heuristic, m);
         state.next_update *= 2;

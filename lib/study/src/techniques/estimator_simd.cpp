@@ -74,12 +74,15 @@ ENVMIS_AVX2 void sample_lambert(const Frame& frame, Rgb albedo, PointArrays u, S
         // sample_disk
         const F8 a = sub(mul(splat(2.0f), load(u.x + l)), splat(1.0f));
         const F8 b = sub(mul(splat(2.0f), load(u.y + l)), splat(1.0f));
-        const F8 centre = _mm256_and_ps(_mm256_cmp_ps(a, splat(0.0f), _CMP_EQ_OQ), _mm256_cmp_ps(b, splat(0.0f), _CMP_EQ_OQ));
+        const F8 centre =
+            _mm256_and_ps(_mm256_cmp_ps(a, splat(0.0f), _CMP_EQ_OQ), _mm256_cmp_ps(b, splat(0.0f), _CMP_EQ_OQ));
         const F8 wide = greater(abs8(a), abs8(b));
         const F8 radius = select(wide, a, b);
-        const F8 angle = select(wide, mul(splat(kPiF / 4), div(b, a)), sub(splat(kPiF / 2), mul(splat(kPiF / 4), div(a, b))));
+        const F8 angle =
+            select(wide, mul(splat(kPiF / 4), div(b, a)), sub(splat(kPiF / 2), mul(splat(kPiF / 4), div(a, b))));
         const SinCos8 p = fast_sincos8(angle);
-        const F8 dx = select(centre, splat(0.0f), mul(radius, p.cos)), dy = select(centre, splat(0.0f), mul(radius, p.sin));
+        const F8 dx = select(centre, splat(0.0f), mul(radius, p.cos)),
+                 dy = select(centre, splat(0.0f), mul(radius, p.sin));
         // sample_cosine_hemisphere: z = sqrt(max(0, 1 - dx^2 - dy^2))
         const F8 rest = sub(sub(splat(1.0f), mul(dx, dx)), mul(dy, dy));
         const F8 dz = _mm256_sqrt_ps(select(less(splat(0.0f), rest), rest, splat(0.0f)));

@@ -9,9 +9,9 @@
 
 #include <cstdint>
 
+#include "detail/simd.h"
 #include "envmis/sampling/envmap.h"
 #include "envmis/study/shading/frame.h"
-#include "detail/simd.h"
 
 namespace envmis::detail {
 

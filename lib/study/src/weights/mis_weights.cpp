@@ -8,7 +8,8 @@ namespace envmis {
 
 OptimalAlpha solve_optimal_alpha(const double* a, const double* b, int m) noexcept {
     // Bounded sizes: Eigen keeps these on the stack, so the solve allocates nothing.
-    using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor, kMaxTechniques, kMaxTechniques>;
+    using Matrix =
+        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor, kMaxTechniques, kMaxTechniques>;
     using Rhs = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor, kMaxTechniques, 3>;
     OptimalAlpha result;
     if (m < 1 || m > kMaxTechniques) return result;
@@ -19,7 +20,8 @@ OptimalAlpha solve_optimal_alpha(const double* a, const double* b, int m) noexce
     // estimate stays finite on singular matrices, whose zero pivots it skips.
     const Eigen::SelfAdjointEigenSolver<Matrix> eigen(A, Eigen::EigenvaluesOnly);
     const auto& lambda = eigen.eigenvalues();
-    result.rcond = eigen.info() == Eigen::Success && lambda.maxCoeff() > 0 ? lambda.minCoeff() / lambda.maxCoeff() : 0.0;
+    result.rcond =
+        eigen.info() == Eigen::Success && lambda.maxCoeff() > 0 ? lambda.minCoeff() / lambda.maxCoeff() : 0.0;
     if (!(result.rcond >= 1e-9)) return result;
     const Rhs alpha = A.ldlt().solve(B);
     if (!alpha.allFinite()) return result;

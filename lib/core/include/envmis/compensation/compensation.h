@@ -24,8 +24,7 @@ struct CompensationOptions {
 };
 
 // Solid-angle-weighted mean of a w x h row-major luminance image (double sums).
-double solid_angle_mean(std::span<const float> luminance, uint32_t w, uint32_t h,
-                        Mapping mapping = Mapping::equirect);
+double solid_angle_mean(std::span<const float> luminance, uint32_t w, uint32_t h, Mapping mapping = Mapping::equirect);
 
 // The same mean from the row sums (sum over x of L(x, y)) of a w-wide image.
 double solid_angle_mean_of_rows(std::span<const double> row_sums, uint32_t w,

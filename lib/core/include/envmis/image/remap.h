@@ -34,14 +34,14 @@ std::array<double, 3> total_power(const RgbImage& image, Mapping m);
 
 struct RemapResult {
     RgbImage image;
-    BadPixels bad_pixels;      // input channel values replaced by 0
+    BadPixels bad_pixels;        // input channel values replaced by 0
     uint32_t supersampling = 0;  // s: s x s sub-samples per input texel
 };
 
 // Converts `in` (mapping `from`) into a width x height image under mapping `to`.
 // supersampling = 0 picks s so that output texels of average size receive at least 16
-// sub-samples where the input texels are largest (s from 2 to 16). Throws std::invalid_argument for an empty or inconsistent
-// image, a zero or too large output size, or a non-square equal-area size.
+// sub-samples where the input texels are largest (s from 2 to 16). Throws std::invalid_argument for an empty or
+// inconsistent image, a zero or too large output size, or a non-square equal-area size.
 RemapResult remap(const RgbImage& in, Mapping from, Mapping to, uint32_t width, uint32_t height,
                   uint32_t supersampling = 0);
 

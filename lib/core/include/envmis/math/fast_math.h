@@ -28,7 +28,8 @@ ENVMIS_HD inline SinCos fast_sincos(float x) noexcept {
     const float r = ((x - y * 0.78515625f) - y * 2.4187564849853515625e-4f) - y * 3.77489497744594108e-8f;
     const float z = r * r;
     const float s = ((-1.9515295891e-4f * z + 8.3321608736e-3f) * z - 1.6666654611e-1f) * z * r + r;
-    const float c = ((2.443315711809948e-5f * z - 1.388731625493765e-3f) * z + 4.166664568298827e-2f) * z * z - 0.5f * z + 1;
+    const float c =
+        ((2.443315711809948e-5f * z - 1.388731625493765e-3f) * z + 4.166664568298827e-2f) * z * z - 0.5f * z + 1;
     const int q = (j >> 1) & 3;  // which quarter turn
     const float sin_x = (q & 1) ? c : s, cos_x = (q & 1) ? s : c;
     return {((q & 2) ? -sin_x : sin_x) * sign, ((q + 1) & 2) ? -cos_x : cos_x};
@@ -45,7 +46,8 @@ ENVMIS_HD inline float fast_atan2(float y, float x) noexcept {
     const bool reduce = n > 0.41421356237309515f * d;
     const float num = reduce ? n - d : n, den = reduce ? n + d : d;
     const float r = den > 0 ? num / den : 0.0f, z = r * r;
-    float a = (((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z - 3.33329491539e-1f) * z * r + r;
+    float a =
+        (((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z - 3.33329491539e-1f) * z * r + r;
     a += reduce ? kPiF / 4 : 0.0f;
     a = swap ? kPiF / 2 - a : a;
     a = x < 0 ? kPiF - a : a;

@@ -41,8 +41,10 @@ struct LargeAllocator {
         return static_cast<T*>(p);
     }
     void deallocate(T* p, size_t n) noexcept {
-        if (n * sizeof(T) < kLarge) ::operator delete(p);
-        else std::free(p);
+        if (n * sizeof(T) < kLarge)
+            ::operator delete(p);
+        else
+            std::free(p);
     }
     // Default-initialisation: no zero fill for trivial types.
     template <class U>

@@ -31,12 +31,12 @@
 #include <span>
 #include <vector>
 
-#include "envmis/sampling/allocator.h"
 #include "envmis/math/math.h"
+#include "envmis/sampling/allocator.h"
 
 namespace envmis {
 
-inline constexpr uint32_t kCdfUnits = 1u << 31;   // total of a fixed-point CDF
+inline constexpr uint32_t kCdfUnits = 1u << 31;    // total of a fixed-point CDF
 inline constexpr uint32_t kMaxCells1D = 1u << 16;  // per dimension (uint16 guide entries)
 
 // A point found by inverting a CDF: the cell and the position inside it, in [0,1).
@@ -77,10 +77,13 @@ struct CdfView {
         uint32_t lo = guide[k], hi = k + 1 < n ? guide[k + 1] : n - 1;
         while (lo < hi) {  // last cell whose start is <= t
             const uint32_t mid = (lo + hi + 1) / 2;
-            if (start[mid] <= t) lo = mid; else hi = mid - 1;
+            if (start[mid] <= t)
+                lo = mid;
+            else
+                hi = mid - 1;
         }
-        const float offset = (static_cast<float>(t - start[lo]) + (x - static_cast<float>(t))) /
-                             static_cast<float>(width(lo));
+        const float offset =
+            (static_cast<float>(t - start[lo]) + (x - static_cast<float>(t))) / static_cast<float>(width(lo));
         // Both terms are >= 0 (t >= start[lo], t <= x) and the found cell is not empty,
         // so only the rounding up to 1 needs a clamp.
         return {lo, min(offset, kOneMinusEpsilon)};
@@ -210,7 +213,7 @@ struct Distribution2DView {
     const uint16_t* guide = nullptr;  // w h, likewise
     CdfView marginal;                 // over the h rows
     uint32_t w = 0, h = 0;
-    float pdf_scale = 0;              // w h 2^-62: density per unit of the marginal times unit of a row
+    float pdf_scale = 0;  // w h 2^-62: density per unit of the marginal times unit of a row
 
     struct Sample {
         Vec2 p;                 // continuous point in [0,1)^2
@@ -274,7 +277,11 @@ public:
     Distribution2D(uint32_t w, uint32_t h, LargeVector<uint32_t> cells, const CellRowFunction& rows);
 
     Distribution2DView view() const noexcept {
-        return {start_.data(), guide_.data(), {marginal_start_.data(), marginal_guide_.data(), h_}, w_, h_,
+        return {start_.data(),
+                guide_.data(),
+                {marginal_start_.data(), marginal_guide_.data(), h_},
+                w_,
+                h_,
                 static_cast<float>(uint64_t{w_} * h_) * 0x1p-62f};
     }
     Distribution2DView::Sample sample(Vec2 u) const noexcept { return view().sample(u); }

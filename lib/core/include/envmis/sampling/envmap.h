@@ -24,10 +24,10 @@
 #include <vector>
 
 #include "envmis/compensation/compensation.h"
-#include "envmis/sampling/distribution.h"
 #include "envmis/image/image.h"
 #include "envmis/image/mapping.h"
 #include "envmis/math/math.h"
+#include "envmis/sampling/distribution.h"
 
 namespace envmis {
 
@@ -42,17 +42,17 @@ enum class DensityFallback : uint32_t {
 std::string_view to_string(DensityFallback f) noexcept;
 
 struct EnvMapOptions {
-    CompensationOptions compensation;  // enabled by default, alpha = 1
-    LumaCoefficients luma;             // of the radiance's colour space (Rec.709 by default)
-    Axes axes;                         // world frame of directions (z up by default)
+    CompensationOptions compensation;     // enabled by default, alpha = 1
+    LumaCoefficients luma;                // of the radiance's colour space (Rec.709 by default)
+    Axes axes;                            // world frame of directions (z up by default)
     Mapping mapping = Mapping::equirect;  // equal_area needs a square image
 };
 
 // What the build measured and did; recorded in table files.
 struct EnvMapStats {
-    BadPixels bad_pixels;            // channel values replaced by 0
-    double mean_luminance = 0;       // Lbar, solid-angle weighted
-    float threshold = 0;             // alpha Lbar if compensation was applied, else 0
+    BadPixels bad_pixels;       // channel values replaced by 0
+    double mean_luminance = 0;  // Lbar, solid-angle weighted
+    float threshold = 0;        // alpha Lbar if compensation was applied, else 0
     float max_luminance = 0;
     float min_positive_luminance = 0;  // 0 if the map is black
     uint64_t zeroed_texels = 0;        // texels with L > 0 whose density compensation set to 0

@@ -28,10 +28,10 @@ inline constexpr uint32_t kTableVersion = 3;
 
 // Where a table's map came from.
 struct TableSource {
-    std::string name;                 // file name of the source image (no folders)
-    uint64_t content_hash = 0;        // hash64 of the source file's bytes
-    std::string input_colorspace;     // colour space the pixels were read in
-    std::string working_colorspace;   // colour space of the stored radiance
+    std::string name;                // file name of the source image (no folders)
+    uint64_t content_hash = 0;       // hash64 of the source file's bytes
+    std::string input_colorspace;    // colour space the pixels were read in
+    std::string working_colorspace;  // colour space of the stored radiance
 };
 
 struct Table {

@@ -30,7 +30,7 @@ public:
     ColourConfig(ColourConfig&&) noexcept;
     ColourConfig& operator=(ColourConfig&&) noexcept;
 
-    std::string description() const;         // where the config came from
+    std::string description() const;          // where the config came from
     std::vector<std::string> spaces() const;  // names of its colour spaces
     bool has_space(const std::string& name) const;
     // The canonical name for a file's colour-space metadata ("Linear", "scene_linear",

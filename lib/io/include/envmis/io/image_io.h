@@ -30,7 +30,7 @@ public:
 };
 
 struct LoadOptions {
-    std::string colorspace;                 // input colour space; empty: from the file's metadata
+    std::string colorspace;                    // input colour space; empty: from the file's metadata
     std::string working_space = "lin_rec709";  // a colour space of the OCIO config (colour.h)
 };
 

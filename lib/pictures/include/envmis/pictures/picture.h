@@ -55,8 +55,8 @@ void blit(Image8& dst, const Image8& src, int x, int y);
 // blocks and keeps the image's mean. NaN and Inf count as 0.
 RgbImage resize(RgbImageView image, uint32_t new_width, uint32_t new_height);
 // The same for one float per pixel (densities, errors), row-major, width x height values.
-std::vector<float> resize(std::span<const float> values, uint32_t width, uint32_t height,
-                          uint32_t new_width, uint32_t new_height);
+std::vector<float> resize(std::span<const float> values, uint32_t width, uint32_t height, uint32_t new_width,
+                          uint32_t new_height);
 // The same for a picture, averaged in linear light so that edges do not darken.
 Image8 resize(const Image8& image, uint32_t new_width, uint32_t new_height);
 
@@ -97,8 +97,7 @@ Rgb8 colour_map(float t);
 // The colour of one value: kNoValueColour or colour_map(scale.position(value)).
 Rgb8 false_colour(float value, const ColourScale& scale);
 // A width x height picture of row-major `values` (width * height of them).
-Image8 false_colour(std::span<const float> values, uint32_t width, uint32_t height,
-                    const ColourScale& scale);
+Image8 false_colour(std::span<const float> values, uint32_t width, uint32_t height, const ColourScale& scale);
 
 // One log scale for several images, so they can be compared by colour: hi is the largest
 // finite value of all of them, lo the `low_quantile` of their positive values together
@@ -106,8 +105,8 @@ Image8 false_colour(std::span<const float> values, uint32_t width, uint32_t heig
 // hi. Without any positive value the scale is [0.1, 1].
 ColourScale shared_log_scale(std::span<const std::span<const float>> images, float low_quantile = 0.01f,
                              float max_decades = 8);
-inline ColourScale shared_log_scale(std::initializer_list<std::span<const float>> images,
-                                    float low_quantile = 0.01f, float max_decades = 8) {
+inline ColourScale shared_log_scale(std::initializer_list<std::span<const float>> images, float low_quantile = 0.01f,
+                                    float max_decades = 8) {
     return shared_log_scale(std::span(images.begin(), images.size()), low_quantile, max_decades);
 }
 

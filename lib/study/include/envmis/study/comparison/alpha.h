@@ -27,11 +27,11 @@
 #include <span>
 #include <vector>
 
-#include "envmis/study/shading/bsdf.h"
-#include "envmis/study/comparison/comparison.h"
-#include "envmis/sampling/envmap.h"
-#include "envmis/study/techniques/estimator.h"
 #include "envmis/image/image.h"
+#include "envmis/sampling/envmap.h"
+#include "envmis/study/comparison/comparison.h"
+#include "envmis/study/shading/bsdf.h"
+#include "envmis/study/techniques/estimator.h"
 
 namespace envmis {
 
@@ -64,7 +64,7 @@ struct AlphaOptions {
     std::vector<float> candidates = {0, 0.25f, 0.5f, 0.75f, 1, 1.25f, 1.5f, 2, 3};
     std::vector<Bsdf> bsdfs = ComparisonOptions{}.bsdfs;
     std::vector<ShadingPoint> points = sphere_points(16);
-    Allocation allocation;    // samples per MIS estimate, as the estimates will use
+    Allocation allocation;     // samples per MIS estimate, as the estimates will use
     uint32_t max_width = 128;  // of the downsampled copy the quadratures run on
 };
 
@@ -77,14 +77,12 @@ struct AlphaCandidate {
 };
 
 // The choice, per BSDF and for the whole map. Each picks the candidate with the lowest
-// criterion (the smallest alpha on a tie, within 1e-6 relative: float rounding). BSDFs disagree: a diffuse lobe gains most from
-// strong compensation, a glossy one often from mild compensation, so a map-wide alpha
-// can be well off the best for some BSDFs. Over the 14 bundled and shared maps with
-// lambert, phong:50 and ggx:0.1 (42 cases; exact variances at full resolution against a
-// sweep of alpha = 0, 0.25, ..., 3), the map-wide choice is over 5% worse than the
-// case's best in 6 cases (up to 27%), each BSDF's own choice in none (at most 3.9%).
-// `compare` therefore uses one compensated map per BSDF; a table file, which holds one
-// density, takes the map-wide alpha.
+// criterion (the smallest alpha on a tie, within 1e-6 relative: float rounding). BSDFs disagree: a diffuse lobe gains
+// most from strong compensation, a glossy one often from mild compensation, so a map-wide alpha can be well off the
+// best for some BSDFs. Over the 14 bundled and shared maps with lambert, phong:50 and ggx:0.1 (42 cases; exact
+// variances at full resolution against a sweep of alpha = 0, 0.25, ..., 3), the map-wide choice is over 5% worse than
+// the case's best in 6 cases (up to 27%), each BSDF's own choice in none (at most 3.9%). `compare` therefore uses one
+// compensated map per BSDF; a table file, which holds one density, takes the map-wide alpha.
 struct AlphaChoice {
     std::vector<float> bsdf_alphas;          // lowest AlphaCandidate::per_bsdf, per BSDF
     float alpha = 0;                         // lowest AlphaCandidate::criterion

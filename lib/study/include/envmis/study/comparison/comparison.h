@@ -27,10 +27,10 @@
 #include <string>
 #include <vector>
 
-#include "envmis/study/shading/bsdf.h"
 #include "envmis/sampling/envmap.h"
-#include "envmis/study/techniques/estimator.h"
 #include "envmis/study/reference/quadrature.h"
+#include "envmis/study/shading/bsdf.h"
+#include "envmis/study/techniques/estimator.h"
 
 namespace envmis {
 
@@ -38,7 +38,7 @@ struct ComparisonOptions {
     std::vector<Bsdf> bsdfs = {Bsdf::lambert(), Bsdf::phong(50), Bsdf::ggx(0.1f)};
     std::vector<Technique> techniques = default_techniques();
     Allocation allocation;
-    uint32_t spp = 1024;   // estimates per point, BSDF and technique
+    uint32_t spp = 1024;  // estimates per point, BSDF and technique
     uint64_t seed = 1;
     uint32_t threads = 0;  // 0: all cores
     QuadratureOptions quadrature{1e-3, 32};

@@ -11,8 +11,8 @@
 // threads.
 #pragma once
 
-#include "envmis/study/shading/bsdf.h"
 #include "envmis/sampling/envmap.h"
+#include "envmis/study/shading/bsdf.h"
 #include "envmis/study/techniques/estimator.h"
 
 namespace envmis {

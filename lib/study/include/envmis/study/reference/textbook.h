@@ -12,8 +12,8 @@
 #include <span>
 #include <vector>
 
-#include "envmis/sampling/distribution.h"
 #include "envmis/math/math.h"
+#include "envmis/sampling/distribution.h"
 
 namespace envmis {
 

@@ -21,8 +21,8 @@
 #include <string>
 #include <string_view>
 
-#include "envmis/study/shading/frame.h"
 #include "envmis/math/math.h"
+#include "envmis/study/shading/frame.h"
 
 namespace envmis {
 

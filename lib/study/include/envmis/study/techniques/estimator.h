@@ -30,10 +30,10 @@
 #include <string_view>
 #include <vector>
 
-#include "envmis/study/shading/bsdf.h"
-#include "envmis/sampling/envmap.h"
-#include "envmis/study/weights/mis_weights.h"
 #include "envmis/math/random.h"
+#include "envmis/sampling/envmap.h"
+#include "envmis/study/shading/bsdf.h"
+#include "envmis/study/weights/mis_weights.h"
 
 namespace envmis {
 
@@ -83,13 +83,13 @@ ENVMIS_HD inline float mis_weight(Heuristic h, float a, float b) noexcept {
 // What an adaptive technique has learnt at one shading point. Start a fresh one for
 // every point; the techniques that do not learn leave it untouched.
 struct PointState {
-    uint32_t estimates = 0;     // made at this point so far
-    uint32_t next_update = 8;   // the estimate count at which the learnt values change
+    uint32_t estimates = 0;    // made at this point so far
+    uint32_t next_update = 8;  // the estimate count at which the learnt values change
     // Optimal MIS: sums over samples of c_k c_l / Q^2 and f c_k / Q^2 (Q = sum n p),
     // unbiased estimates of the system's integrals up to a common factor.
     double a[kMaxTechniques * kMaxTechniques] = {};
     double b[kMaxTechniques * 3] = {};
-    OptimalAlpha optimal;       // alpha = 0 (balance) until the first update
+    OptimalAlpha optimal;          // alpha = 0 (balance) until the first update
     uint32_t ill_conditioned = 0;  // updates that found the system singular: balance kept
     // Variance-aware MIS: moments of each technique's own estimate luminance(f) / p.
     double sum[2] = {}, sum2[2] = {};
