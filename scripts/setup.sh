@@ -3,12 +3,13 @@
 # only touched when something is missing, so CI and developers pay nothing on a warm box.
 set -euo pipefail
 
-# The one list of build dependencies (clang and libclang-rt-14-dev: the libFuzzer build).
+# The one list of build dependencies (clang and libclang-rt-14-dev: the libFuzzer build;
+# clang-format: the style check in CI).
 packages=(
   cmake g++ pkg-config
   libopenimageio-dev libopencolorio-dev libopenexr-dev libeigen3-dev
   libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev
-  clang libclang-rt-14-dev
+  clang libclang-rt-14-dev clang-format
 )
 
 missing=()

@@ -20,7 +20,14 @@ set_tests_properties(consumer.clean PROPERTIES FIXTURES_SETUP envmis_consumer_cl
 set_tests_properties(consumer.install PROPERTIES
   FIXTURES_REQUIRED envmis_consumer_clean FIXTURES_SETUP envmis_installed)
 
-foreach(kind core io)
+# The installed runtime holds nothing but lib/core: no study, I/O or picture code.
+add_test(NAME consumer.core-contents
+  COMMAND ${CMAKE_COMMAND} -DARCHIVE=${envmis_consumer_prefix}/${CMAKE_INSTALL_LIBDIR}/libenvmis_core.a
+    -DSOURCES=${PROJECT_SOURCE_DIR}/lib/core/src -DNM=${CMAKE_NM} -DAR=${CMAKE_AR}
+    -P ${CMAKE_CURRENT_LIST_DIR}/core_contents.cmake)
+set_tests_properties(consumer.core-contents PROPERTIES FIXTURES_REQUIRED envmis_installed LABELS consumer)
+
+foreach(kind core study io)
   set(build ${envmis_consumer_dir}/build-${kind})
   add_test(NAME consumer.${kind}
     COMMAND ${CMAKE_CTEST_COMMAND} --build-and-test ${CMAKE_CURRENT_LIST_DIR} ${build}

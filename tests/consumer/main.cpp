@@ -13,8 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "envmis/sampling/envmap.h"
-#include "envmis/table/table.h"
+#include "envmis/core.h"
 #ifdef ENVMIS_CONSUMER_IO
 #include "envmis/io/colour.h"
 #include "envmis/io/image_io.h"

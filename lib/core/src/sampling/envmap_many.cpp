@@ -9,7 +9,7 @@
 // several sizes, at the poles, the seam and the last column). If one of those functions
 // changes, this file must change with it; the tests fail until it does. GCC 12's
 // auto-vectoriser does not vectorise the scalar loops in a target("avx2") function
-// (README, Performance), hence the intrinsics.
+// (docs/performance-log.md), hence the intrinsics.
 #include "envmis/sampling/envmap.h"
 
 #include <algorithm>

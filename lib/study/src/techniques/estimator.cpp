@@ -123,7 +123,7 @@ bool runs_in_lanes(const Technique& t, const Allocation& a) noexcept {
 // sample and look up eight lanes at a time, and for a Lambertian surface (seen from
 // above) so do the BSDF's sampling, pdf, value and the weighted sums
 // (estimator_simd.h): the lanes are then padded to a multiple of eight with valid
-// points, whose results are dropped. See README, Performance, for what each step
+// points, whose results are dropped. See docs/performance-log.md for what each step
 // gained. kMaxLanes sizes the working arrays, which one estimate alone must not pay for.
 template <uint32_t kMaxLanes, BsdfKind K>
 [[gnu::flatten]] void estimate_lanes_of(const EnvMapView& env, const Technique& t, const Allocation& a,
