@@ -81,7 +81,7 @@ CLI::Validator size_validator(bool single) {
             if (parse_size(text, single)) return {};
             return "'" + text + "': expected " + expected + ", each 1 to " + std::to_string(kMaxCells1D);
         },
-        expected);
+        "");
 }
 
 namespace {

@@ -56,7 +56,7 @@ struct Size {
     uint32_t width = 0, height = 0;
 };
 std::optional<Size> parse_size(const std::string& text, bool single);
-// A validator for such a flag, saying what it expects.
+// A validator for such a flag, saying what it expects when it refuses a value.
 CLI::Validator size_validator(bool single);
 
 // A map ready to sample, and where it came from.

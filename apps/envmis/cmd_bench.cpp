@@ -109,6 +109,7 @@ constexpr int kMaxRepeats = 1000;
 void add_bench_flags(CLI::App& sub, BenchArgs& args) {
     sub.add_option("input", args.input, "HDR image or table (default: a synthetic sky with a small sun)");
     sub.add_option("--size", args.size, "Size of the synthetic sky, WxH, each side 1 to 65536")
+        ->type_name("WxH")
         ->capture_default_str()
         ->check(size_validator(false));
     sub.add_option("--repeats", args.repeats, "Repeats of each measurement")

@@ -28,6 +28,7 @@ void add_convert_flags(CLI::App& sub, ConvertArgs& args) {
     sub.add_option("--size", args.size,
                    "Output size: N (equal-area N x N, equirect 2N x N) or WxH, each side 1 to 65536 (default: "
                    "about the input's texel count)")
+        ->type_name("N|WxH")
         ->check(size_validator(true));
     sub.add_option("--supersampling", args.supersampling,
                    "Sub-samples per input texel side (default 0: automatic, at least 16 per output texel)")
