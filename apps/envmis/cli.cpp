@@ -12,6 +12,7 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <string_view>
 
 #include "envmis/io/image_io.h"
 
@@ -48,6 +49,39 @@ void add_map_flags(CLI::App& app, MapFlags& flags) {
         ->capture_default_str();
     app.add_option("--axes", flags.axes, "World frame of directions: z-up, y-up or a signed permutation like x,z,-y")
         ->capture_default_str();
+}
+
+namespace {
+// A side of a size: 1 to kMaxCells1D, digits only.
+std::optional<uint32_t> parse_side(std::string_view text) {
+    if (text.empty() || text.size() > 5 || text.find_first_not_of("0123456789") != std::string_view::npos) return {};
+    const uint32_t side = static_cast<uint32_t>(std::stoul(std::string(text)));
+    if (side == 0 || side > kMaxCells1D) return {};
+    return side;
+}
+}  // namespace
+
+std::optional<Size> parse_size(const std::string& text, bool single) {
+    const size_t x = text.find('x');
+    if (x == std::string::npos) {
+        if (!single) return {};
+        if (const auto n = parse_side(text)) return Size{*n, 0};
+        return {};
+    }
+    const auto w = parse_side(std::string_view(text).substr(0, x)),
+               h = parse_side(std::string_view(text).substr(x + 1));
+    if (!w || !h) return {};
+    return Size{*w, *h};
+}
+
+CLI::Validator size_validator(bool single) {
+    const std::string expected = single ? "N or WxH" : "WxH";
+    return CLI::Validator(
+        [single, expected](std::string& text) -> std::string {
+            if (parse_size(text, single)) return {};
+            return "'" + text + "': expected " + expected + ", each 1 to " + std::to_string(kMaxCells1D);
+        },
+        "");
 }
 
 namespace {

@@ -3,12 +3,15 @@
 #pragma once
 
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <cstdint>
 #include <functional>
 #include <optional>
 #include <ostream>
 #include <string>
+#include <system_error>
+#include <type_traits>
 
 #include <CLI/CLI.hpp>
 
@@ -29,6 +32,32 @@ struct MapFlags {
     std::string mapping = "equirect";  // or "equal-area" (a square image)
 };
 void add_map_flags(CLI::App& app, MapFlags& flags);
+
+// The bounds of a count, size or seed flag, in the flag's own type T (an integer):
+// "-n: Value -5 not in range 1 to 1099511627776". The text is read as a decimal T in full:
+// CLI11 2.1 alone reads "-5" into a uint64_t as 2^64 - 5 and "18446744073709551616" as
+// 2^64 - 1, and would pass both where the upper bound is the type's maximum (seeds).
+template <class T>
+CLI::Validator in_range(T lo, T hi) {
+    static_assert(std::is_integral_v<T>);
+    return CLI::Validator(
+        [lo, hi](std::string& text) -> std::string {
+            T value{};
+            const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+            if (error == std::errc() && end == text.data() + text.size() && value >= lo && value <= hi) return {};
+            return "Value " + text + " not in range " + std::to_string(lo) + " to " + std::to_string(hi);
+        },
+        CLI::Range(lo, hi).get_description());
+}
+
+// An image size "WxH", each side 1 to kMaxCells1D (65536), or with `single` also "N"
+// (returned as N x 0). Digits only: no sign, no spaces. Empty where the text is not one.
+struct Size {
+    uint32_t width = 0, height = 0;
+};
+std::optional<Size> parse_size(const std::string& text, bool single);
+// A validator for such a flag, saying what it expects when it refuses a value.
+CLI::Validator size_validator(bool single);
 
 // A map ready to sample, and where it came from.
 struct LoadedMap {

@@ -93,132 +93,188 @@ std::pair<std::unique_ptr<Sampler>, double> build_repeatedly(const RgbImage& ima
     return {std::move(sampler), median(builds)};
 }
 
+// The arguments of `envmis bench`.
+struct BenchArgs {
+    std::string input, size = "8192x4096";
+    int repeats = 5;
+    uint32_t samples = 1u << 20;
+    bool json = false, no_compensate = false;
+};
+
+// At most 2^26 samples a repeat: the points and the batch arrays take about 40 bytes a
+// sample (2.7 GB at the limit); at most 1000 repeats.
+constexpr uint32_t kMaxBenchSamples = 1u << 26;
+constexpr int kMaxRepeats = 1000;
+
+void add_bench_flags(CLI::App& sub, BenchArgs& args) {
+    sub.add_option("input", args.input, "HDR image or table (default: a synthetic sky with a small sun)");
+    sub.add_option("--size", args.size, "Size of the synthetic sky, WxH, each side 1 to 65536")
+        ->type_name("WxH")
+        ->capture_default_str()
+        ->check(size_validator(false));
+    sub.add_option("--repeats", args.repeats, "Repeats of each measurement")
+        ->capture_default_str()
+        ->check(in_range(1, kMaxRepeats));
+    sub.add_option("--samples", args.samples, "Samples and pdf evaluations per repeat")
+        ->capture_default_str()
+        ->check(in_range(uint32_t{1}, kMaxBenchSamples));
+    sub.add_flag("--no-compensate", args.no_compensate, "Measure the uncompensated density");
+    sub.add_flag("--json", args.json, "Print one JSON object instead of text lines");
+}
+
+// The map measured: the input's radiance, or the synthetic sky of --size.
+struct BenchMap {
+    RgbImage image;
+    std::string name;
+};
+
+BenchMap bench_map(const BenchArgs& args) {
+    if (args.input.empty()) {
+        const Size size = *parse_size(args.size, false);  // the flag's validator has accepted it
+        return {reference::synthetic_sky(size.width, size.height), "synthetic-sky"};
+    }
+    MapFlags flags;
+    flags.no_compensate = true;
+    return {to_image(load_map(args.input, flags).map.radiance()), args.input};
+}
+
+// The random points every sampler is timed on: u for sampling, directions for the pdf.
+struct BenchPoints {
+    std::vector<Vec2> us;
+    std::vector<Vec3> directions;
+};
+
+BenchPoints bench_points(uint32_t n) {
+    std::mt19937_64 rng(7);
+    auto uniform = [&rng] { return static_cast<float>(rng() >> 40) * 0x1p-24f; };
+    BenchPoints points{std::vector<Vec2>(n), std::vector<Vec3>(n)};
+    for (Vec2& u : points.us) u = {uniform(), uniform()};
+    for (Vec3& d : points.directions) {
+        const float z = 1 - 2 * uniform(), phi = 2 * kPiF * uniform(), r = std::sqrt(std::max(0.0f, 1 - z * z));
+        d = {r * std::cos(phi), r * std::sin(phi), z};
+    }
+    return points;
+}
+
+// Medians over the repeats: per sampler, and the speedups over the textbook sampler.
+struct BenchResult {
+    std::vector<Timing> timings;
+    double build = 0, sample = 0, pdf = 0, batch_sample = 0, batch_pdf = 0;  // speedups
+};
+
+// Sampling and pdf times of the two samplers, back to back in each repeat, so that the
+// ratios compare like with like on a machine whose speed drifts. The guided sampler
+// goes through its view, as a renderer's hot loop uses it (the view's flat arrays are
+// read once, not rebuilt from the map at every call); guided-batch is the same sampler
+// through sample_many and lookup_many (the latter finds the radiance too), as a
+// wavefront renderer would call it. times: guided sample, textbook sample, guided pdf,
+// textbook pdf, batch sample, batch lookup; ratios: textbook over the others.
+struct CallTimes {
+    std::vector<double> times[6], ratios[4];
+};
+
+CallTimes time_calls(const EnvMap& guided, const reference::TextbookEnvMap& textbook, const BenchPoints& points,
+                     int repeats, Progress& progress, int& step) {
+    const auto sample_cost = [&](const auto& sampler) {
+        return ns_per_call(points.us, [&](Vec2 u) {
+            const EnvSample s = sampler.sample(u);
+            return s.pdf + s.direction.x + s.radiance.r;
+        });
+    };
+    const auto pdf_cost = [&](const auto& sampler) {
+        return ns_per_call(points.directions, [&](Vec3 d) { return sampler.pdf(d); });
+    };
+    const EnvMapView view = guided.view();
+    BatchInputs batch(points.us, points.directions);
+    CallTimes c;
+    for (int r = 0; r < repeats; ++r) {
+        const double t[6] = {sample_cost(view),  sample_cost(textbook),   pdf_cost(view),
+                             pdf_cost(textbook), batch.sample_cost(view), batch.lookup_cost(view)};
+        for (int k = 0; k < 6; ++k) c.times[k].push_back(t[k]);
+        c.ratios[0].push_back(t[1] / t[0]);
+        c.ratios[1].push_back(t[3] / t[2]);
+        c.ratios[2].push_back(t[1] / t[4]);
+        c.ratios[3].push_back(t[3] / t[5]);
+        progress.update(++step);
+    }
+    return c;
+}
+
+BenchResult measure(const RgbImage& image, const EnvMapOptions& options, const BenchPoints& points, int repeats) {
+    Progress progress("bench", 3 * repeats);
+    int step = 0;
+    const auto [guided, guided_build] = build_repeatedly<EnvMap>(
+        image, repeats, [&](RgbImage& copy) { return EnvMap(std::move(copy), options); }, progress, step);
+    const auto [textbook, textbook_build] = build_repeatedly<reference::TextbookEnvMap>(
+        image, repeats, [&](RgbImage&) { return reference::TextbookEnvMap(image, options); }, progress, step);
+    const CallTimes c = time_calls(*guided, *textbook, points, repeats, progress, step);
+    const double texels = static_cast<double>(image.width) * image.height;
+    const double guided_bytes = guided->distribution().bytes() / texels;
+    BenchResult result;
+    result.timings = {
+        {"guided", guided_build, median(c.times[0]), median(c.times[2]), guided_bytes},
+        {"guided-batch", guided_build, median(c.times[4]), median(c.times[5]), guided_bytes},
+        {"textbook", textbook_build, median(c.times[1]), median(c.times[3]), textbook->distribution_bytes() / texels}};
+    result.build = textbook_build / guided_build;
+    result.sample = median(c.ratios[0]);
+    result.pdf = median(c.ratios[1]);
+    result.batch_sample = median(c.ratios[2]);
+    result.batch_pdf = median(c.ratios[3]);
+    return result;
+}
+
+void print_bench_json(const BenchArgs& args, const BenchMap& map, const BenchResult& result) {
+    nlohmann::json j = {{"map", map.name},
+                        {"width", map.image.width},
+                        {"height", map.image.height},
+                        {"compensated", !args.no_compensate},
+                        {"repeats", args.repeats},
+                        {"samples", args.samples}};
+    for (const Timing& t : result.timings)
+        j["samplers"].push_back({{"sampler", t.sampler},
+                                 {"build_ms", t.build_ms},
+                                 {"ns_per_sample", t.ns_per_sample},
+                                 {"ns_per_pdf", t.ns_per_pdf},
+                                 {"bytes_per_texel", t.bytes_per_texel}});
+    j["speedup_vs_textbook"] = {{"build", result.build},
+                                {"sample", result.sample},
+                                {"pdf", result.pdf},
+                                {"batch_sample", result.batch_sample},
+                                {"batch_pdf", result.batch_pdf}};
+    std::cout << j.dump(2) << "\n";
+}
+
+void print_bench_text(const BenchArgs& args, const BenchMap& map, const BenchResult& result) {
+    std::printf("map=%s size=%ux%u compensated=%d repeats=%d samples=%u (medians)\n", map.name.c_str(), map.image.width,
+                map.image.height, !args.no_compensate, args.repeats, args.samples);
+    for (const Timing& t : result.timings)
+        std::printf("sampler=%s build_ms=%.1f ns_per_sample=%.1f ns_per_pdf=%.1f bytes_per_texel=%.2f\n",
+                    t.sampler.c_str(), t.build_ms, t.ns_per_sample, t.ns_per_pdf, t.bytes_per_texel);
+    std::printf(
+        "speedup_vs_textbook build=%.2fx sample=%.2fx pdf=%.2fx batch_sample=%.2fx "
+        "batch_pdf=%.2fx (sample, pdf: median of the ratios within each repeat)\n",
+        result.build, result.sample, result.pdf, result.batch_sample, result.batch_pdf);
+}
+
+void run_bench(const BenchArgs& args) {
+    const BenchMap map = bench_map(args);
+    EnvMapOptions options;
+    options.compensation.enabled = !args.no_compensate;
+    const BenchResult result = measure(map.image, options, bench_points(args.samples), args.repeats);
+    if (args.json)
+        print_bench_json(args, map, result);
+    else
+        print_bench_text(args, map, result);
+}
+
 }  // namespace
 
 Subcommand add_bench(CLI::App& app) {
-    struct Args {
-        std::string input, size = "8192x4096";
-        int repeats = 5;
-        uint32_t samples = 1u << 20;
-        bool json = false, no_compensate = false;
-    };
-    auto args = std::make_shared<Args>();
+    auto args = std::make_shared<BenchArgs>();
     CLI::App* sub = app.add_subcommand(
         "bench", "Time building and sampling, guided-CDF sampler versus the textbook sampler (medians of repeats)");
-    sub->add_option("input", args->input, "HDR image or table (default: a synthetic sky with a small sun)");
-    sub->add_option("--size", args->size, "Size of the synthetic sky, WxH")->capture_default_str();
-    sub->add_option("--repeats", args->repeats, "Repeats of each measurement")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    sub->add_option("--samples", args->samples, "Samples and pdf evaluations per repeat")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    sub->add_flag("--no-compensate", args->no_compensate, "Measure the uncompensated density");
-    sub->add_flag("--json", args->json, "Print one JSON object instead of text lines");
-    return {
-        sub, [args] {
-            RgbImage image;
-            std::string map_name;
-            if (args->input.empty()) {
-                unsigned w = 0, h = 0;
-                char x = 0;
-                if (std::sscanf(args->size.c_str(), "%u%c%u", &w, &x, &h) != 3 || x != 'x' || !w || !h ||
-                    w > kMaxCells1D || h > kMaxCells1D)
-                    throw std::runtime_error("--size '" + args->size + "': expected WxH, each 1 to 65536");
-                image = reference::synthetic_sky(w, h);
-                map_name = "synthetic-sky";
-            } else {
-                MapFlags flags;
-                flags.no_compensate = true;
-                image = to_image(load_map(args->input, flags).map.radiance());
-                map_name = args->input;
-            }
-            EnvMapOptions options;
-            options.compensation.enabled = !args->no_compensate;
-
-            std::mt19937_64 rng(7);
-            auto uniform = [&rng] { return static_cast<float>(rng() >> 40) * 0x1p-24f; };
-            std::vector<Vec2> us(args->samples);
-            for (Vec2& u : us) u = {uniform(), uniform()};
-            std::vector<Vec3> directions(args->samples);
-            for (Vec3& d : directions) {
-                const float z = 1 - 2 * uniform(), phi = 2 * kPiF * uniform(), r = std::sqrt(std::max(0.0f, 1 - z * z));
-                d = {r * std::cos(phi), r * std::sin(phi), z};
-            }
-
-            Progress progress("bench", 3 * args->repeats);
-            int step = 0;
-            const auto [guided, guided_build] = build_repeatedly<EnvMap>(
-                image, args->repeats, [&](RgbImage& copy) { return EnvMap(std::move(copy), options); }, progress, step);
-            const auto [textbook, textbook_build] = build_repeatedly<reference::TextbookEnvMap>(
-                image, args->repeats, [&](RgbImage&) { return reference::TextbookEnvMap(image, options); }, progress,
-                step);
-            // Sampling and pdf times: the two samplers back to back in each repeat, so
-            // that the ratios compare like with like on a machine whose speed drifts.
-            const auto sample_cost = [&](const auto& sampler) {
-                return ns_per_call(us, [&](Vec2 u) {
-                    const EnvSample s = sampler.sample(u);
-                    return s.pdf + s.direction.x + s.radiance.r;
-                });
-            };
-            const auto pdf_cost = [&](const auto& sampler) {
-                return ns_per_call(directions, [&](Vec3 d) { return sampler.pdf(d); });
-            };
-            // The guided sampler through its view, as a renderer's hot loop uses it: the
-            // view's flat arrays are read once, not rebuilt from the map at every call.
-            // guided-batch is the same sampler through sample_many and lookup_many (the
-            // latter finds the radiance too), as a wavefront renderer would call it.
-            const EnvMapView view = guided->view();
-            BatchInputs batch(us, directions);
-            std::vector<double> times[6], ratios[4];
-            for (int r = 0; r < args->repeats; ++r) {
-                const double t[6] = {sample_cost(view),   sample_cost(*textbook),  pdf_cost(view),
-                                     pdf_cost(*textbook), batch.sample_cost(view), batch.lookup_cost(view)};
-                for (int k = 0; k < 6; ++k) times[k].push_back(t[k]);
-                ratios[0].push_back(t[1] / t[0]);
-                ratios[1].push_back(t[3] / t[2]);
-                ratios[2].push_back(t[1] / t[4]);
-                ratios[3].push_back(t[3] / t[5]);
-                progress.update(++step);
-            }
-            const double texels = static_cast<double>(image.width) * image.height;
-            const double guided_bytes = guided->distribution().bytes() / texels;
-            const std::vector<Timing> timings = {
-                {"guided", guided_build, median(times[0]), median(times[2]), guided_bytes},
-                {"guided-batch", guided_build, median(times[4]), median(times[5]), guided_bytes},
-                {"textbook", textbook_build, median(times[1]), median(times[3]),
-                 textbook->distribution_bytes() / texels}};
-            const double build_speedup = textbook_build / guided_build, sample_speedup = median(ratios[0]),
-                         pdf_speedup = median(ratios[1]), batch_sample_speedup = median(ratios[2]),
-                         batch_pdf_speedup = median(ratios[3]);
-            if (args->json) {
-                nlohmann::json j = {{"map", map_name},          {"width", image.width},
-                                    {"height", image.height},   {"compensated", !args->no_compensate},
-                                    {"repeats", args->repeats}, {"samples", args->samples}};
-                for (const Timing& t : timings)
-                    j["samplers"].push_back({{"sampler", t.sampler},
-                                             {"build_ms", t.build_ms},
-                                             {"ns_per_sample", t.ns_per_sample},
-                                             {"ns_per_pdf", t.ns_per_pdf},
-                                             {"bytes_per_texel", t.bytes_per_texel}});
-                j["speedup_vs_textbook"] = {{"build", build_speedup},
-                                            {"sample", sample_speedup},
-                                            {"pdf", pdf_speedup},
-                                            {"batch_sample", batch_sample_speedup},
-                                            {"batch_pdf", batch_pdf_speedup}};
-                std::cout << j.dump(2) << "\n";
-                return;
-            }
-            std::printf("map=%s size=%ux%u compensated=%d repeats=%d samples=%u (medians)\n", map_name.c_str(),
-                        image.width, image.height, !args->no_compensate, args->repeats, args->samples);
-            for (const Timing& t : timings)
-                std::printf("sampler=%s build_ms=%.1f ns_per_sample=%.1f ns_per_pdf=%.1f bytes_per_texel=%.2f\n",
-                            t.sampler.c_str(), t.build_ms, t.ns_per_sample, t.ns_per_pdf, t.bytes_per_texel);
-            std::printf(
-                "speedup_vs_textbook build=%.2fx sample=%.2fx pdf=%.2fx batch_sample=%.2fx "
-                "batch_pdf=%.2fx (sample, pdf: median of the ratios within each repeat)\n",
-                build_speedup, sample_speedup, pdf_speedup, batch_sample_speedup, batch_pdf_speedup);
-        }};
+    add_bench_flags(*sub, *args);
+    return {sub, [args] { run_bench(*args); }};
 }
 
 }  // namespace envmis::cli

@@ -7,30 +7,39 @@
 
 namespace envmis::cli {
 
+namespace {
+
+// The arguments of `envmis info`.
+struct InfoArgs {
+    std::string input;
+    MapFlags map;
+};
+
+void print_info(const InfoArgs& args, const LoadedMap& loaded) {
+    std::cout << args.input << ": ";
+    if (loaded.from_table)
+        std::cout << "envmis table, format version " << loaded.table_version
+                  << (loaded.mapped ? ", radiance used in place from a mapping of the file" : "") << "\n";
+    else
+        std::cout << "image, " << loaded.channels << " channels\n";
+    print_summary(std::cout, loaded);
+    std::cout << std::fixed << std::setprecision(1) << "  time          load " << loaded.load_ms << " ms"
+              << (loaded.from_table ? " (includes rebuilding the sampler)" : "") << ", build " << loaded.build_ms
+              << " ms\n";
+    if (const std::string memory = resident_memory(); !memory.empty())
+        std::cout << "  process       " << memory << "\n";
+}
+
+void run_info(const InfoArgs& args) { print_info(args, load_map(args.input, args.map)); }
+
+}  // namespace
+
 Subcommand add_info(CLI::App& app) {
-    struct Args {
-        std::string input;
-        MapFlags map;
-    };
-    auto args = std::make_shared<Args>();
+    auto args = std::make_shared<InfoArgs>();
     CLI::App* sub = app.add_subcommand("info", "Describe a table file, or an HDR map and the sampler it would give");
     sub->add_option("input", args->input, "Table (.envmis) or HDR image")->required();
     add_map_flags(*sub, args->map);
-    return {sub, [args] {
-                const LoadedMap loaded = load_map(args->input, args->map);
-                std::cout << args->input << ": ";
-                if (loaded.from_table)
-                    std::cout << "envmis table, format version " << loaded.table_version
-                              << (loaded.mapped ? ", radiance used in place from a mapping of the file" : "") << "\n";
-                else
-                    std::cout << "image, " << loaded.channels << " channels\n";
-                print_summary(std::cout, loaded);
-                std::cout << std::fixed << std::setprecision(1) << "  time          load " << loaded.load_ms << " ms"
-                          << (loaded.from_table ? " (includes rebuilding the sampler)" : "") << ", build "
-                          << loaded.build_ms << " ms\n";
-                if (const std::string memory = resident_memory(); !memory.empty())
-                    std::cout << "  process       " << memory << "\n";
-            }};
+    return {sub, [args] { run_info(*args); }};
 }
 
 }  // namespace envmis::cli

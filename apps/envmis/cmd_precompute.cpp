@@ -29,35 +29,44 @@ void print_compact_error(std::ostream& out, const EnvMap& map) {
         << 100 * worst << "%, sampling density total variation " << 0.5 * distance << "\n";
 }
 
+// The arguments of `envmis precompute`.
+struct PrecomputeArgs {
+    std::string input, output;
+    MapFlags map;
+    bool compact = false;
+};
+
+void add_precompute_flags(CLI::App& sub, PrecomputeArgs& args) {
+    sub.add_option("input", args.input, "HDR image (EXR, .hdr, .pfm, TIFF, ...)")->required();
+    sub.add_option("-o,--output", args.output, "Table file to write (.envmis)")->required();
+    sub.add_flag("--compact", args.compact,
+                 "Store the radiance in RGBE (4 bytes/texel instead of 16; density rebuilt on load); prints the error");
+    add_map_flags(sub, args.map);
+}
+
+void print_precompute(const PrecomputeArgs& args, const LoadedMap& loaded, double write_ms) {
+    std::cout << "envmis precompute: " << args.input << " -> " << args.output << "\n";
+    print_summary(std::cout, loaded);
+    if (args.compact) print_compact_error(std::cout, loaded.map);
+    std::cout << std::fixed << std::setprecision(1) << "  time          load " << loaded.load_ms << " ms, build "
+              << loaded.build_ms << " ms, write " << write_ms << " ms\n";
+}
+
+void run_precompute(const PrecomputeArgs& args) {
+    const LoadedMap loaded = load_map(args.input, args.map);
+    if (loaded.from_table) throw std::runtime_error(args.input + ": is already a table; give an image");
+    const auto start = std::chrono::steady_clock::now();
+    write_table(args.output, loaded.map, loaded.source, args.compact ? TableEncoding::compact : TableEncoding::full);
+    print_precompute(args, loaded, milliseconds_since(start));
+}
+
 }  // namespace
 
 Subcommand add_precompute(CLI::App& app) {
-    struct Args {
-        std::string input, output;
-        MapFlags map;
-        bool compact = false;
-    };
-    auto args = std::make_shared<Args>();
+    auto args = std::make_shared<PrecomputeArgs>();
     CLI::App* sub = app.add_subcommand("precompute", "Build the sampling table of an HDR map and save it");
-    sub->add_option("input", args->input, "HDR image (EXR, .hdr, .pfm, TIFF, ...)")->required();
-    sub->add_option("-o,--output", args->output, "Table file to write (.envmis)")->required();
-    sub->add_flag(
-        "--compact", args->compact,
-        "Store the radiance in RGBE (4 bytes/texel instead of 16; density rebuilt on load); prints the error");
-    add_map_flags(*sub, args->map);
-    return {sub, [args] {
-                const LoadedMap loaded = load_map(args->input, args->map);
-                if (loaded.from_table) throw std::runtime_error(args->input + ": is already a table; give an image");
-                const auto start = std::chrono::steady_clock::now();
-                write_table(args->output, loaded.map, loaded.source,
-                            args->compact ? TableEncoding::compact : TableEncoding::full);
-                const double write_ms = milliseconds_since(start);
-                std::cout << "envmis precompute: " << args->input << " -> " << args->output << "\n";
-                print_summary(std::cout, loaded);
-                if (args->compact) print_compact_error(std::cout, loaded.map);
-                std::cout << std::fixed << std::setprecision(1) << "  time          load " << loaded.load_ms
-                          << " ms, build " << loaded.build_ms << " ms, write " << write_ms << " ms\n";
-            }};
+    add_precompute_flags(*sub, *args);
+    return {sub, [args] { run_precompute(*args); }};
 }
 
 }  // namespace envmis::cli

@@ -2,6 +2,7 @@
 #include <charconv>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <random>
 
@@ -44,36 +45,51 @@ void write_samples(std::ostream& out, const EnvMap& map, uint64_t n, uint64_t se
     }
 }
 
+// The arguments of `envmis sample`.
+struct SampleArgs {
+    std::string input, output;
+    uint64_t count = 1000;
+    uint64_t seed = 1;
+    MapFlags map;
+};
+
+// At most 2^40 samples (about 60 TB of CSV): far above any use, far below where a count
+// typed wrong (or negative, read as 2^64 - n) would run for ever.
+constexpr uint64_t kMaxSamples = uint64_t{1} << 40;
+
+void add_sample_flags(CLI::App& sub, SampleArgs& args) {
+    sub.add_option("input", args.input, "Table (.envmis) or HDR image")->required();
+    sub.add_option("-n,--count", args.count, "Number of samples")
+        ->capture_default_str()
+        ->check(in_range(uint64_t{1}, kMaxSamples));
+    sub.add_option("--seed", args.seed, "Random seed")
+        ->capture_default_str()
+        ->check(in_range(uint64_t{0}, std::numeric_limits<uint64_t>::max()));
+    sub.add_option("-o,--output", args.output, "CSV file to write (default: standard output)");
+    add_map_flags(sub, args.map);
+}
+
+void run_sample(const SampleArgs& args) {
+    const LoadedMap loaded = load_map(args.input, args.map);
+    if (args.output.empty()) {
+        write_samples(std::cout, loaded.map, args.count, args.seed);
+        std::cout.flush();
+        if (!std::cout) throw std::runtime_error("standard output: write failed");
+    } else {
+        write_file_atomically(args.output,
+                              [&](std::ostream& out) { write_samples(out, loaded.map, args.count, args.seed); });
+    }
+}
+
 }  // namespace
 
 Subcommand add_sample(CLI::App& app) {
-    struct Args {
-        std::string input, output;
-        uint64_t count = 1000;
-        uint64_t seed = 1;
-        MapFlags map;
-    };
-    auto args = std::make_shared<Args>();
+    auto args = std::make_shared<SampleArgs>();
     CLI::App* sub = app.add_subcommand(
         "sample",
         "Draw directions from a map's sampler: CSV u,v,x,y,z,pdf (image point, world direction, solid-angle pdf)");
-    sub->add_option("input", args->input, "Table (.envmis) or HDR image")->required();
-    sub->add_option("-n,--count", args->count, "Number of samples")->capture_default_str();
-    sub->add_option("--seed", args->seed, "Random seed")->capture_default_str();
-    sub->add_option("-o,--output", args->output, "CSV file to write (default: standard output)");
-    add_map_flags(*sub, args->map);
-    return {sub, [args] {
-                const LoadedMap loaded = load_map(args->input, args->map);
-                if (args->output.empty()) {
-                    write_samples(std::cout, loaded.map, args->count, args->seed);
-                    std::cout.flush();
-                    if (!std::cout) throw std::runtime_error("standard output: write failed");
-                } else {
-                    write_file_atomically(args->output, [&](std::ostream& out) {
-                        write_samples(out, loaded.map, args->count, args->seed);
-                    });
-                }
-            }};
+    add_sample_flags(*sub, *args);
+    return {sub, [args] { run_sample(*args); }};
 }
 
 }  // namespace envmis::cli

@@ -1,6 +1,7 @@
 // envmis: precompute, inspect, sample, visualise and benchmark environment-map samplers.
 #include <exception>
 #include <iostream>
+#include <string>
 #include <vector>
 
 #include "cli.h"
@@ -10,6 +11,9 @@ int main(int argc, char** argv) {
     CLI::App app{"envmis: importance sampling of HDR environment maps, with and without MIS compensation"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "envmis 0.1.0");
+    // A usage error is one line, naming the flag: "envmis: -n: Value -5 not in range 1 to ...".
+    app.failure_message(
+        [](const CLI::App*, const CLI::Error& e) { return "envmis: " + std::string(e.what()) + " (see --help)\n"; });
     const std::vector<Subcommand> subcommands = {add_compare(app), add_report(app), add_precompute(app),
                                                  add_info(app),    add_sample(app), add_visualize(app),
                                                  add_bench(app),   add_convert(app)};

@@ -1,0 +1,190 @@
+// Specification of the count, size and seed flags of `envmis` precompute, info, sample,
+// visualize, bench and convert: a negative or out-of-range value is refused before any
+// work starts, with exit code != 0, nothing on stdout, one line on stderr that names the
+// flag, and no output file. Every test runs the real binary (ENVMIS_CLI) in a temporary
+// folder of its own.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kStudio = (fs::path(ENVMIS_DATA_DIR) / "envmaps" / "studio.exr").string();
+
+std::string read_file(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::string quoted(const std::string& s) {
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+struct Result {
+    std::string command;
+    int exit_code = -1;
+    std::string out, err;
+};
+
+std::ostream& operator<<(std::ostream& os, const Result& r) {
+    return os << "\n$ " << r.command << "\nexit code " << r.exit_code << "\n--- stdout:\n"
+              << r.out.substr(0, 2000) << "--- stderr:\n"
+              << r.err;
+}
+
+// One refused value: the arguments after `envmis`, and the flag the message must name.
+struct BadFlag {
+    std::string name;
+    std::vector<std::string> args;
+    std::string flag;
+};
+
+std::ostream& operator<<(std::ostream& os, const BadFlag& c) { return os << c.name; }
+
+// Each test works in a folder of its own, removed afterwards.
+class Folder : public testing::Test {
+public:
+    void SetUp() override {
+        const auto* info = testing::UnitTest::GetInstance()->current_test_info();
+        std::string name = std::string(info->test_suite_name()) + "_" + info->name();
+        for (char& c : name)
+            if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+        dir_ = fs::temp_directory_path() / ("envmis_flags_test_" + std::to_string(::getpid()) + "_" + name);
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override {
+        std::error_code ignored;
+        fs::remove_all(dir_, ignored);
+    }
+
+    // Runs envmis with `args` in the test's folder; its output goes beside the folder.
+    Result envmis(const std::vector<std::string>& args) const {
+        Result r;
+        r.command = "envmis";
+        std::string command = "cd " + quoted(dir_.string()) + " && " + quoted(ENVMIS_CLI);
+        for (const std::string& a : args) {
+            command.append(" ").append(quoted(a));
+            r.command.append(" ").append(a);
+        }
+        const fs::path out = dir_.string() + ".stdout", err = dir_.string() + ".stderr";
+        const int status =
+            std::system((command + " > " + quoted(out.string()) + " 2> " + quoted(err.string())).c_str());
+        r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        r.out = read_file(out);
+        r.err = read_file(err);
+        fs::remove(out);
+        fs::remove(err);
+        return r;
+    }
+
+    bool folder_is_empty() const { return fs::is_empty(dir_); }
+
+    fs::path dir_;
+};
+
+class Flags : public Folder, public testing::WithParamInterface<BadFlag> {};
+class FlagBounds : public Folder {};
+
+TEST_P(Flags, AnOutOfRangeValueIsRefusedInOneLineNamingTheFlagBeforeAnyWork) {
+    const BadFlag& c = GetParam();
+    const Result r = envmis(c.args);
+    EXPECT_NE(r.exit_code, 0) << r;
+    EXPECT_EQ(r.out, "") << r;
+    EXPECT_TRUE(!r.err.empty() && r.err.back() == '\n' && r.err.find('\n') == r.err.size() - 1)
+        << "expected exactly one line on stderr" << r;
+    EXPECT_NE(r.err.find(c.flag), std::string::npos) << "stderr does not name " << c.flag << r;
+    EXPECT_TRUE(folder_is_empty()) << "an output file was written" << r;
+}
+
+std::vector<std::string> sample(std::vector<std::string> flags) {
+    flags.insert(flags.begin(), {"sample", kStudio, "-o", "out.csv"});
+    return flags;
+}
+
+std::vector<std::string> convert(std::vector<std::string> flags) {
+    flags.insert(flags.begin(), {"convert", kStudio, "-o", "out.exr"});
+    return flags;
+}
+
+std::vector<std::string> bench(std::vector<std::string> flags) {
+    flags.insert(flags.begin(), {"bench", "--repeats", "1", "--samples", "16", "--size", "16x8"});
+    return flags;
+}
+
+std::vector<std::string> visualize(std::vector<std::string> flags) {
+    flags.insert(flags.begin(), {"visualize", kStudio, "-o", "out.png"});
+    return flags;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Subcommands, Flags,
+    testing::Values(
+        // sample: -n (--count, the name the message gives) 1 to 2^40, --seed 0 to 2^64 - 1.
+        BadFlag{"SampleNegativeCount", sample({"-n", "-5"}), "--count"},
+        BadFlag{"SampleNegativeCountLongName", sample({"--count", "-1"}), "--count"},
+        BadFlag{"SampleZeroCount", sample({"-n", "0"}), "--count"},
+        BadFlag{"SampleCountAbove2To40", sample({"-n", "1099511627777"}), "--count"},
+        BadFlag{"SampleNegativeSeed", sample({"--seed", "-5"}), "--seed"},
+        BadFlag{"SampleSeedAbove64Bits", sample({"--seed", "18446744073709551616"}), "--seed"},
+        BadFlag{"SampleToStandardOutputNegativeCount", {"sample", kStudio, "-n", "-5"}, "--count"},
+        // convert: --size N or WxH, each side 1 to 65536 (equirect N to 32768); --supersampling 0 to 64.
+        BadFlag{"ConvertNegativeSize", convert({"--size", "-4"}), "--size"},
+        BadFlag{"ConvertNegativeWidth", convert({"--size", "-4x4"}), "--size"},
+        BadFlag{"ConvertNegativeHeight", convert({"--size", "4x-4"}), "--size"},
+        BadFlag{"ConvertZeroSize", convert({"--size", "0"}), "--size"},
+        BadFlag{"ConvertSizeAbove65536", convert({"--size", "65537", "--to", "equal-area"}), "--size"},
+        BadFlag{"ConvertWidthAbove65536", convert({"--size", "70000x16"}), "--size"},
+        BadFlag{"ConvertEquirectSizeWhoseWidthIsAbove65536", convert({"--size", "40000", "--to", "equirect"}),
+                "--size"},
+        BadFlag{"ConvertNegativeSupersampling", convert({"--supersampling", "-1"}), "--supersampling"},
+        BadFlag{"ConvertSupersamplingAbove64", convert({"--supersampling", "65"}), "--supersampling"},
+        // bench: --repeats 1 to 1000, --samples 1 to 2^26, --size WxH each 1 to 65536.
+        BadFlag{"BenchNegativeRepeats", bench({"--repeats", "-1"}), "--repeats"},
+        BadFlag{"BenchZeroRepeats", bench({"--repeats", "0"}), "--repeats"},
+        BadFlag{"BenchRepeatsAbove1000", bench({"--repeats", "1001"}), "--repeats"},
+        BadFlag{"BenchNegativeSamples", bench({"--samples", "-1"}), "--samples"},
+        BadFlag{"BenchZeroSamples", bench({"--samples", "0"}), "--samples"},
+        BadFlag{"BenchSamplesAbove2To26", bench({"--samples", "67108865"}), "--samples"},
+        BadFlag{"BenchNegativeWidth", bench({"--size", "-4x4"}), "--size"},
+        BadFlag{"BenchNegativeHeight", bench({"--size", "8x-4"}), "--size"},
+        BadFlag{"BenchZeroWidth", bench({"--size", "0x8"}), "--size"},
+        BadFlag{"BenchWidthAbove65536", bench({"--size", "65537x8"}), "--size"},
+        BadFlag{"BenchSizeWithoutHeight", bench({"--size", "16"}), "--size"},
+        // visualize: --panel-width 64 to 4096.
+        BadFlag{"VisualizeNegativePanelWidth", visualize({"--panel-width", "-1"}), "--panel-width"},
+        BadFlag{"VisualizePanelWidthBelow64", visualize({"--panel-width", "63"}), "--panel-width"},
+        BadFlag{"VisualizePanelWidthAbove4096", visualize({"--panel-width", "4097"}), "--panel-width"},
+        // The map flags: --alpha a finite number >= 0 (or auto).
+        BadFlag{"SampleNegativeAlpha", sample({"--alpha", "-1"}), "--alpha"},
+        BadFlag{"SampleInfiniteAlpha", sample({"--alpha", "inf"}), "--alpha"},
+        BadFlag{"PrecomputeNegativeAlpha", {"precompute", kStudio, "-o", "out.envmis", "--alpha", "-0.5"}, "--alpha"},
+        BadFlag{"PrecomputeNanAlpha", {"precompute", kStudio, "-o", "out.envmis", "--alpha", "nan"}, "--alpha"},
+        BadFlag{"InfoNegativeAlpha", {"info", kStudio, "--alpha", "-1"}, "--alpha"},
+        BadFlag{"VisualizeNegativeAlpha", visualize({"--alpha", "-1"}), "--alpha"}),
+    [](const testing::TestParamInfo<BadFlag>& info) { return info.param.name; });
+
+// The limits themselves are accepted.
+TEST_F(FlagBounds, TheLimitsThemselvesAreAccepted) {
+    const Result s = envmis({"sample", kStudio, "-n", "1", "--seed", "18446744073709551615"});
+    EXPECT_EQ(s.exit_code, 0) << s;
+    EXPECT_EQ(s.out.substr(0, s.out.find('\n')), "u,v,x,y,z,pdf") << s;
+    const Result b = envmis({"bench", "--size", "1x1", "--repeats", "1", "--samples", "1"});
+    EXPECT_EQ(b.exit_code, 0) << b;
+    const Result z = envmis({"sample", kStudio, "-n", "1", "--seed", "0", "--alpha", "0"});
+    EXPECT_EQ(z.exit_code, 0) << z;
+}
+
+}  // namespace
