@@ -1,6 +1,7 @@
 // envmis compare IN: the variance study. Estimates direct lighting on analytic BSDFs with
 // every technique at equal sample count and reports how much MIS compensation gains.
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -42,6 +43,19 @@ constexpr uint32_t kMaxSamples = 65536;  // per estimate, of each kind
 constexpr uint32_t kMaxPoints = 1000000;
 constexpr uint32_t kMaxThreads = 1024;
 constexpr uint32_t kMaxImageSpp = 65536, kMaxReferenceSpp = 1 << 20;
+
+// A seed: an integer 0 to 2^64-1. CLI::Range(uint64_t{0}, max) cannot say so: CLI11 2.1
+// reads "-1" and "18446744073709551616" as 2^64-1, inside the range.
+CLI::Validator seed_check() {
+    return {[](std::string& text) -> std::string {
+                uint64_t value = 0;
+                const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+                if (error != std::errc() || end != text.data() + text.size())
+                    return "Value " + text + " is not an integer 0 to 18446744073709551615";
+                return {};
+            },
+            "UINT64"};
+}
 
 // Everything a run is set up with: the parsed flags, the plain map, the points, the
 // compensation strengths chosen and their maps.
@@ -109,9 +123,7 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
     sub.add_option("--bsdf-samples", args.bsdf_samples, "BSDF samples per MIS estimate (0 to 65536)")
         ->capture_default_str()
         ->check(CLI::Range(uint32_t{0}, kMaxSamples));
-    sub.add_option("--seed", args.seed, "Random seed")
-        ->capture_default_str()
-        ->check(CLI::Range(uint64_t{0}, std::numeric_limits<uint64_t>::max()));
+    sub.add_option("--seed", args.seed, "Random seed")->capture_default_str()->check(seed_check());
     sub.add_option("--threads", args.threads,
                    "Worker threads, 1 to 1024 (default: all cores); results do not depend on it")
         ->check(CLI::Range(uint32_t{1}, kMaxThreads));
