@@ -64,8 +64,8 @@ struct Setup {
     EnvMap plain;
     std::vector<ShadingPoint> points;
     ComparisonOptions options;
-    std::vector<Technique> requested;  // --techniques; empty: each study's default
-    std::vector<float> swept;          // --alpha-sweep
+    std::vector<Technique> alpha_techniques, allocation_techniques;  // of the sweeps asked for
+    std::vector<float> swept;                                        // --alpha-sweep
     std::optional<AlphaChoice> choice;
     float map_alpha = 0;
     std::vector<float> bsdf_alphas;
@@ -204,6 +204,10 @@ Setup prepare(const CompareArgs& args) {
     std::vector<Technique> requested;
     ComparisonOptions options = comparison_options(args, requested);
     std::vector<float> swept = args.alpha_sweep.empty() ? std::vector<float>{} : parse_alpha_sweep(args.alpha_sweep);
+    // Each sweep's techniques, checked before any study runs.
+    std::vector<Technique> alpha_techniques, allocation_techniques;
+    if (!swept.empty()) alpha_techniques = alpha_sweep_techniques(requested);
+    if (args.allocation_sweep) allocation_techniques = allocation_sweep_techniques(requested);
     if (!args.images.empty()) std::filesystem::create_directories(args.images);
     if (!args.plots.empty()) std::filesystem::create_directories(args.plots);
     std::string map_name;
@@ -226,12 +230,22 @@ Setup prepare(const CompareArgs& args) {
     const float map_alpha = choice ? choice->alpha : fixed_alpha;
     std::vector<float> bsdf_alphas = choice ? choice->bsdf_alphas : std::vector<float>(options.bsdfs.size(), map_alpha);
     CompensatedMaps compensated = compensated_maps(plain, bsdf_alphas);
-    return {std::move(map_name), std::move(plain),  std::move(points), std::move(options),     std::move(requested),
-            std::move(swept),    std::move(choice), map_alpha,         std::move(bsdf_alphas), std::move(compensated)};
+    return {std::move(map_name),
+            std::move(plain),
+            std::move(points),
+            std::move(options),
+            std::move(alpha_techniques),
+            std::move(allocation_techniques),
+            std::move(swept),
+            std::move(choice),
+            map_alpha,
+            std::move(bsdf_alphas),
+            std::move(compensated)};
 }
 
 // A RunControl that shows `label`'s progress on stderr and stops at Ctrl-C.
-RunControl watched(const char* label, std::shared_ptr<std::optional<Progress>> bar) {
+RunControl watched(const char* label) {
+    auto bar = std::make_shared<std::optional<Progress>>();
     return {&interrupted(), [label, bar](size_t done, size_t total) {
                 if (!*bar) bar->emplace(label, total);
                 (*bar)->update(done);
@@ -242,8 +256,7 @@ Outcome run_compare(const CompareArgs& args, const Setup& setup) {
     Outcome outcome;
     const bool sweeping = !setup.swept.empty() || args.allocation_sweep;
     if (!sweeping) {
-        auto bar = std::make_shared<std::optional<Progress>>();
-        outcome.comparison = compare(setup.inputs(), watched("compare", bar));
+        outcome.comparison = compare(setup.inputs(), watched("compare"));
     }
     if (!setup.swept.empty()) {
         // auto's choices and alpha = 0 are swept too, to say where auto stands.
@@ -255,16 +268,14 @@ Outcome run_compare(const CompareArgs& args, const Setup& setup) {
         std::sort(alphas.begin(), alphas.end());
         alphas.erase(std::unique(alphas.begin(), alphas.end()), alphas.end());
         StudyInputs inputs = setup.inputs();
-        inputs.options.techniques = alpha_sweep_techniques(setup.requested);
-        auto bar = std::make_shared<std::optional<Progress>>();
+        inputs.options.techniques = setup.alpha_techniques;
         outcome.alphas_swept = alphas.size();
-        outcome.alpha = run_alpha_sweep(inputs, alphas, args.exact, watched("alpha sweep", bar));
+        outcome.alpha = run_alpha_sweep(inputs, alphas, args.exact, watched("alpha sweep"));
     }
     if (args.allocation_sweep && !interrupted()) {
         StudyInputs inputs = setup.inputs();
-        inputs.options.techniques = allocation_sweep_techniques(setup.requested);
-        auto bar = std::make_shared<std::optional<Progress>>();
-        outcome.allocation = run_allocation_sweep(inputs, args.allocation_sweep, watched("allocation sweep", bar));
+        inputs.options.techniques = setup.allocation_techniques;
+        outcome.allocation = run_allocation_sweep(inputs, args.allocation_sweep, watched("allocation sweep"));
     }
     return outcome;
 }
