@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iostream>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <optional>
@@ -16,11 +18,18 @@
 
 #include "cli.h"
 #include "envmis/table/atomic_file.h"
+#include "results.h"
 
 namespace envmis::cli {
 namespace {
 
 using nlohmann::json;
+
+// The flags of `envmis report`, as CLI11 fills them.
+struct ReportArgs {
+    std::vector<std::string> inputs;
+    std::string output, title = "envmis results", command, plots;
+};
 
 json read_results(const std::string& path) {
     std::ifstream in(path);
@@ -144,9 +153,10 @@ void write_allocation(std::ostream& out, const std::vector<json>& runs) {
     if (header) out << "\n";
 }
 
-void write_report(std::ostream& out, const std::vector<json>& runs, const std::string& title,
-                  const std::string& command, const std::string& plots) {
-    std::vector<std::string> techniques;  // in the order of the first run that has them
+// The techniques in the order of the first run that has them (mis-balance, the
+// baseline, left out) and the (map, BSDF) cases of all runs.
+std::pair<std::vector<std::string>, std::vector<Case>> collect_cases(const std::vector<json>& runs) {
+    std::vector<std::string> techniques;
     std::vector<Case> cases;
     for (const json& run : runs) {
         const std::string map = run["inputs"].value("map", "?");
@@ -164,7 +174,11 @@ void write_report(std::ostream& out, const std::vector<json>& runs, const std::s
         }
     }
     std::erase(techniques, "mis-balance");
+    return {techniques, cases};
+}
 
+void write_intro(std::ostream& out, const std::vector<json>& runs, const std::string& title,
+                 const std::string& command) {
     out << "# " << title << "\n\n";
     if (!command.empty()) out << "Made by `" << command << "`.\n\n";
     const auto with_results =
@@ -176,8 +190,11 @@ void write_report(std::ostream& out, const std::vector<json>& runs, const std::s
         << "MIS over the plain density (`mis-balance`), as the geometric mean over " << first.value("points_done", 0)
         << " shading points of the per-point ratios; " << first.value("spp", 0)
         << " estimates per point. Below 1 is better than balance MIS.\n\n";
+}
 
-    // Summary: one row per case, one column per technique, and the geometric mean row.
+// Summary: one row per case, one column per technique, the geometric mean row and the
+// MIS technique that gains most.
+void write_summary(std::ostream& out, const std::vector<std::string>& techniques, const std::vector<Case>& cases) {
     out << "## Variance relative to balance MIS\n\n| map | bsdf |";
     for (const std::string& t : techniques) out << " " << t << " |";
     out << "\n|---|---|";
@@ -211,9 +228,11 @@ void write_report(std::ostream& out, const std::vector<json>& runs, const std::s
         out << "**Lowest variance of the MIS techniques across the table: `" << best << "`, "
             << number(1 / best_ratio, "%.2f") << "x lower variance than balance MIS (geometric mean over "
             << cases.size() << " cases).**\n\n";
+}
 
-    // Optimal MIS against balance MIS over the same density, case by case, with the
-    // noise of the measured variances.
+// Optimal MIS against balance MIS over the same density, case by case, with the noise
+// of the measured variances.
+void write_optimal(std::ostream& out, const std::vector<Case>& cases) {
     const std::pair<const char*, const char*> pairs[] = {{"mis-optimal", "mis-balance"},
                                                          {"mis-optimal-comp", "mis-balance-comp"},
                                                          {"mis-optimal-all", "mis-balance-all"}};
@@ -244,49 +263,76 @@ void write_report(std::ostream& out, const std::vector<json>& runs, const std::s
     if (header)
         out << "\nOptimal MIS is at most balance MIS within error in " << cases_within << " of " << cases_total
             << " cases.\n\n";
+}
 
-    write_strength(out, runs);
-    write_allocation(out, runs);
-    if (!plots.empty()) {
-        out << "## Plots\n\n";
-        std::vector<std::string> seen;
-        for (const json& run : runs) {
-            const std::string name = stem(run);
-            if (std::find(seen.begin(), seen.end(), name) != seen.end()) continue;
-            seen.push_back(name);
-            out << "### " << run["inputs"].value("map", "?") << "\n\n";
-            for (const char* plot : {"variance_vs_balance", "alpha_sweep", "allocation"})
-                out << "![" << name << " " << plot << "](" << plots << "/" << name << "/" << plot << ".png)\n";
-            out << "\n";
-        }
+// Links to each map's plots, once per map.
+void write_plots(std::ostream& out, const std::vector<json>& runs, const std::string& plots) {
+    if (plots.empty()) return;
+    out << "## Plots\n\n";
+    std::vector<std::string> seen;
+    for (const json& run : runs) {
+        const std::string name = stem(run);
+        if (std::find(seen.begin(), seen.end(), name) != seen.end()) continue;
+        seen.push_back(name);
+        out << "### " << run["inputs"].value("map", "?") << "\n\n";
+        for (const char* plot : {"variance_vs_balance", "alpha_sweep", "allocation"})
+            out << "![" << name << " " << plot << "](" << plots << "/" << name << "/" << plot << ".png)\n";
+        out << "\n";
     }
+}
 
+// The report's full table of a run: compare's figures (results.h), as Markdown.
+constexpr StatsColumn kReportColumns[] = {{"mean", "mean", 0, "%.4g"},
+                                          {"reference", "reference", 0, "%.4g"},
+                                          {"variance", "variance", 0, "%.4g"},
+                                          {"std_error", "std_error", 0, "%.3g"},
+                                          {"rel_mse", "rel_mse", 0, "%.4g"},
+                                          {"ns_per_estimate", "ns/estimate", 0, "%.0f"},
+                                          {"efficiency", "efficiency", 0, "%.4g"},
+                                          {"variance_ratio_vs_mis", "var/mis", 0, "%.3f"}};
+
+// Each run's full table.
+void write_tables(std::ostream& out, const std::vector<json>& runs) {
     for (const json& run : runs) {
         if (!run.contains("results")) continue;
         const json& in = run["inputs"];
         out << "## " << in.value("map", "?") << " (" << in.value("width", 0) << "x" << in.value("height", 0)
-            << "), alpha " << number(in.value("alpha", 1.0), "%.3g") << "\n\n"
-            << "| bsdf | technique | mean | reference | variance | std_error | rel_mse | ns/estimate | efficiency | "
-               "var/mis |\n"
-            << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-        for (const json& r : run["results"])
-            out << "| " << r["bsdf"].get<std::string>() << " | " << r["technique"].get<std::string>() << " | "
-                << number(r["mean"]) << " | " << number(r["reference"]) << " | " << number(r["variance"]) << " | "
-                << number(r["std_error"], "%.3g") << " | " << number(r["rel_mse"]) << " | "
-                << number(r["ns_per_estimate"], "%.0f") << " | " << number(r["efficiency"]) << " | "
-                << number(r["variance_ratio_vs_mis"], "%.3f") << " |\n";
+            << "), alpha " << number(in.value("alpha", 1.0), "%.3g") << "\n\n| bsdf | technique |";
+        for (const StatsColumn& c : kReportColumns) out << " " << c.heading << " |";
+        out << "\n|---|---|";
+        for (size_t i = 0; i < std::size(kReportColumns); ++i) out << "---:|";
+        out << "\n";
+        for (const json& r : run["results"]) {
+            out << "| " << r["bsdf"].get<std::string>() << " | " << r["technique"].get<std::string>() << " |";
+            for (const StatsColumn& c : kReportColumns) out << " " << cell_text(r[c.key].get<double>(), c) << " |";
+            out << "\n";
+        }
         out << "\n";
     }
+}
+
+void write_report(std::ostream& out, const std::vector<json>& runs, const ReportArgs& args) {
+    const auto [techniques, cases] = collect_cases(runs);
+    write_intro(out, runs, args.title, args.command);
+    write_summary(out, techniques, cases);
+    write_optimal(out, cases);
+    write_strength(out, runs);
+    write_allocation(out, runs);
+    write_plots(out, runs, args.plots);
+    write_tables(out, runs);
+}
+
+void run_report(const ReportArgs& args) {
+    std::vector<json> runs;
+    for (const std::string& path : args.inputs) runs.push_back(read_results(path));
+    write_file_atomically(args.output, [&](std::ostream& out) { write_report(out, runs, args); });
+    std::cout << "report: " << args.output << " (" << runs.size() << " runs)\n";
 }
 
 }  // namespace
 
 Subcommand add_report(CLI::App& app) {
-    struct Args {
-        std::vector<std::string> inputs;
-        std::string output, title = "envmis results", command, plots;
-    };
-    auto args = std::make_shared<Args>();
+    auto args = std::make_shared<ReportArgs>();
     CLI::App* sub = app.add_subcommand("report", "Markdown report from the JSON of envmis compare runs (one per map)");
     sub->add_option("results", args->inputs, "JSON files written by envmis compare --json")->required();
     sub->add_option("-o,--output", args->output, "Markdown file to write")->required();
@@ -294,14 +340,7 @@ Subcommand add_report(CLI::App& app) {
     sub->add_option("--command", args->command, "The command that made the results, quoted in the report");
     sub->add_option("--plots", args->plots,
                     "Folder, relative to the report, holding each map's plots (MAP/variance_vs_balance.png, ...)");
-    return {sub, [args] {
-                std::vector<json> runs;
-                for (const std::string& path : args->inputs) runs.push_back(read_results(path));
-                write_file_atomically(args->output, [&](std::ostream& out) {
-                    write_report(out, runs, args->title, args->command, args->plots);
-                });
-                std::cout << "report: " << args->output << " (" << runs.size() << " runs)\n";
-            }};
+    return {sub, [args] { run_report(*args); }};
 }
 
 }  // namespace envmis::cli

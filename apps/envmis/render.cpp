@@ -82,32 +82,21 @@ io::Image8 stack(const io::Image8& top, const io::Image8& bottom) {
 
 }  // namespace
 
-std::filesystem::path render_comparison(const EnvMap& plain, const EnvMap& compensated,
-                                        const ComparisonOptions& options, const RenderOptions& render_options,
-                                        const std::filesystem::path& folder, const std::string& map_name,
-                                        const std::atomic<bool>* stop) {
+namespace {
+
+Scene parse_scene(const std::string& size, uint32_t spheres) {
     unsigned w = 0, h = 0;
     char x = 0;
-    if (std::sscanf(render_options.size.c_str(), "%u%c%u", &w, &x, &h) != 3 || x != 'x' || w < 16 || h < 16 ||
-        w > 8192 || h > 8192)
-        throw std::runtime_error("--image '" + render_options.size + "': expected WxH, each 16 to 8192");
-    std::filesystem::create_directories(folder);
-    const auto spheres = static_cast<uint32_t>(options.bsdfs.size());
-    const Scene scene{w, h, spheres, 0.45f * std::min(static_cast<float>(w) / spheres, static_cast<float>(h))};
+    if (std::sscanf(size.c_str(), "%u%c%u", &w, &x, &h) != 3 || x != 'x' || w < 16 || h < 16 || w > 8192 || h > 8192)
+        throw std::runtime_error("--image '" + size + "': expected WxH, each 16 to 8192");
+    return {w, h, spheres, 0.45f * std::min(static_cast<float>(w) / spheres, static_cast<float>(h))};
+}
 
-    const RgbImage reference =
-        render(scene, DirectLightingEstimator(plain, Technique::parse("mis-power"), options.allocation), options.bsdfs,
-               render_options.reference_spp, options.seed ^ 0x5eed, options.threads, stop);
-    io::write_exr(folder / "reference.exr", reference);
-    std::vector<std::pair<std::string, RgbImage>> renders;
-    for (const Technique& t : options.techniques) {
-        const DirectLightingEstimator estimator(plain, compensated, t, options.allocation);
-        renders.emplace_back(
-            t.name(), render(scene, estimator, options.bsdfs, render_options.spp, options.seed, options.threads, stop));
-        io::write_exr(folder / (t.name() + ".exr"), renders.back().second);
-    }
-
-    // Tone-map all renders as one wide image, so that they share one exposure.
+// Tone-maps the reference and all renders as one wide image, so that they share one
+// exposure; panel 0 is the reference.
+io::Image8 tonemap_together(const RgbImage& reference, const std::vector<std::pair<std::string, RgbImage>>& renders,
+                            LumaCoefficients luma) {
+    const uint32_t w = reference.width, h = reference.height;
     const uint32_t panels = static_cast<uint32_t>(renders.size()) + 1;
     RgbImage wide{w * panels, h, std::vector<Rgb>(size_t{w} * panels * h)};
     auto place = [&](const RgbImage& image, uint32_t panel) {
@@ -116,37 +105,70 @@ std::filesystem::path render_comparison(const EnvMap& plain, const EnvMap& compe
     };
     place(reference, 0);
     for (uint32_t i = 0; i < renders.size(); ++i) place(renders[i].second, i + 1);
-    const io::Image8 shown = pictures::tonemap(wide, 0, plain.options().luma);
+    return pictures::tonemap(wide, 0, luma);
+}
 
-    std::vector<pictures::Panel> top = {
-        {crop(shown, 0, w), "reference (" + std::to_string(render_options.reference_spp) + " spp)"}};
+// The caption of the montage: map, BSDFs, samples and alpha.
+std::string caption_text(const std::string& map_name, const ComparisonOptions& options, uint32_t spp, float alpha) {
+    std::string bsdf_names;
+    for (const Bsdf& b : options.bsdfs) bsdf_names += (bsdf_names.empty() ? "" : ", ") + b.name();
+    char caption[256];
+    std::snprintf(caption, sizeof caption, "%s: %s at %u spp (%u env + %u BSDF samples each), alpha %.3g",
+                  map_name.c_str(), bsdf_names.c_str(), spp, options.allocation.env, options.allocation.bsdf, alpha);
+    return caption;
+}
+
+// The montage: the tone-mapped renders on top, their relative squared errors below;
+// writes each panel's PNG on the way.
+io::Image8 write_panels(const std::filesystem::path& folder, const RgbImage& reference,
+                        const std::vector<std::pair<std::string, RgbImage>>& renders, const io::Image8& shown,
+                        uint32_t reference_spp, const std::string& caption) {
+    const uint32_t w = reference.width, h = reference.height;
+    std::vector<pictures::Panel> top = {{crop(shown, 0, w), "reference (" + std::to_string(reference_spp) + " spp)"}};
     io::write_png(folder / "reference.png", top[0].image);
-    std::vector<std::vector<float>> errors;
-    std::vector<double> mean_errors;
-    for (uint32_t i = 0; i < renders.size(); ++i) {
-        top.push_back({crop(shown, (i + 1) * w, w), renders[i].first});
-        io::write_png(folder / (renders[i].first + ".png"), top.back().image);
-        mean_errors.push_back(0);
-        errors.push_back(relative_squared_error(renders[i].second, reference, mean_errors.back()));
-    }
     // A fixed scale: a few pixels hit by a rare bright sample would otherwise stretch it
     // over many decades and leave the typical errors indistinguishable.
     const pictures::ColourScale scale{1e-4f, 10.0f, true};
     std::vector<pictures::Panel> bottom;
     for (uint32_t i = 0; i < renders.size(); ++i) {
+        top.push_back({crop(shown, (i + 1) * w, w), renders[i].first});
+        io::write_png(folder / (renders[i].first + ".png"), top.back().image);
+        double mean_error = 0;
+        const std::vector<float> error = relative_squared_error(renders[i].second, reference, mean_error);
         char title[96];
-        std::snprintf(title, sizeof title, "%s relMSE %.3g", renders[i].first.c_str(), mean_errors[i]);
-        bottom.push_back({pictures::false_colour(errors[i], w, h, scale), title, true});
+        std::snprintf(title, sizeof title, "%s relMSE %.3g", renders[i].first.c_str(), mean_error);
+        bottom.push_back({pictures::false_colour(error, w, h, scale), title, true});
         io::write_png(folder / (renders[i].first + "-relmse.png"), bottom.back().image);
     }
     const io::Image8 bar = pictures::colour_bar(scale, "per-pixel relative squared error", std::min(4u * w, 1600u));
-    std::string bsdf_names;
-    for (const Bsdf& b : options.bsdfs) bsdf_names += (bsdf_names.empty() ? "" : ", ") + b.name();
-    char caption[256];
-    std::snprintf(caption, sizeof caption, "%s: %s at %u spp (%u env + %u BSDF samples each), alpha %.3g",
-                  map_name.c_str(), bsdf_names.c_str(), render_options.spp, options.allocation.env,
-                  options.allocation.bsdf, compensated.options().compensation.alpha);
-    const io::Image8 montage = stack(pictures::montage(top, caption), pictures::montage(bottom, "", &bar));
+    return stack(pictures::montage(top, caption), pictures::montage(bottom, "", &bar));
+}
+
+}  // namespace
+
+std::filesystem::path render_comparison(const StudyInputs& inputs, const RenderOptions& render_options,
+                                        const std::filesystem::path& folder, const std::string& map_name,
+                                        const RunControl& control) {
+    const ComparisonOptions& options = inputs.options;
+    const EnvMap& compensated = inputs.compensated.maps.front();
+    const Scene scene = parse_scene(render_options.size, static_cast<uint32_t>(options.bsdfs.size()));
+    std::filesystem::create_directories(folder);
+
+    const RgbImage reference =
+        render(scene, DirectLightingEstimator(inputs.plain, Technique::parse("mis-power"), options.allocation),
+               options.bsdfs, render_options.reference_spp, options.seed ^ 0x5eed, options.threads, control.stop);
+    io::write_exr(folder / "reference.exr", reference);
+    std::vector<std::pair<std::string, RgbImage>> renders;
+    for (const Technique& t : options.techniques) {
+        const DirectLightingEstimator estimator(inputs.plain, compensated, t, options.allocation);
+        renders.emplace_back(t.name(), render(scene, estimator, options.bsdfs, render_options.spp, options.seed,
+                                              options.threads, control.stop));
+        io::write_exr(folder / (t.name() + ".exr"), renders.back().second);
+    }
+    const io::Image8 shown = tonemap_together(reference, renders, inputs.plain.options().luma);
+    const io::Image8 montage =
+        write_panels(folder, reference, renders, shown, render_options.reference_spp,
+                     caption_text(map_name, options, render_options.spp, compensated.options().compensation.alpha));
     const std::filesystem::path path = folder / "montage.png";
     io::write_png(path, montage);
     return path;

@@ -17,11 +17,14 @@ struct RenderOptions {
     uint32_t reference_spp = 512;  // estimates per pixel of the reference (mis-power)
 };
 
-// Writes reference.{exr,png}, <technique>.{exr,png}, <technique>-relmse.png and
-// montage.png into `folder` (created if missing). Returns the montage's path.
-std::filesystem::path render_comparison(const EnvMap& plain, const EnvMap& compensated,
-                                        const ComparisonOptions& options, const RenderOptions& render,
+// Renders every technique of inputs.options, every sphere sampling the first map of
+// inputs.compensated (inputs.points are not used: the pixels are the points), and writes
+// reference.{exr,png}, <technique>.{exr,png}, <technique>-relmse.png and montage.png into
+// `folder` (created if missing). Stops at control.stop (the pictures then hold the rows
+// done). Returns the montage's path. Cost: pixels x (spp x techniques + reference_spp)
+// estimates.
+std::filesystem::path render_comparison(const StudyInputs& inputs, const RenderOptions& render,
                                         const std::filesystem::path& folder, const std::string& map_name,
-                                        const std::atomic<bool>* stop);
+                                        const RunControl& control);
 
 }  // namespace envmis::cli

@@ -3,10 +3,16 @@
 // quadrature over the map (quadrature.h), which shares no code with the estimators'
 // sampling.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -46,6 +52,101 @@ TEST(Compare, SinglePointVariancesMatchTheExactVariances) {
         EXPECT_NEAR(r["variance"].get<double>(), exact, 0.08 * exact) << r["bsdf"] << " " << r["technique"];
         EXPECT_NEAR(r["mean"].get<double>(), r["reference"].get<double>(), 4 * r["std_error"].get<double>())
             << r["bsdf"] << " " << r["technique"];
+    }
+    fs::remove_all(dir);
+}
+
+struct CliRun {
+    int exit_code = -1;
+    std::string out;  // stdout and stderr together
+};
+
+// `envmis compare map.exr ARGS` in `dir`, with stdout and stderr.
+CliRun run_compare(const fs::path& dir, const std::string& args) {
+    const std::string command =
+        "cd '" + dir.string() + "' && '" + ENVMIS_CLI + "' compare map.exr " + args + " > out.txt 2>&1";
+    const int status = std::system(command.c_str());
+    std::ifstream in(dir / "out.txt", std::ios::binary);
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : 128,
+            {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()}};
+}
+
+fs::path small_map_folder(const char* name) {
+    const fs::path dir = fs::temp_directory_path() / (std::string(name) + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    io::write_exr(dir / "map.exr", test::random_map(32, 16, 5, 2));
+    return dir;
+}
+
+// Every count, size and seed flag rejects a negative and an out-of-range value with one
+// line naming the flag, before any work (CLI11 would otherwise read "-5" into an unsigned
+// as 2^64 - 5).
+TEST(Compare, CountAndSeedFlagsRejectNegativeAndOutOfRangeValues) {
+    const fs::path dir = small_map_folder("envmis_compare_flags_test");
+    const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
+        {"--spp", {"-5", "0", "4294967296"}},        {"--points", {"-5", "0", "1000001"}},
+        {"--threads", {"-1", "0", "1025"}},          {"--env-samples", {"-1", "65537"}},
+        {"--bsdf-samples", {"-1", "65537"}},         {"--seed", {"-1", "18446744073709551616", "x"}},
+        {"--allocation-sweep", {"-4", "1", "1025"}}, {"--image-spp", {"-1", "0", "65537"}},
+        {"--reference-spp", {"-1", "0", "1048577"}},
+    };
+    for (const auto& [flag, values] : cases)
+        for (const std::string& value : values) {
+            const CliRun r = run_compare(dir, flag + " " + value + " --points 1 --spp 1");
+            EXPECT_NE(r.exit_code, 0) << flag << " " << value << "\n" << r.out;
+            EXPECT_NE(r.out.find(flag + ": Value " + value), std::string::npos) << flag << " " << value << "\n"
+                                                                                << r.out;
+            EXPECT_EQ(r.out.find("envmis compare:"), std::string::npos) << flag << " " << value << " started a run";
+        }
+    // The limits themselves are accepted.
+    const CliRun edge =
+        run_compare(dir, "--seed 18446744073709551615 --threads 1 --points 1 --spp 1 --techniques bsdf");
+    EXPECT_EQ(edge.exit_code, 0) << edge.out;
+    EXPECT_NE(edge.out.find("seed 18446744073709551615"), std::string::npos) << edge.out;
+    fs::remove_all(dir);
+}
+
+// The BSDFs' albedo is shown in the header line and in the JSON inputs, and --bsdf sets
+// it; the estimator is linear in a Lambertian's albedo, so halving it halves every mean.
+TEST(Compare, BsdfAlbedoIsShownAndSet) {
+    const fs::path dir = small_map_folder("envmis_compare_albedo_test");
+    const std::string common =
+        "--points 3 --spp 64 --threads 2 --seed 7 --techniques env,bsdf,mis-balance,mis-balance-comp";
+    const CliRun plain = run_compare(dir, common + " --json default.json");
+    ASSERT_EQ(plain.exit_code, 0) << plain.out;
+    EXPECT_NE(plain.out.find(", BSDF albedo lambert 0.8, phong:50 0.8, ggx:0.1 0.95/0.64/0.54\n"), std::string::npos)
+        << plain.out;
+    const nlohmann::json defaults = nlohmann::json::parse(std::ifstream(dir / "default.json"))["inputs"]["albedo"];
+    EXPECT_EQ(defaults["lambert"], nlohmann::json({0.8, 0.8, 0.8}));
+    EXPECT_EQ(defaults["phong:50"], nlohmann::json({0.8, 0.8, 0.8}));
+    EXPECT_EQ(defaults["ggx:0.1"], nlohmann::json({0.95, 0.64, 0.54}));
+
+    const CliRun dark = run_compare(dir, common + " --bsdf lambert:0.4 --json dark.json");
+    const CliRun bright = run_compare(dir, common + " --bsdf lambert:0.8 --json bright.json");
+    ASSERT_EQ(dark.exit_code, 0) << dark.out;
+    ASSERT_EQ(bright.exit_code, 0) << bright.out;
+    EXPECT_NE(dark.out.find(", BSDF albedo 0.4\n"), std::string::npos) << dark.out;
+    EXPECT_NE(bright.out.find(", BSDF albedo 0.8\n"), std::string::npos) << bright.out;
+    const nlohmann::json d = nlohmann::json::parse(std::ifstream(dir / "dark.json"));
+    const nlohmann::json b = nlohmann::json::parse(std::ifstream(dir / "bright.json"));
+    EXPECT_EQ(d["inputs"]["albedo"]["lambert:0.4"], nlohmann::json({0.4, 0.4, 0.4}));
+    EXPECT_EQ(b["inputs"]["albedo"]["lambert"], nlohmann::json({0.8, 0.8, 0.8})) << "the default keeps its name";
+    ASSERT_EQ(d["results"].size(), b["results"].size());
+    ASSERT_EQ(d["results"].size(), 4u);
+    for (size_t i = 0; i < d["results"].size(); ++i) {
+        const nlohmann::json &x = d["results"][i], &y = b["results"][i];
+        EXPECT_EQ(x["bsdf"], "lambert:0.4");
+        EXPECT_EQ(x["technique"], y["technique"]);
+        const double half = 0.5 * y["mean"].get<double>();
+        EXPECT_NEAR(x["mean"].get<double>(), half, 1e-6 * half) << x["technique"];
+        EXPECT_NEAR(x["variance_ratio_vs_mis"].get<double>(), y["variance_ratio_vs_mis"].get<double>(), 1e-6)
+            << x["technique"];
+    }
+    for (const char* bad : {"lambert:-0.1", "lambert:1.5", "phong:50:2", "ggx:0.1:abc"}) {
+        const CliRun r = run_compare(dir, std::string("--points 1 --spp 1 --bsdf ") + bad);
+        EXPECT_NE(r.exit_code, 0) << bad;
+        EXPECT_NE(r.out.find(bad), std::string::npos) << bad << "\n" << r.out;
     }
     fs::remove_all(dir);
 }

@@ -11,6 +11,7 @@
 #include "envmis/core.h"
 #include "envmis/study/comparison/alpha.h"
 #include "envmis/study/comparison/comparison.h"
+#include "envmis/study/comparison/sweeps.h"
 #include "envmis/study/reference/quadrature.h"
 #include "envmis/study/reference/textbook.h"
 #include "envmis/study/shading/bsdf.h"

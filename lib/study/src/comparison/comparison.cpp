@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -77,9 +78,12 @@ Rgb average_estimate(const DirectLightingEstimator& estimator, const ShadingPoin
     return {static_cast<float>(r / spp), static_cast<float>(g / spp), static_cast<float>(b / spp)};
 }
 
-Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<const ShadingPoint> points,
-                   const ComparisonOptions& options, const std::atomic<bool>* stop,
-                   const std::function<void(size_t, size_t)>& progress) {
+namespace {
+
+// The study with one compensated map for every BSDF.
+Comparison compare_one(const EnvMap& plain, const EnvMap& compensated, std::span<const ShadingPoint> points,
+                       const ComparisonOptions& options, const std::atomic<bool>* stop,
+                       const std::function<void(size_t, size_t)>& progress) {
     if (options.bsdfs.empty() || options.techniques.empty() || options.spp == 0 || points.empty())
         throw std::invalid_argument("compare: needs at least one BSDF, technique, shading point and sample");
     std::vector<DirectLightingEstimator> estimators;
@@ -177,6 +181,57 @@ Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<con
         result.bsdfs.push_back(std::move(bc));
     }
     return result;
+}
+
+}  // namespace
+
+EnvMap compensated_map(const EnvMap& plain, float alpha) {
+    EnvMapOptions options = plain.options();
+    options.compensation = {true, alpha};
+    return EnvMap(to_image(plain.radiance()), options);
+}
+
+CompensatedMaps compensated_maps(const EnvMap& plain, std::span<const float> bsdf_alphas) {
+    CompensatedMaps result;
+    for (float alpha : bsdf_alphas) {
+        const size_t i =
+            static_cast<size_t>(std::find(result.alphas.begin(), result.alphas.end(), alpha) - result.alphas.begin());
+        if (i == result.alphas.size()) {
+            result.alphas.push_back(alpha);
+            result.maps.push_back(compensated_map(plain, alpha));
+        }
+        result.of_bsdf.push_back(i);
+    }
+    return result;
+}
+
+Comparison compare(const StudyInputs& inputs, const RunControl& control) {
+    const ComparisonOptions& options = inputs.options;
+    if (inputs.compensated.of_bsdf.size() != options.bsdfs.size())
+        throw std::invalid_argument("compare: needs one compensated map per BSDF");
+    const size_t runs = inputs.compensated.maps.size();
+    std::vector<std::optional<BsdfComparison>> slots(options.bsdfs.size());
+    Comparison merged{{}, inputs.points.size(), inputs.points.size()};
+    for (size_t m = 0; m < runs; ++m) {
+        if (control.stopped()) {
+            merged.points_done = 0;
+            break;
+        }
+        ComparisonOptions run = options;
+        run.bsdfs.clear();
+        std::vector<size_t> slot;
+        for (size_t b = 0; b < options.bsdfs.size(); ++b)
+            if (inputs.compensated.of_bsdf[b] == m) run.bsdfs.push_back(options.bsdfs[b]), slot.push_back(b);
+        const Comparison c = compare_one(inputs.plain, inputs.compensated.maps[m], inputs.points, run, control.stop,
+                                         [&](size_t done, size_t total) {
+                                             if (control.progress) control.progress(m * total + done, runs * total);
+                                         });
+        merged.points_done = std::min(merged.points_done, c.points_done);
+        for (size_t i = 0; i < c.bsdfs.size(); ++i) slots[slot[i]] = c.bsdfs[i];
+    }
+    for (auto& s : slots)
+        if (s) merged.bsdfs.push_back(std::move(*s));
+    return merged;
 }
 
 }  // namespace envmis

@@ -75,13 +75,51 @@ struct Comparison {
 // head-on (wo = normal).
 std::vector<ShadingPoint> sphere_points(uint32_t k);
 
-// Runs the study. `plain` and `compensated` are the same map without and with
-// compensation. Throws std::invalid_argument for an invalid technique (env-comp), an
-// empty list or spp of 0. Checks `stop` between points and returns what is done;
-// calls `progress(done, total)` after each point.
-Comparison compare(const EnvMap& plain, const EnvMap& compensated, std::span<const ShadingPoint> points,
-                   const ComparisonOptions& options, const std::atomic<bool>* stop = nullptr,
-                   const std::function<void(size_t, size_t)>& progress = {});
+// A map compensated with each BSDF's strength: one map per distinct alpha, and the one
+// each BSDF (in ComparisonOptions::bsdfs order) samples. Building one costs a new
+// density over the map's radiance (tens of ms for a 1k map).
+struct CompensatedMaps {
+    std::vector<float> alphas;  // distinct
+    std::vector<EnvMap> maps;   // maps[i] is compensated with alphas[i]
+    std::vector<size_t> of_bsdf;
+
+    float alpha_of(size_t bsdf) const { return alphas[of_bsdf[bsdf]]; }
+};
+
+// `plain` compensated with strength alpha (a new build from its radiance).
+EnvMap compensated_map(const EnvMap& plain, float alpha);
+// One map per distinct value of bsdf_alphas, each BSDF's alpha.
+CompensatedMaps compensated_maps(const EnvMap& plain, std::span<const float> bsdf_alphas);
+
+// What a study runs on: the same map without compensation (`plain`, sampled by the
+// techniques that do not compensate, and the quadrature references' radiance) and with
+// it (`compensated`, each BSDF's own), the shading points and the options. The maps and
+// points are borrowed: they must outlive the call.
+struct StudyInputs {
+    const EnvMap& plain;
+    const CompensatedMaps& compensated;
+    std::span<const ShadingPoint> points;
+    ComparisonOptions options;
+};
+
+// How a long run is watched and stopped: `stop` is checked between points (the run
+// returns what is done); `progress(done, total)` is called after each point, in units
+// the caller does not need to know (points times runs).
+struct RunControl {
+    const std::atomic<bool>* stop = nullptr;
+    std::function<void(size_t done, size_t total)> progress = {};
+
+    bool stopped() const { return stop && stop->load(); }
+};
+
+// Runs the study: every technique on every BSDF at every point, each BSDF sampling its
+// own compensated map (one run per map, over the BSDFs that use it, merged in BSDF
+// order). Throws std::invalid_argument for an invalid technique (env-comp), an empty
+// list or spp of 0. Stopped early, it holds the BSDFs whose run started, and
+// points_done is the fewest points any BSDF covers (0 for those whose run did not
+// start). Cost: points x BSDFs x techniques x spp estimates (tens of ns each) plus a
+// quadrature reference per point and BSDF.
+Comparison compare(const StudyInputs& inputs, const RunControl& control = {});
 
 // Runs `spp` estimates of `technique` at one point, learning as adaptive techniques do,
 // and returns their mean (RGB): one pixel of a rendered comparison.

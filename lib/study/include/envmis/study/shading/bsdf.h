@@ -43,9 +43,18 @@ struct Bsdf {
     static Bsdf lambert(Rgb albedo = {0.8f, 0.8f, 0.8f}) { return {BsdfKind::lambert, albedo, 0, 0}; }
     static Bsdf phong(float n, Rgb albedo = {0.8f, 0.8f, 0.8f}) { return {BsdfKind::phong, albedo, n, 0}; }
     static Bsdf ggx(float alpha, Rgb f0 = {0.95f, 0.64f, 0.54f}) { return {BsdfKind::ggx, f0, 0, alpha}; }
-    // "lambert", "phong:N" (N >= 0) or "ggx:A" (0 < A <= 1). Throws std::invalid_argument.
+    // "lambert[:ALBEDO]", "phong:N[:ALBEDO]" (0 <= N <= 1e5) or "ggx:A[:F0]" (0.001 <= A <= 1),
+    // ALBEDO and F0 a grey reflectance in [0, 1] (the same on r, g and b; default: that
+    // of lambert(), phong() and ggx()). Throws std::invalid_argument.
     static Bsdf parse(std::string_view text);
-    std::string name() const;  // the text parse() reads back
+    // The text parse() reads back: "lambert", "phong:50", "ggx:0.1" with the default
+    // reflectance, followed by ":ALBEDO" otherwise ("lambert:0.5"; a non-grey one as
+    // ":R/G/B", which parse() does not read).
+    std::string name() const;
+    // The reflectance as text: "0.8" when grey, "0.95/0.64/0.54" otherwise.
+    std::string albedo_text() const;
+    // The reflectance of lambert(), phong() and ggx() when none is given.
+    static Rgb default_reflectance(BsdfKind kind);
 
     ENVMIS_HD Rgb eval(Vec3 wo, Vec3 wi) const noexcept;
     ENVMIS_HD float pdf(Vec3 wo, Vec3 wi) const noexcept;
