@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -49,6 +50,9 @@ CLI::Validator in_range(T lo, T hi) {
         },
         CLI::Range(lo, hi).get_description());
 }
+
+// A seed flag: any 64-bit unsigned integer, and nothing else.
+inline CLI::Validator any_seed() { return in_range(uint64_t{0}, std::numeric_limits<uint64_t>::max()); }
 
 // An image size "WxH", each side 1 to kMaxCells1D (65536), or with `single` also "N"
 // (returned as N x 0). Digits only: no sign, no spaces. Empty where the text is not one.

@@ -1,7 +1,6 @@
 // envmis compare IN: the variance study. Estimates direct lighting on analytic BSDFs with
 // every technique at equal sample count and reports how much MIS compensation gains.
 #include <algorithm>
-#include <charconv>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -36,26 +35,13 @@ struct CompareArgs {
     MapFlags map;
 };
 
-// The limits of the count and seed flags (each flag's own type, so that CLI11 rejects a
-// negative value instead of wrapping it).
+// The limits of the count flags, checked by in_range (cli.h), which refuses a negative value
+// instead of wrapping it.
 constexpr uint32_t kMaxSpp = std::numeric_limits<uint32_t>::max();
 constexpr uint32_t kMaxSamples = 65536;  // per estimate, of each kind
 constexpr uint32_t kMaxPoints = 1000000;
 constexpr uint32_t kMaxThreads = 1024;
 constexpr uint32_t kMaxImageSpp = 65536, kMaxReferenceSpp = 1 << 20;
-
-// A seed: an integer 0 to 2^64-1. CLI::Range(uint64_t{0}, max) cannot say so: CLI11 2.1
-// reads "-1" and "18446744073709551616" as 2^64-1, inside the range.
-CLI::Validator seed_check() {
-    return {[](std::string& text) -> std::string {
-                uint64_t value = 0;
-                const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-                if (error != std::errc() || end != text.data() + text.size())
-                    return "Value " + text + " is not an integer 0 to 18446744073709551615";
-                return {};
-            },
-            "UINT64"};
-}
 
 // Everything a run is set up with: the parsed flags, the plain map, the points, the
 // compensation strengths chosen and their maps.
@@ -116,22 +102,22 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
         "mis-{balance,optimal}-all,one-sample[-comp])");
     sub.add_option("--spp", args.spp, "Estimates per shading point, BSDF and technique (1 to 2^32-1)")
         ->capture_default_str()
-        ->check(CLI::Range(uint32_t{1}, kMaxSpp));
+        ->check(in_range(uint32_t{1}, kMaxSpp));
     sub.add_option("--env-samples", args.env_samples, "Environment samples per MIS estimate (0 to 65536)")
         ->capture_default_str()
-        ->check(CLI::Range(uint32_t{0}, kMaxSamples));
+        ->check(in_range(uint32_t{0}, kMaxSamples));
     sub.add_option("--bsdf-samples", args.bsdf_samples, "BSDF samples per MIS estimate (0 to 65536)")
         ->capture_default_str()
-        ->check(CLI::Range(uint32_t{0}, kMaxSamples));
-    sub.add_option("--seed", args.seed, "Random seed")->capture_default_str()->check(seed_check());
+        ->check(in_range(uint32_t{0}, kMaxSamples));
+    sub.add_option("--seed", args.seed, "Random seed")->capture_default_str()->check(any_seed());
     sub.add_option("--threads", args.threads,
                    "Worker threads, 1 to 1024 (default: all cores); results do not depend on it")
-        ->check(CLI::Range(uint32_t{1}, kMaxThreads));
+        ->check(in_range(uint32_t{1}, kMaxThreads));
     sub.add_option("--normal", args.normal, "One shading point with this normal x,y,z");
     sub.add_option("--view", args.view, "View direction x,y,z for --normal (default: the normal)");
     sub.add_option("--points", args.points, "Shading points: K normals spread evenly over the sphere (1 to 10^6)")
         ->capture_default_str()
-        ->check(CLI::Range(uint32_t{1}, kMaxPoints));
+        ->check(in_range(uint32_t{1}, kMaxPoints));
 }
 
 void add_output_flags(CLI::App& sub, CompareArgs& args) {
@@ -139,11 +125,11 @@ void add_output_flags(CLI::App& sub, CompareArgs& args) {
         ->capture_default_str();
     sub.add_option("--image-spp", args.render.spp, "Estimates per pixel for each technique's render (1 to 65536)")
         ->capture_default_str()
-        ->check(CLI::Range(uint32_t{1}, kMaxImageSpp));
+        ->check(in_range(uint32_t{1}, kMaxImageSpp));
     sub.add_option("--reference-spp", args.render.reference_spp,
                    "Estimates per pixel of the reference render (mis-power; 1 to 2^20)")
         ->capture_default_str()
-        ->check(CLI::Range(uint32_t{1}, kMaxReferenceSpp));
+        ->check(in_range(uint32_t{1}, kMaxReferenceSpp));
     sub.add_option("--json", args.json, "Write the results as JSON");
     sub.add_option("--csv", args.csv, "Write the results as CSV");
     sub.add_option("--images", args.images, "Folder for EXR and PNG pictures (renders, errors, montage)");
@@ -165,7 +151,7 @@ void add_sweep_flags(CLI::App& sub, CompareArgs& args) {
            "--allocation-sweep", args.allocation_sweep,
            "N: the MIS techniques (default mis-balance, mis-balance-comp) at every split n_env:n_bsdf = k:(N-k) "
            "of N samples per estimate, with the most efficient marked, instead of the normal table")
-        ->check(CLI::Range(uint32_t{2}, uint32_t{1024}));
+        ->check(in_range(uint32_t{2}, uint32_t{1024}));
 }
 
 // The plain map as the flags and the file say, and the fixed alpha (--alpha, or the

@@ -1,8 +1,6 @@
 // envmis sample TABLE|HDR -n N: directions drawn from a map's sampler, as CSV.
-#include <charconv>
 #include <fstream>
 #include <iostream>
-#include <limits>
 #include <memory>
 #include <random>
 
@@ -62,9 +60,7 @@ void add_sample_flags(CLI::App& sub, SampleArgs& args) {
     sub.add_option("-n,--count", args.count, "Number of samples")
         ->capture_default_str()
         ->check(in_range(uint64_t{1}, kMaxSamples));
-    sub.add_option("--seed", args.seed, "Random seed")
-        ->capture_default_str()
-        ->check(in_range(uint64_t{0}, std::numeric_limits<uint64_t>::max()));
+    sub.add_option("--seed", args.seed, "Random seed")->capture_default_str()->check(any_seed());
     sub.add_option("-o,--output", args.output, "CSV file to write (default: standard output)");
     add_map_flags(sub, args.map);
 }

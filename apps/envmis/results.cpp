@@ -53,13 +53,13 @@ std::string cell_text(double value, const StatsColumn& column) {
 
 std::string headings_text(std::span<const StatsColumn> columns) {
     std::string line;
-    for (const StatsColumn& c : columns) line += " " + padded(c.heading, c.width);
+    for (const StatsColumn& c : columns) line.append(" ").append(padded(c.heading, c.width));
     return line;
 }
 
 std::string cells_text(const TechniqueStats& stats, std::span<const StatsColumn> columns) {
     std::string line;
-    for (const StatsColumn& c : columns) line += " " + cell_text(stats_figure(stats, c.key), c);
+    for (const StatsColumn& c : columns) line.append(" ").append(cell_text(stats_figure(stats, c.key), c));
     return line;
 }
 
