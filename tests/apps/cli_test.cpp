@@ -27,11 +27,15 @@
 #include <thread>
 #include <vector>
 
+#include "cli_run.h"
+
 extern char** environ;
 
 namespace {
 
 namespace fs = std::filesystem;
+using envmis::test::read_file;
+using envmis::test::Result;
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -41,34 +45,10 @@ const fs::path kBundled = fs::path(ENVMIS_DATA_DIR) / "envmaps";
 // ---------------------------------------------------------------------------------
 // Helpers: running the command, reading what it wrote, making input files.
 
-std::string read_file(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 void write_file(const fs::path& path, const std::string& bytes) {
     std::ofstream out(path, std::ios::binary);
     out << bytes;
     if (!out) throw std::runtime_error("test setup: cannot write " + path.string());
-}
-
-std::string quoted(const std::string& s) {
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
-struct Result {
-    std::string command;
-    int exit_code = -1;
-    std::string out, err;
-};
-
-// Describes a run for failure messages.
-std::ostream& operator<<(std::ostream& os, const Result& r) {
-    return os << "\n$ " << r.command << "\nexit code " << r.exit_code << "\n--- stdout:\n"
-              << r.out.substr(0, 2000) << "--- stderr:\n"
-              << r.err;
 }
 
 // A regex search, case-insensitive, across lines.
@@ -112,42 +92,13 @@ void write_exr(const fs::path& path, const Pixels& p) {
 }
 
 // Each test works in a folder of its own, removed afterwards.
-class Cli : public testing::Test {
+class Cli : public envmis::test::TempFolder {
 public:
-    void SetUp() override {
-        const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-        std::string name = std::string(info->test_suite_name()) + "_" + info->name();
-        for (char& c : name)
-            if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-        dir_ = fs::temp_directory_path() / ("envmis_cli_test_" + std::to_string(::getpid()) + "_" + name);
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override {
-        std::error_code ignored;
-        fs::remove_all(dir_, ignored);
-    }
-
-    fs::path file(const std::string& name) const { return dir_ / name; }
+    Cli() : TempFolder("envmis_cli_test_") {}
 
     // Runs envmis with `args` (each passed as one argument) in the test's folder.
     Result envmis(const std::vector<std::string>& args) const {
-        Result r;
-        r.command = "envmis";
-        std::string command = "cd " + quoted(dir_.string()) + " && " + quoted(ENVMIS_CLI);
-        for (const std::string& a : args) {
-            command.append(" ").append(quoted(a));
-            r.command.append(" ").append(a);
-        }
-        const fs::path out = dir_ / "..stdout", err = dir_ / "..stderr";
-        const int status =
-            std::system((command + " > " + quoted(out.string()) + " 2> " + quoted(err.string())).c_str());
-        r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-        r.out = read_file(out);
-        r.err = read_file(err);
-        fs::remove(out);
-        fs::remove(err);
-        return r;
+        return envmis::test::run_envmis(dir_, args, dir_ / "..stdout", dir_ / "..stderr");
     }
 
     // The names in the test's folder (hidden ones included).
@@ -179,8 +130,6 @@ public:
         for (int i = 0; i < w * h; ++i) p.rgb.insert(p.rgb.end(), {0.1f + i % 7, 0.2f + i % 5, 0.3f + i % 3});
         return p;
     }
-
-    fs::path dir_;
 };
 
 // A failure as the user must see it: exit code != 0, nothing on stdout, and one line on

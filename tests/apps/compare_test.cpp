@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_run.h"
 #include "envmis/io/image_io.h"
 #include "envmis/study/reference/quadrature.h"
 #include "maps.h"
@@ -66,9 +67,7 @@ CliRun run_compare(const fs::path& dir, const std::string& args) {
     const std::string command =
         "cd '" + dir.string() + "' && '" + ENVMIS_CLI + "' compare map.exr " + args + " > out.txt 2>&1";
     const int status = std::system(command.c_str());
-    std::ifstream in(dir / "out.txt", std::ios::binary);
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : 128,
-            {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()}};
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : 128, test::read_file(dir / "out.txt")};
 }
 
 fs::path small_map_folder(const char* name) {

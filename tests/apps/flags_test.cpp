@@ -4,45 +4,20 @@
 // flag, and no output file. Every test runs the real binary (ENVMIS_CLI) in a temporary
 // folder of its own.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <ostream>
 #include <string>
 #include <vector>
 
+#include "cli_run.h"
+
 namespace {
 
 namespace fs = std::filesystem;
+using envmis::test::Result;
 
 const std::string kStudio = (fs::path(ENVMIS_DATA_DIR) / "envmaps" / "studio.exr").string();
-
-std::string read_file(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-std::string quoted(const std::string& s) {
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
-struct Result {
-    std::string command;
-    int exit_code = -1;
-    std::string out, err;
-};
-
-std::ostream& operator<<(std::ostream& os, const Result& r) {
-    return os << "\n$ " << r.command << "\nexit code " << r.exit_code << "\n--- stdout:\n"
-              << r.out.substr(0, 2000) << "--- stderr:\n"
-              << r.err;
-}
 
 // One refused value: the arguments after `envmis`, and the flag the message must name.
 struct BadFlag {
@@ -54,45 +29,16 @@ struct BadFlag {
 std::ostream& operator<<(std::ostream& os, const BadFlag& c) { return os << c.name; }
 
 // Each test works in a folder of its own, removed afterwards.
-class Folder : public testing::Test {
+class Folder : public envmis::test::TempFolder {
 public:
-    void SetUp() override {
-        const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-        std::string name = std::string(info->test_suite_name()) + "_" + info->name();
-        for (char& c : name)
-            if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-        dir_ = fs::temp_directory_path() / ("envmis_flags_test_" + std::to_string(::getpid()) + "_" + name);
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override {
-        std::error_code ignored;
-        fs::remove_all(dir_, ignored);
-    }
+    Folder() : TempFolder("envmis_flags_test_") {}
 
     // Runs envmis with `args` in the test's folder; its output goes beside the folder.
     Result envmis(const std::vector<std::string>& args) const {
-        Result r;
-        r.command = "envmis";
-        std::string command = "cd " + quoted(dir_.string()) + " && " + quoted(ENVMIS_CLI);
-        for (const std::string& a : args) {
-            command.append(" ").append(quoted(a));
-            r.command.append(" ").append(a);
-        }
-        const fs::path out = dir_.string() + ".stdout", err = dir_.string() + ".stderr";
-        const int status =
-            std::system((command + " > " + quoted(out.string()) + " 2> " + quoted(err.string())).c_str());
-        r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-        r.out = read_file(out);
-        r.err = read_file(err);
-        fs::remove(out);
-        fs::remove(err);
-        return r;
+        return envmis::test::run_envmis(dir_, args, dir_.string() + ".stdout", dir_.string() + ".stderr");
     }
 
     bool folder_is_empty() const { return fs::is_empty(dir_); }
-
-    fs::path dir_;
 };
 
 class Flags : public Folder, public testing::WithParamInterface<BadFlag> {};

@@ -43,6 +43,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_run.h"
 #include "stats.h"
 
 namespace {
@@ -50,6 +51,8 @@ namespace {
 namespace fs = std::filesystem;
 using envmis::test::chi_square;
 using envmis::test::ChiSquare;
+using envmis::test::quoted;
+using envmis::test::read_file;
 using envmis::test::sidak_level;
 
 constexpr double kPi = 3.14159265358979323846;
@@ -157,8 +160,7 @@ struct Row {
 
 // Reads `u,v,x,y,z,pdf` rows; throws on anything else, so that a malformed file fails loudly.
 std::vector<Row> read_csv(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const std::string text = read_file(path);
     const std::string header = "u,v,x,y,z,pdf\n";
     if (text.compare(0, header.size(), header) != 0) throw std::runtime_error(path.string() + ": wrong header");
     std::vector<Row> rows;
@@ -178,12 +180,6 @@ std::vector<Row> read_csv(const fs::path& path) {
     return rows;
 }
 
-std::string quoted(const std::string& s) {
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
 // Runs `envmis sample` into `csv`; returns an empty string or what went wrong.
 std::string run_sample(const fs::path& map, bool compensated, uint64_t seed, const fs::path& csv) {
     const fs::path err = csv.string() + ".stderr";
@@ -193,9 +189,7 @@ std::string run_sample(const fs::path& map, bool compensated, uint64_t seed, con
                                 quoted(err.string());
     const int status = std::system(command.c_str());
     if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return {};
-    std::ifstream in(err);
-    return command + " failed (status " + std::to_string(status) +
-           "): " + std::string{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    return command + " failed (status " + std::to_string(status) + "): " + read_file(err);
 }
 
 // ---------------------------------------------------------------------------------

@@ -2,16 +2,12 @@
 // (--alpha auto, --alpha-sweep, --exact, --allocation-sweep, --plots), run on the built
 // command with a small synthetic sun map, a few points and few estimates.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <map>
 #include <set>
 #include <sstream>
@@ -20,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_run.h"
 #include "envmis/io/image_io.h"
 #include "maps.h"
 
@@ -27,53 +24,28 @@ namespace envmis {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string read_file(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-struct Result {
-    int exit_code = -1;
-    std::string out, err;
-};
-
-std::ostream& operator<<(std::ostream& os, const Result& r) {
-    return os << "\nexit code " << r.exit_code << "\n--- stdout:\n"
-              << r.out.substr(0, 3000) << "--- stderr:\n"
-              << r.err;
-}
+using test::read_file;
+using test::Result;
 
 // Each test works in a folder of its own holding map.exr (64 x 32 sky with a sun).
-class Sweep : public testing::Test {
+class Sweep : public test::TempFolder {
 public:
+    Sweep() : TempFolder("envmis_sweep_test_") {}
+
     void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("envmis_sweep_test_" + std::to_string(::getpid()) + "_" +
-                                            testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
+        TempFolder::SetUp();
         io::write_exr(dir_ / "map.exr", test::sun_sky_map(64, 32));
     }
-    void TearDown() override {
-        std::error_code ignored;
-        fs::remove_all(dir_, ignored);
-    }
 
-    fs::path file(const std::string& name) const { return dir_ / name; }
-
-    // `envmis compare map.exr` with a small study and `args` (no quoting needed).
+    // `envmis compare map.exr` with a small study and `args` (no quoting needed); its
+    // output stays in out.txt and err.txt.
     Result compare(const std::string& args) const {
-        const std::string command = "cd '" + dir_.string() + "' && '" + ENVMIS_CLI +
-                                    "' compare map.exr --points 4 --spp 64 --threads 2 " + args +
-                                    " > out.txt 2> err.txt";
-        const int status = std::system(command.c_str());
-        Result r{WIFEXITED(status) ? WEXITSTATUS(status) : 128, read_file(file("out.txt")), read_file(file("err.txt"))};
-        return r;
+        return test::run_shell("cd '" + dir_.string() + "' && '" + ENVMIS_CLI +
+                                   "' compare map.exr --points 4 --spp 64 --threads 2 " + args,
+                               file("out.txt"), file("err.txt"), test::Killed::as_128);
     }
 
     nlohmann::json json(const std::string& name) const { return nlohmann::json::parse(std::ifstream(file(name))); }
-
-    fs::path dir_;
 };
 
 // Width and height from a PNG's IHDR chunk (big-endian, bytes 16 to 23).

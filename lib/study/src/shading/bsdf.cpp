@@ -33,17 +33,6 @@ Rgb parse_albedo(std::string_view text, std::string_view value, Rgb fallback) {
 
 bool same(Rgb a, Rgb b) { return a.r == b.r && a.g == b.g && a.b == b.b; }
 
-// ":A" for a grey albedo, ":R/G/B" otherwise (not read back by parse()); "" for the default.
-std::string albedo_suffix(Rgb albedo, Rgb fallback) {
-    if (same(albedo, fallback)) return "";
-    char buffer[64];
-    if (albedo.r == albedo.g && albedo.g == albedo.b)
-        std::snprintf(buffer, sizeof buffer, ":%g", albedo.r);
-    else
-        std::snprintf(buffer, sizeof buffer, ":%g/%g/%g", albedo.r, albedo.g, albedo.b);
-    return buffer;
-}
-
 }  // namespace
 
 Rgb Bsdf::default_reflectance(BsdfKind kind) {
@@ -78,7 +67,9 @@ Bsdf Bsdf::parse(std::string_view text) {
 
 std::string Bsdf::name() const {
     char buffer[32];
-    const std::string albedo = albedo_suffix(reflectance, default_reflectance(kind));
+    // ":" + albedo_text() unless the reflectance is the kind's default.
+    const std::string albedo =
+        same(reflectance, default_reflectance(kind)) ? std::string() : std::string(":").append(albedo_text());
     switch (kind) {
         case BsdfKind::lambert: return "lambert" + albedo;
         case BsdfKind::phong: std::snprintf(buffer, sizeof buffer, "phong:%g", exponent); return buffer + albedo;
