@@ -52,34 +52,35 @@ void add_map_flags(CLI::App& app, MapFlags& flags) {
 }
 
 namespace {
-// A side of a size: 1 to kMaxCells1D, digits only.
-std::optional<uint32_t> parse_side(std::string_view text) {
+// A side of a size: min_side to max_side (at most kMaxCells1D), digits only.
+std::optional<uint32_t> parse_side(std::string_view text, uint32_t min_side, uint32_t max_side) {
     if (text.empty() || text.size() > 5 || text.find_first_not_of("0123456789") != std::string_view::npos) return {};
     const uint32_t side = static_cast<uint32_t>(std::stoul(std::string(text)));
-    if (side == 0 || side > kMaxCells1D) return {};
+    if (side < min_side || side > max_side) return {};
     return side;
 }
 }  // namespace
 
-std::optional<Size> parse_size(const std::string& text, bool single) {
+std::optional<Size> parse_size(const std::string& text, bool single, uint32_t min_side, uint32_t max_side) {
     const size_t x = text.find('x');
     if (x == std::string::npos) {
         if (!single) return {};
-        if (const auto n = parse_side(text)) return Size{*n, 0};
+        if (const auto n = parse_side(text, min_side, max_side)) return Size{*n, 0};
         return {};
     }
-    const auto w = parse_side(std::string_view(text).substr(0, x)),
-               h = parse_side(std::string_view(text).substr(x + 1));
+    const auto w = parse_side(std::string_view(text).substr(0, x), min_side, max_side),
+               h = parse_side(std::string_view(text).substr(x + 1), min_side, max_side);
     if (!w || !h) return {};
     return Size{*w, *h};
 }
 
-CLI::Validator size_validator(bool single) {
-    const std::string expected = single ? "N or WxH" : "WxH";
+CLI::Validator size_validator(bool single, uint32_t min_side, uint32_t max_side) {
+    const std::string expected = std::string(single ? "N or WxH" : "WxH") + ", each " + std::to_string(min_side) +
+                                 " to " + std::to_string(max_side);
     return CLI::Validator(
-        [single, expected](std::string& text) -> std::string {
-            if (parse_size(text, single)) return {};
-            return "'" + text + "': expected " + expected + ", each 1 to " + std::to_string(kMaxCells1D);
+        [=](std::string& text) -> std::string {
+            if (parse_size(text, single, min_side, max_side)) return {};
+            return "'" + text + "': expected " + expected;
         },
         "");
 }

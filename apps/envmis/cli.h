@@ -54,14 +54,16 @@ CLI::Validator in_range(T lo, T hi) {
 // A seed flag: any 64-bit unsigned integer, and nothing else.
 inline CLI::Validator any_seed() { return in_range(uint64_t{0}, std::numeric_limits<uint64_t>::max()); }
 
-// An image size "WxH", each side 1 to kMaxCells1D (65536), or with `single` also "N"
-// (returned as N x 0). Digits only: no sign, no spaces. Empty where the text is not one.
+// An image size "WxH", each side min_side to max_side (default 1 to kMaxCells1D = 65536),
+// or with `single` also "N" (returned as N x 0). Digits only: no sign, no spaces. Empty
+// where the text is not one.
 struct Size {
     uint32_t width = 0, height = 0;
 };
-std::optional<Size> parse_size(const std::string& text, bool single);
+std::optional<Size> parse_size(const std::string& text, bool single, uint32_t min_side = 1,
+                               uint32_t max_side = kMaxCells1D);
 // A validator for such a flag, saying what it expects when it refuses a value.
-CLI::Validator size_validator(bool single);
+CLI::Validator size_validator(bool single, uint32_t min_side = 1, uint32_t max_side = kMaxCells1D);
 
 // A map ready to sample, and where it came from.
 struct LoadedMap {

@@ -121,8 +121,10 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
 }
 
 void add_output_flags(CLI::App& sub, CompareArgs& args) {
-    sub.add_option("--image", args.render.size, "Size WxH of the rendered row of spheres, one per BSDF (with --images)")
-        ->capture_default_str();
+    sub.add_option("--image", args.render.size,
+                   "Size WxH of the rendered row of spheres, one per BSDF (with --images), each side 16 to 8192")
+        ->capture_default_str()
+        ->check(size_validator(false, kMinImageSide, kMaxImageSide));
     sub.add_option("--image-spp", args.render.spp, "Estimates per pixel for each technique's render (1 to 65536)")
         ->capture_default_str()
         ->check(in_range(uint32_t{1}, kMaxImageSpp));

@@ -2,9 +2,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
+#include "cli.h"
 #include "envmis/io/image_io.h"
 #include "envmis/pictures/picture.h"
 
@@ -85,10 +88,11 @@ io::Image8 stack(const io::Image8& top, const io::Image8& bottom) {
 namespace {
 
 Scene parse_scene(const std::string& size, uint32_t spheres) {
-    unsigned w = 0, h = 0;
-    char x = 0;
-    if (std::sscanf(size.c_str(), "%u%c%u", &w, &x, &h) != 3 || x != 'x' || w < 16 || h < 16 || w > 8192 || h > 8192)
-        throw std::runtime_error("--image '" + size + "': expected WxH, each 16 to 8192");
+    const std::optional<Size> parsed = parse_size(size, false, kMinImageSide, kMaxImageSide);
+    if (!parsed)
+        throw std::runtime_error("--image '" + size + "': expected WxH, each " + std::to_string(kMinImageSide) +
+                                 " to " + std::to_string(kMaxImageSide));
+    const auto [w, h] = *parsed;
     return {w, h, spheres, 0.45f * std::min(static_cast<float>(w) / spheres, static_cast<float>(h))};
 }
 

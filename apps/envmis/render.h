@@ -4,6 +4,7 @@
 #pragma once
 
 #include <atomic>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
@@ -11,8 +12,11 @@
 
 namespace envmis::cli {
 
+// The rendered image's sides: wide enough for the spheres, small enough to render.
+constexpr uint32_t kMinImageSide = 16, kMaxImageSide = 8192;
+
 struct RenderOptions {
-    std::string size = "768x256";  // WxH
+    std::string size = "768x256";  // WxH, each side kMinImageSide to kMaxImageSide
     uint32_t spp = 16;             // estimates per pixel for each technique
     uint32_t reference_spp = 512;  // estimates per pixel of the reference (mis-power)
 };

@@ -98,6 +98,15 @@ TEST(Compare, CountAndSeedFlagsRejectNegativeAndOutOfRangeValues) {
                                                                                 << r.out;
             EXPECT_EQ(r.out.find("envmis compare:"), std::string::npos) << flag << " " << value << " started a run";
         }
+    // The rendered image's size, checked as the flags are parsed, before any study.
+    for (const std::string value : {"-4x5", "0x0", "15x16", "8193x16", "16", "abc"}) {
+        const CliRun r = run_compare(dir, "--image " + value + " --points 1 --spp 1");
+        EXPECT_NE(r.exit_code, 0) << value << "\n" << r.out;
+        EXPECT_NE(r.out.find("--image: '" + value + "': expected WxH, each 16 to 8192"), std::string::npos)
+            << value << "\n"
+            << r.out;
+        EXPECT_EQ(r.out.find("envmis compare:"), std::string::npos) << "--image " << value << " started a run";
+    }
     // The limits themselves are accepted.
     const CliRun edge =
         run_compare(dir, "--seed 18446744073709551615 --threads 1 --points 1 --spp 1 --techniques bsdf");
