@@ -15,10 +15,6 @@ float parse_parameter(std::string_view text, std::string_view value) {
     return v;
 }
 
-}  // namespace
-
-namespace {
-
 // The optional grey albedo after a BSDF's parameters: "" keeps `fallback`.
 Rgb parse_albedo(std::string_view text, std::string_view value, Rgb fallback) {
     if (value.empty() && text.ends_with(':'))
