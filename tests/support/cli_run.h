@@ -47,20 +47,15 @@ inline std::ostream& operator<<(std::ostream& os, const Result& r) {
               << r.err;
 }
 
-// How run_shell() reports a command killed by a signal.
-enum class Killed {
-    plus_signal,  // 128 + the signal's number, as the shell does
-    as_128,       // 128, whatever the signal
-};
-
 // Runs the shell command line `command` with its stdout written to `out` and its stderr
-// to `err` (both replaced, and left in place), and returns the run with what they hold.
-inline Result run_shell(const std::string& command, const std::filesystem::path& out, const std::filesystem::path& err,
-                        Killed killed = Killed::plus_signal) {
+// to `err` (both replaced, and left in place), and returns the run with what they hold;
+// a command killed by a signal exits 128 + the signal's number, as the shell reports it.
+inline Result run_shell(const std::string& command, const std::filesystem::path& out,
+                        const std::filesystem::path& err) {
     const int status = std::system((command + " > " + quoted(out.string()) + " 2> " + quoted(err.string())).c_str());
     Result r;
     r.command = command;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : killed == Killed::as_128 ? 128 : 128 + WTERMSIG(status);
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     r.out = read_file(out);
     r.err = read_file(err);
     return r;
