@@ -4,7 +4,8 @@
 //   math/          vectors, fast polynomial maths, random numbers, hashing
 //   image/         RGB images and bad-pixel repair, mappings and axes, remapping
 //   compensation/  the compensation threshold (Karlik et al. 2019)
-//   sampling/      2D distributions and the environment-map sampler, with batch calls
+//   sampling/      2D distributions and the environment-map sampler, with batch calls;
+//                  binned.h: normal-aware bins (a density per bin of shading normals)
 //   table/         table files (written atomically, read or memory-mapped)
 #pragma once
 
@@ -17,6 +18,7 @@
 #include "envmis/math/math.h"
 #include "envmis/math/random.h"
 #include "envmis/sampling/allocator.h"
+#include "envmis/sampling/binned.h"
 #include "envmis/sampling/distribution.h"
 #include "envmis/sampling/envmap.h"
 #include "envmis/table/atomic_file.h"

@@ -79,26 +79,31 @@ struct EnvMapView {
     ENVMIS_HD EnvSample sample(Vec2 u) const noexcept {
         // Prefetching the radiance near the answer overlaps its load with the search's.
         const auto s = distribution.sample(u, [this](size_t i) { ENVMIS_PREFETCH(radiance + i); });
+        return at(s.p, s.pdf, static_cast<size_t>(s.y) * distribution.w + s.x);
+    }
+    // The sample at image point p of texel `texel`, drawn with image-space density
+    // image_pdf (by this map's distribution or another over the same texels: binned.h).
+    ENVMIS_HD EnvSample at(Vec2 p, float image_pdf, size_t texel) const noexcept {
         if (mapping == Mapping::equal_area) [[unlikely]]
-            return sample_equal_area(s);
-        const SinCos theta = sincos_half_turns(turns, s.p.y), phi = sincos_turns(turns, s.p.x);
+            return at_equal_area(p, image_pdf, texel);
+        const SinCos theta = sincos_half_turns(turns, p.y), phi = sincos_turns(turns, p.x);
         const float sin_theta = theta.sin;  // >= 0 on [0, 1): see fast_math_test
         const Vec3 canonical{sin_theta * phi.cos, sin_theta * phi.sin, theta.cos};
-        return {to_world(axes, canonical), solid_angle_pdf(s.pdf, sin_theta),
-                radiance[static_cast<size_t>(s.y) * distribution.w + s.x], s.p};
+        return {to_world(axes, canonical), solid_angle_pdf(image_pdf, sin_theta), radiance[texel], p};
     }
-    // The equal-area half of sample(), out of line: inlined, its code slows the
+    // The equal-area half of at(), out of line: inlined, its code slows the
     // equirectangular path by a fifth (measured).
-    ENVMIS_NOINLINE ENVMIS_HD EnvSample sample_equal_area(const Distribution2DView::Sample& s) const noexcept {
-        return {to_world(axes, equal_area_direction(s.p)), s.pdf * (1 / kFourPi),
-                radiance[static_cast<size_t>(s.y) * distribution.w + s.x], s.p};
+    ENVMIS_NOINLINE ENVMIS_HD EnvSample at_equal_area(Vec2 p, float image_pdf, size_t texel) const noexcept {
+        return {to_world(axes, equal_area_direction(p)), image_pdf * (1 / kFourPi), radiance[texel], p};
     }
     // Solid-angle pdf of sampling `direction` (a unit vector in the world frame).
     ENVMIS_HD float pdf(Vec3 direction) const noexcept { return pdf_uv(uv_of(direction)); }
     // Solid-angle pdf at image point uv; bit-identical to sample(u).pdf when uv = sample(u).uv.
-    ENVMIS_HD float pdf_uv(Vec2 uv) const noexcept {
-        if (mapping == Mapping::equal_area) return distribution.pdf(uv) * (1 / kFourPi);
-        return solid_angle_pdf(distribution.pdf(uv), sincos_half_turns(turns, uv.y).sin);
+    ENVMIS_HD float pdf_uv(Vec2 uv) const noexcept { return image_to_solid_angle(distribution.pdf(uv), uv); }
+    // An image-space density at uv, per steradian.
+    ENVMIS_HD float image_to_solid_angle(float image_pdf, Vec2 uv) const noexcept {
+        if (mapping == Mapping::equal_area) return image_pdf * (1 / kFourPi);
+        return solid_angle_pdf(image_pdf, sincos_half_turns(turns, uv.y).sin);
     }
     // Image point of a world direction.
     ENVMIS_HD Vec2 uv_of(Vec3 direction) const noexcept {
@@ -107,7 +112,7 @@ struct EnvMapView {
             return equal_area_uv_out_of_line(canonical);
         return equirect_uv(canonical);
     }
-    // Out of line for the same reason as sample_equal_area.
+    // Out of line for the same reason as at_equal_area.
     ENVMIS_NOINLINE ENVMIS_HD static Vec2 equal_area_uv_out_of_line(Vec3 canonical) noexcept {
         return equal_area_uv(canonical);
     }

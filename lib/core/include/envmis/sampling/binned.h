@@ -1,0 +1,292 @@
+// Normal-aware environment sampling: per-bin densities, chosen by the shading normal.
+//
+// Why: a renderer spends 1 to 16 samples per shading point, too few for a technique
+// that learns per point. A global density cannot know which hemisphere a point sees:
+// half its samples land below the horizon, and its compensation subtracts the mean over
+// the whole sphere rather than over what the point sees. Here the sphere of normals is
+// cut into K bins; each bin samples the environment proportionally to
+//
+//   q_b(x) = max(L(x) - alpha_b E_b / pi, 0) * c_b(x)     (per cell, see below)
+//
+// where E_b / pi is the cosine-weighted mean radiance of the hemisphere around the bin's
+// centre normal n_b and c_b an upper bound of cos+(omega . n) over every direction omega
+// of the cell and every normal n of the bin (the cosine of the cell's angle to n_b less
+// both angular radii, 0 beyond 90 degrees). So the density is > 0 wherever any normal of
+// the bin sees compensated light, and 0 on cells that no normal of the bin sees.
+//
+// Representation (what keeps it small): the map is cut into a coarse grid of cells
+// (BinnedEnvMap::cells(); 32 x 16 for a 1k map, at most 128 x 64); each bin holds only
+// the masses of its cells (sum over the cell's texels of q_b times their solid angle), in
+// a Distribution2D over the grid. Inside a cell, a texel is picked by the plain map's
+// own density (luminance times solid angle), through the plain EnvMap's row CDFs and one
+// small CDF over each cell's rows: pdf_b(x) = P_b(cell) P(row | cell) P(x | row, cell),
+// exact in 31-bit fixed point as in distribution.h, so sample and pdf agree exactly.
+// The plain map is therefore what a binned table stores at the texel level; the
+// compensation lives in the bins.
+//
+// Lobes: the best compensation strength depends on the BSDF (a diffuse lobe gains from
+// strong compensation, a sharp glossy one from mild or none), so each bin holds one cell
+// table per lobe class (by default diffuse, Phong 20 and Phong 200), and a shading point
+// picks the class nearest its BSDF's sharpness (lobe_class). alpha_b is chosen per bin and
+// class at build time from the exact variance of 1 + 1 balance MIS on a downsampled map
+// (binned.cpp), among fixed candidates and the plain density itself, so the choice never
+// predicts a loss against the plain density.
+//
+// Bins: a g x g grid over the octahedral map of normals (K = g^2, 100 by default), so a
+// normal finds its bin in O(1): a few adds, one division, no loop over bins.
+//
+// Measure and exactness: as EnvMapView (solid angle, world frame). pdf(n, omega) is the
+// density of the bin that n picks, so the MIS weight of a BSDF sample matches what
+// sample(n, u) would have drawn. A compensated bin is incomplete (pdf 0 where L <= its
+// threshold): combine it with BSDF sampling.
+//
+// Cost: sample O(1) (four fixed-point CDF inversions, two in small tables), pdf O(1);
+// noexcept, allocation-free, ENVMIS_HD. Memory on top of the plain map: 6 bytes per cell
+// per bin per class, 6 bytes per (cell column, texel row); figures in docs/performance.md.
+// Build: one pass over the texels (cell histograms), then O(K classes cells) work.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "envmis/sampling/envmap.h"
+
+namespace envmis {
+
+// Octahedral grid of normals: the bin (of g x g) of a unit vector in the canonical
+// frame. A zero or non-finite vector gets bin 0.
+ENVMIS_HD inline uint32_t normal_bin(Vec3 n, uint32_t g) noexcept {
+    const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
+    if (!(l1 > 0 && l1 <= 0x1.fffffep127f)) return 0;
+    float u = n.x / l1, v = n.y / l1;
+    if (n.z < 0) {
+        const float fu = (1 - std::abs(v)) * (u < 0 ? -1.0f : 1.0f), fv = (1 - std::abs(u)) * (v < 0 ? -1.0f : 1.0f);
+        u = fu, v = fv;
+    }
+    return detail::cell_of(0.5f * (v + 1), g) * g + detail::cell_of(0.5f * (u + 1), g);
+}
+
+// Canonical unit normal at point (s, t) in [0,1]^2 of the octahedral map of normals.
+ENVMIS_HD inline Vec3 octahedral_normal(float s, float t) noexcept {
+    const float u = 2 * s - 1, v = 2 * t - 1, z = 1 - std::abs(u) - std::abs(v);
+    Vec3 n{u, v, z};
+    if (z < 0) {
+        n.x = (1 - std::abs(v)) * (u < 0 ? -1.0f : 1.0f);
+        n.y = (1 - std::abs(u)) * (v < 0 ? -1.0f : 1.0f);
+    }
+    return normalize(n);
+}
+
+// Lobe classes: 0 is diffuse (Lambert); a positive exponent is a Phong lobe that sharp.
+// The class of a BSDF with Phong exponent e (0 for Lambert; a GGX roughness a has
+// e = 2 / a^2 - 2) among `exponents` (ascending, the first 0): the nearest on the
+// scale log(1 + e).
+uint32_t lobe_class(std::span<const float> exponents, float phong_exponent) noexcept;
+
+struct BinnedOptions {
+    uint32_t bins_per_side = 10;  // g: K = g^2 bins; 1 to 64
+    // Cell grid: columns (rows: half of them for equirect, as many for equal-area).
+    // 0 picks map width / 32, clamped to [1, 128] and to the map's size.
+    uint32_t cell_columns = 0;
+    std::vector<float> lobe_exponents = {0, 20, 200};  // ascending, first 0 (diffuse); 1 to 8
+    // Compensation per bin: the candidates auto mode chooses among (finite, >= 0), or,
+    // with auto_alpha false, `alpha` for every bin and class.
+    bool auto_alpha = true;
+    float alpha = 1;
+    std::vector<float> candidates = {0, 0.5f, 1, 1.5f, 2, 3};
+};
+
+// What one (class, bin) samples. alpha < 0 marks the plain density (no compensation
+// and no cosine bound), which auto mode keeps where nothing else was predicted better.
+struct BinChoice {
+    float alpha = 0;
+    float threshold = 0;  // alpha E_b / pi, as applied (rounded to a histogram edge)
+    bool plain() const noexcept { return alpha < 0; }
+};
+
+// The layout and choices that rebuild a BinnedEnvMap bit-identically from its plain map
+// (what table files store).
+struct BinLayout {
+    uint32_t bins_per_side = 0, cell_columns = 0, cell_rows = 0;
+    std::vector<float> lobe_exponents;
+    std::vector<BinChoice> choices;  // class-major: choices[c K + b]
+};
+
+// One bin's density; the same interface as EnvMapView (sample, pdf, lookup, eval).
+struct BinnedEnvMapView;
+struct BinView {
+    const BinnedEnvMapView* map = nullptr;
+    Distribution2DView cells;  // over the cell grid
+
+    ENVMIS_HD EnvSample sample(Vec2 u) const noexcept;
+    ENVMIS_HD float pdf(Vec3 direction) const noexcept;
+    ENVMIS_HD float pdf_uv(Vec2 uv) const noexcept;
+    ENVMIS_HD Rgb eval(Vec3 direction) const noexcept;
+    ENVMIS_HD EnvMapView::Lookup lookup(Vec3 direction) const noexcept;
+};
+
+// Non-owning, device-friendly view of a BinnedEnvMap (flat arrays).
+struct BinnedEnvMapView {
+    EnvMapView plain;                      // texel level: the plain density and the radiance
+    const uint32_t* cell_start = nullptr;  // per (class, bin): cells_w cells_h, row-major
+    const uint16_t* cell_guide = nullptr;
+    const uint32_t* cell_marginal_start = nullptr;  // per (class, bin): cells_h
+    const uint16_t* cell_marginal_guide = nullptr;
+    // Per cell column cx and texel row y: CDF over the texel rows of cell (cx, row of y),
+    // at [cx h + y]: the cell's rows weighted by their plain mass inside the column.
+    const uint32_t* rows_start = nullptr;
+    const uint16_t* rows_guide = nullptr;
+    const uint32_t* column_edges = nullptr;  // cells_w + 1 texel columns
+    const uint32_t* row_edges = nullptr;     // cells_h + 1 texel rows
+    uint32_t cells_w = 0, cells_h = 0, bins_per_side = 0, bins = 0, classes = 0;
+
+    // The density that normal (world frame) picks for lobe class `lobe`.
+    ENVMIS_HD BinView bin(Vec3 normal, uint32_t lobe) const noexcept {
+        const uint32_t b = normal_bin(to_canonical(plain.axes, normal), bins_per_side);
+        return bin_at(min(lobe, classes - 1) * bins + b);
+    }
+    ENVMIS_HD BinView bin_at(uint32_t class_bin) const noexcept {
+        const size_t cells = size_t{cells_w} * cells_h;
+        return {this,
+                {cell_start + class_bin * cells,
+                 cell_guide + class_bin * cells,
+                 {cell_marginal_start + size_t{class_bin} * cells_h, cell_marginal_guide + size_t{class_bin} * cells_h,
+                  cells_h},
+                 cells_w,
+                 cells_h,
+                 static_cast<float>(cells) * 0x1p-62f}};
+    }
+    ENVMIS_HD EnvSample sample(Vec3 normal, uint32_t lobe, Vec2 u) const noexcept {
+        return bin(normal, lobe).sample(u);
+    }
+    ENVMIS_HD float pdf(Vec3 normal, uint32_t lobe, Vec3 direction) const noexcept {
+        return bin(normal, lobe).pdf(direction);
+    }
+    ENVMIS_HD EnvMapView::Lookup lookup(Vec3 normal, uint32_t lobe, Vec3 direction) const noexcept {
+        return bin(normal, lobe).lookup(direction);
+    }
+    ENVMIS_HD Rgb eval(Vec3 direction) const noexcept { return plain.eval(direction); }
+
+    // Cell column and row of texel (x, y): the cell whose edges hold it.
+    ENVMIS_HD uint32_t cell_column(uint32_t x) const noexcept {
+        return static_cast<uint32_t>(uint64_t{x} * cells_w / plain.distribution.w);
+    }
+    ENVMIS_HD uint32_t cell_row(uint32_t y) const noexcept {
+        return static_cast<uint32_t>(uint64_t{y} * cells_h / plain.distribution.h);
+    }
+    // The CDF over the texel rows of cell (cx, cy).
+    ENVMIS_HD CdfView cell_rows(uint32_t cx, uint32_t cy) const noexcept {
+        const size_t at = size_t{cx} * plain.distribution.h + row_edges[cy];
+        return {rows_start + at, rows_guide + at, row_edges[cy + 1] - row_edges[cy]};
+    }
+    // Image-space density of texel (x, y) under a bin, from the fixed-point widths of its
+    // cell (row and column of the bin's grid), of its row in the cell, and of the texel
+    // and its row segment in the plain row CDF; one expression for sample and pdf.
+    ENVMIS_HD float texel_pdf(const BinView& b, uint32_t cx, uint32_t cy, uint32_t row_width, uint32_t x,
+                              uint32_t y) const noexcept {
+        const CdfView row = plain.distribution.row(y);
+        const uint32_t x1 = column_edges[cx + 1];
+        const uint32_t segment = (x1 < row.n ? row.start[x1] : kCdfUnits) - row.start[column_edges[cx]];
+        const float cell =
+            static_cast<float>(b.cells.marginal.width(cy)) * static_cast<float>(b.cells.row(cy).width(cx)) * 0x1p-62f;
+        const float texels = static_cast<float>(uint64_t{plain.distribution.w} * plain.distribution.h);
+        return cell * (static_cast<float>(row_width) * 0x1p-31f) *
+               (static_cast<float>(row.width(x)) / static_cast<float>(segment)) * texels;
+    }
+};
+
+// Both for n (normal, direction) pairs at once, one array per world coordinate: the
+// batch forms of BinnedEnvMapView::lookup and sample, bit-identical to n single calls.
+// Host only; noexcept and allocation-free.
+void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays normals, DirectionArrays in,
+                 LookupArrays out, uint32_t n) noexcept;
+void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays normals, PointArrays in, SampleArrays out,
+                 uint32_t n) noexcept;
+
+class BinnedEnvMap {
+public:
+    BinnedEnvMap() = default;
+    // Builds the bins over `plain`, which must be uncompensated (its density is the
+    // texel level of every bin). Throws std::invalid_argument for a compensated map or
+    // invalid options.
+    BinnedEnvMap(EnvMap plain, const BinnedOptions& options = {});
+    // Rebuilds the bins a layout describes (a table's), bit-identical to the build that
+    // chose it. Throws std::invalid_argument on a layout that does not fit the map.
+    BinnedEnvMap(EnvMap plain, const BinLayout& layout);
+
+    BinnedEnvMapView view() const noexcept;
+    const EnvMap& plain() const noexcept { return plain_; }
+    const BinLayout& layout() const noexcept { return layout_; }
+    uint32_t bins() const noexcept { return layout_.bins_per_side * layout_.bins_per_side; }
+    uint32_t classes() const noexcept { return static_cast<uint32_t>(layout_.lobe_exponents.size()); }
+    uint32_t lobe_class(float phong_exponent) const noexcept {
+        return envmis::lobe_class(layout_.lobe_exponents, phong_exponent);
+    }
+    // True if every bin of the class samples where its normals see light (no bin zeroes
+    // texels by compensation); a compensated class is incomplete (envmap.h).
+    bool complete(uint32_t lobe) const noexcept;
+    // Bytes the bins add to the plain map.
+    size_t bytes() const noexcept;
+    // Seconds the build spent choosing alphas (0 when rebuilt from a layout).
+    double choice_seconds() const noexcept { return choice_seconds_; }
+
+private:
+    void build(const std::vector<std::vector<float>>& masses);
+
+    EnvMap plain_;
+    BinLayout layout_;
+    LargeVector<uint32_t> cell_start_, cell_marginal_start_, rows_start_;
+    LargeVector<uint16_t> cell_guide_, cell_marginal_guide_, rows_guide_;
+    std::vector<uint32_t> column_edges_, row_edges_;
+    double choice_seconds_ = 0;
+};
+
+// ---- inline definitions ----
+
+ENVMIS_HD inline EnvSample BinView::sample(Vec2 u) const noexcept {
+    const BinnedEnvMapView& m = *map;
+    const CellHit r = cells.marginal.invert(u.y);
+    const CellHit c = cells.row(r.index).invert(u.x);
+    const CdfView rows = m.cell_rows(c.index, r.index);
+    const CellHit ry = rows.invert(r.offset);
+    const uint32_t y = m.row_edges[r.index] + ry.index;
+    // The texel: the plain row CDF inverted inside the cell's segment of the row.
+    const CdfView row = m.plain.distribution.row(y);
+    const uint32_t x0 = m.column_edges[c.index], x1 = m.column_edges[c.index + 1];
+    const uint32_t a = row.start[x0], b = x1 < row.n ? row.start[x1] : kCdfUnits;
+    const double units = a + static_cast<double>(c.offset) * (b - a);
+    const auto t = min(static_cast<uint32_t>(units), b - 1);
+    uint32_t lo = x0, hi = x1 - 1;
+    while (lo < hi) {  // last texel of the segment whose start is <= t
+        const uint32_t mid = (lo + hi + 1) / 2;
+        if (row.start[mid] <= t)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    const float ox = min(static_cast<float>((units - row.start[lo]) / row.width(lo)), kOneMinusEpsilon);
+    const Vec2 p{detail::point_in_cell(lo, max(ox, 0.0f), row.n),
+                 detail::point_in_cell(y, ry.offset, m.plain.distribution.h)};
+    const float image_pdf = m.texel_pdf(*this, c.index, r.index, rows.width(ry.index), lo, y);
+    return m.plain.at(p, image_pdf, static_cast<size_t>(y) * row.n + lo);
+}
+
+ENVMIS_HD inline float BinView::pdf_uv(Vec2 uv) const noexcept {
+    const BinnedEnvMapView& m = *map;
+    const uint32_t x = detail::cell_of(uv.x, m.plain.distribution.w), y = detail::cell_of(uv.y, m.plain.distribution.h);
+    const uint32_t cx = m.cell_column(x), cy = m.cell_row(y);
+    const uint32_t row_width = m.cell_rows(cx, cy).width(y - m.row_edges[cy]);
+    const float image_pdf = m.texel_pdf(*this, cx, cy, row_width, x, y);
+    return m.plain.image_to_solid_angle(image_pdf, uv);
+}
+
+ENVMIS_HD inline float BinView::pdf(Vec3 direction) const noexcept { return pdf_uv(map->plain.uv_of(direction)); }
+ENVMIS_HD inline Rgb BinView::eval(Vec3 direction) const noexcept { return map->plain.eval(direction); }
+ENVMIS_HD inline EnvMapView::Lookup BinView::lookup(Vec3 direction) const noexcept {
+    const Vec2 uv = map->plain.uv_of(direction);
+    return {map->plain.eval_uv(uv), pdf_uv(uv)};
+}
+
+}  // namespace envmis

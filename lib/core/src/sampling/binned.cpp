@@ -1,0 +1,266 @@
+// The build of BinnedEnvMap (binned.h): geometry of bins and cells, cell histograms,
+// per-bin thresholds, the exact-variance choice of alpha, and the flat tables.
+#include "envmis/sampling/binned.h"
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "binned_choice.h"
+#include "detail/parallel.h"
+
+namespace envmis {
+
+uint32_t lobe_class(std::span<const float> exponents, float phong_exponent) noexcept {
+    const double key = std::log1p(std::max(0.0, static_cast<double>(phong_exponent)));
+    uint32_t best = 0;
+    double best_distance = std::numeric_limits<double>::infinity();
+    for (uint32_t i = 0; i < exponents.size(); ++i) {
+        const double distance = std::abs(std::log1p(static_cast<double>(exponents[i])) - key);
+        if (distance < best_distance) best = i, best_distance = distance;
+    }
+    return best;
+}
+
+namespace detail {
+
+CellGrid::CellGrid(uint32_t w_, uint32_t h_, uint32_t columns, uint32_t rows, Mapping m)
+    : w(w_), h(h_), cw(columns), ch(rows), mapping(m), column_edges(columns + 1), row_edges(rows + 1) {
+    for (uint32_t c = 0; c <= cw; ++c) column_edges[c] = static_cast<uint32_t>((uint64_t{c} * w + cw - 1) / cw);
+    for (uint32_t r = 0; r <= ch; ++r) row_edges[r] = static_cast<uint32_t>((uint64_t{r} * h + ch - 1) / ch);
+}
+
+namespace {
+
+// The largest angle between `centre` and the curve through point(i / steps), i = 0 ..
+// steps, plus half the largest step between consecutive points (the curve between two
+// points lies within that of one of them), so an upper bound of the region's radius
+// when the curve is its boundary.
+template <class Point>
+float boundary_radius(Vec3 centre, uint32_t steps, Point&& point) {
+    double largest = 0, step = 0;
+    Vec3 previous = point(0.0);
+    for (uint32_t i = 0; i <= steps; ++i) {
+        const Vec3 p = point(static_cast<double>(i) / steps);
+        largest = std::max(largest, std::acos(std::clamp(static_cast<double>(dot(p, centre)), -1.0, 1.0)));
+        step = std::max(step, std::acos(std::clamp(static_cast<double>(dot(p, previous)), -1.0, 1.0)));
+        previous = p;
+    }
+    return static_cast<float>(largest + 0.6 * step + 1e-5);
+}
+
+// Radius of the region that a map (s, t) -> direction takes the square
+// [s0, s1] x [t0, t1] to, from its boundary walked edge by edge.
+template <class Direction>
+float square_radius(Vec3 centre, double s0, double s1, double t0, double t1, Direction&& direction) {
+    constexpr uint32_t kSteps = 64;  // per edge
+    auto at = [&](double s, double t) { return direction(static_cast<float>(s), static_cast<float>(t)); };
+    const float edges[4] = {
+        boundary_radius(centre, kSteps, [&](double f) { return at(s0 + f * (s1 - s0), t0); }),
+        boundary_radius(centre, kSteps, [&](double f) { return at(s1, t0 + f * (t1 - t0)); }),
+        boundary_radius(centre, kSteps, [&](double f) { return at(s1 - f * (s1 - s0), t1); }),
+        boundary_radius(centre, kSteps, [&](double f) { return at(s0, t1 - f * (t1 - t0)); }),
+    };
+    return *std::max_element(edges, edges + 4);
+}
+
+}  // namespace
+
+Geometry::Geometry(const CellGrid& grid, uint32_t g) {
+    cell_direction.resize(size_t{grid.cw} * grid.ch);
+    cell_radius.resize(cell_direction.size());
+    const auto dir = [&](float u, float v) { return image_direction(grid.mapping, {u, v}); };
+    for (uint32_t r = 0; r < grid.ch; ++r)
+        for (uint32_t c = 0; c < grid.cw; ++c) {
+            const double u0 = static_cast<double>(grid.column_edges[c]) / grid.w,
+                         u1 = static_cast<double>(grid.column_edges[c + 1]) / grid.w;
+            const double v0 = static_cast<double>(grid.row_edges[r]) / grid.h,
+                         v1 = static_cast<double>(grid.row_edges[r + 1]) / grid.h;
+            const size_t i = size_t{r} * grid.cw + c;
+            cell_direction[i] = dir(static_cast<float>(0.5 * (u0 + u1)), static_cast<float>(0.5 * (v0 + v1)));
+            cell_radius[i] = square_radius(cell_direction[i], u0, u1, v0, v1, dir);
+        }
+    bin_normal.resize(size_t{g} * g);
+    bin_radius.resize(bin_normal.size());
+    for (uint32_t t = 0; t < g; ++t)
+        for (uint32_t s = 0; s < g; ++s) {
+            const size_t b = size_t{t} * g + s;
+            bin_normal[b] = octahedral_normal((s + 0.5f) / g, (t + 0.5f) / g);
+            bin_radius[b] = square_radius(bin_normal[b], static_cast<double>(s) / g, (s + 1.0) / g,
+                                          static_cast<double>(t) / g, (t + 1.0) / g, octahedral_normal);
+        }
+}
+
+float Geometry::bound(uint32_t bin, size_t cell) const noexcept {
+    const float angle = std::acos(std::clamp(dot(bin_normal[bin], cell_direction[cell]), -1.0f, 1.0f)) -
+                        bin_radius[bin] - cell_radius[cell];
+    if (angle <= 0) return 1;
+    return angle >= kPiF / 2 ? 0.0f : std::cos(angle);
+}
+
+}  // namespace detail
+
+namespace {
+
+using detail::CellGrid;
+
+void check_options(const BinnedOptions& o) {
+    if (o.bins_per_side < 1 || o.bins_per_side > 64)
+        throw std::invalid_argument("bins per side must be 1 to 64, got " + std::to_string(o.bins_per_side));
+    const auto& e = o.lobe_exponents;
+    if (e.empty() || e.size() > 8 || e[0] != 0 || !std::is_sorted(e.begin(), e.end()) ||
+        !std::all_of(e.begin(), e.end(), [](float x) { return x >= 0 && x <= 1e5f; }))
+        throw std::invalid_argument("lobe exponents: 1 to 8, ascending, the first 0, each at most 1e5");
+    const auto valid_alpha = [](float a) { return a >= 0 && a <= 1e3f; };
+    if (o.auto_alpha ? (o.candidates.empty() || !std::all_of(o.candidates.begin(), o.candidates.end(), valid_alpha))
+                     : !valid_alpha(o.alpha))
+        throw std::invalid_argument("bin alphas must be finite, 0 to 1000");
+}
+
+CellGrid grid_for(const EnvMap& plain, uint32_t columns) {
+    const uint32_t w = plain.width(), h = plain.height();
+    if (columns == 0) columns = std::clamp(w / 32, 1u, 128u);
+    if (columns > 4096)
+        throw std::invalid_argument("cell columns must be at most 4096, got " + std::to_string(columns));
+    const bool square = plain.options().mapping == Mapping::equal_area;
+    columns = std::min(columns, w);
+    const uint32_t rows = std::min(square ? columns : std::max(1u, columns / 2), h);
+    return CellGrid(w, h, columns, rows, plain.options().mapping);
+}
+
+}  // namespace
+
+BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinnedOptions& options) : plain_(std::move(plain)) {
+    if (plain_.options().compensation.enabled && plain_.stats().fallback == DensityFallback::none)
+        throw std::invalid_argument("a binned map is built over the plain (uncompensated) map");
+    check_options(options);
+    const auto started = std::chrono::steady_clock::now();
+    const CellGrid grid = grid_for(plain_, options.cell_columns);
+    const detail::Geometry geometry(grid, options.bins_per_side);
+    layout_ = {options.bins_per_side, grid.cw, grid.ch, options.lobe_exponents,
+               detail::choose_bins(plain_, grid, geometry, options)};
+    choice_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    build(detail::bin_masses(plain_, grid, geometry, layout_));
+}
+
+BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinLayout& layout) : plain_(std::move(plain)), layout_(layout) {
+    const uint32_t g = layout.bins_per_side, w = plain_.width(), h = plain_.height();
+    if (g < 1 || g > 64 || layout.cell_columns < 1 || layout.cell_columns > std::min(w, 4096u) ||
+        layout.cell_rows < 1 || layout.cell_rows > h)
+        throw std::invalid_argument("bin layout " + std::to_string(g) + " bins per side, " +
+                                    std::to_string(layout.cell_columns) + "x" + std::to_string(layout.cell_rows) +
+                                    " cells does not fit a " + std::to_string(w) + "x" + std::to_string(h) + " map");
+    BinnedOptions check;
+    check.lobe_exponents = layout.lobe_exponents;
+    check_options(check);
+    if (layout.choices.size() != size_t{g} * g * layout.lobe_exponents.size())
+        throw std::invalid_argument("bin layout: " + std::to_string(layout.choices.size()) + " choices for " +
+                                    std::to_string(size_t{g} * g * layout.lobe_exponents.size()) + " bins");
+    for (const BinChoice& c : layout.choices)
+        if (!(std::isfinite(c.alpha) && c.threshold >= 0 && std::isfinite(c.threshold) &&
+              detail::on_histogram_edge(c.threshold)))
+            throw std::invalid_argument("bin layout: invalid alpha or threshold");
+    const CellGrid grid(w, h, layout.cell_columns, layout.cell_rows, plain_.options().mapping);
+    build(detail::bin_masses(plain_, grid, detail::Geometry(grid, g), layout_));
+}
+
+void BinnedEnvMap::build(const std::vector<std::vector<float>>& masses) {
+    const CellGrid grid(plain_.width(), plain_.height(), layout_.cell_columns, layout_.cell_rows,
+                        plain_.options().mapping);
+    column_edges_ = grid.column_edges;
+    row_edges_ = grid.row_edges;
+    const size_t cells = size_t{grid.cw} * grid.ch;
+    cell_start_.resize(cells * masses.size());
+    cell_guide_.resize(cells * masses.size());
+    cell_marginal_start_.resize(size_t{grid.ch} * masses.size());
+    cell_marginal_guide_.resize(size_t{grid.ch} * masses.size());
+    for (size_t cb = 0; cb < masses.size(); ++cb) {
+        const Distribution2D bin(masses[cb], grid.cw, grid.ch);
+        const Distribution2DView d = bin.view();
+        std::copy_n(d.start, cells, cell_start_.data() + cb * cells);
+        std::copy_n(d.guide, cells, cell_guide_.data() + cb * cells);
+        std::copy_n(d.marginal.start, grid.ch, cell_marginal_start_.data() + cb * grid.ch);
+        std::copy_n(d.marginal.guide, grid.ch, cell_marginal_guide_.data() + cb * grid.ch);
+    }
+    // Each cell's rows, weighted by the plain mass of their segment in the cell.
+    const Distribution2DView plain = plain_.distribution().view();
+    const uint32_t h = grid.h;
+    rows_start_.resize(size_t{grid.cw} * h);
+    rows_guide_.resize(size_t{grid.cw} * h);
+    detail::parallel_for(grid.cw, 1, [&](uint32_t lo, uint32_t hi) {
+        std::vector<double> mass(h);
+        detail::CdfScratch scratch(h);
+        for (uint32_t cx = lo; cx < hi; ++cx) {
+            const uint32_t x0 = grid.column_edges[cx], x1 = grid.column_edges[cx + 1];
+            for (uint32_t y = 0; y < h; ++y) {
+                const CdfView row = plain.row(y);
+                const uint32_t segment = (x1 < grid.w ? row.start[x1] : kCdfUnits) - row.start[x0];
+                mass[y] = static_cast<double>(plain.marginal.width(y)) * segment;
+            }
+            for (uint32_t cy = 0; cy < grid.ch; ++cy) {
+                const uint32_t y0 = grid.row_edges[cy], n = grid.row_edges[cy + 1] - y0;
+                const size_t at = size_t{cx} * h + y0;
+                uint32_t invalid = 0;
+                detail::build_cdf(mass.data() + y0, n, rows_start_.data() + at, rows_guide_.data() + at, invalid,
+                                  scratch);
+            }
+        }
+    });
+}
+
+BinnedEnvMapView BinnedEnvMap::view() const noexcept {
+    return {plain_.view(),
+            cell_start_.data(),
+            cell_guide_.data(),
+            cell_marginal_start_.data(),
+            cell_marginal_guide_.data(),
+            rows_start_.data(),
+            rows_guide_.data(),
+            column_edges_.data(),
+            row_edges_.data(),
+            layout_.cell_columns,
+            layout_.cell_rows,
+            layout_.bins_per_side,
+            bins(),
+            classes()};
+}
+
+bool BinnedEnvMap::complete(uint32_t lobe) const noexcept {
+    const uint32_t k = bins();
+    lobe = std::min(lobe, classes() - 1);
+    for (uint32_t b = 0; b < k; ++b) {
+        const BinChoice& c = layout_.choices[size_t{lobe} * k + b];
+        if (!c.plain() && c.threshold > 0) return false;
+    }
+    return true;
+}
+
+size_t BinnedEnvMap::bytes() const noexcept {
+    return (cell_start_.size() + cell_marginal_start_.size() + rows_start_.size()) * sizeof(uint32_t) +
+           (cell_guide_.size() + cell_marginal_guide_.size() + rows_guide_.size()) * sizeof(uint16_t) +
+           (column_edges_.size() + row_edges_.size()) * sizeof(uint32_t);
+}
+
+void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays normals, DirectionArrays in,
+                 LookupArrays out, uint32_t n) noexcept {
+    for (uint32_t i = 0; i < n; ++i) {
+        const EnvMapView::Lookup l =
+            env.lookup({normals.x[i], normals.y[i], normals.z[i]}, lobe, {in.x[i], in.y[i], in.z[i]});
+        out.r[i] = l.radiance.r, out.g[i] = l.radiance.g, out.b[i] = l.radiance.b, out.pdf[i] = l.pdf;
+    }
+}
+
+void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays normals, PointArrays in, SampleArrays out,
+                 uint32_t n) noexcept {
+    for (uint32_t i = 0; i < n; ++i) {
+        const EnvSample s = env.sample({normals.x[i], normals.y[i], normals.z[i]}, lobe, {in.x[i], in.y[i]});
+        out.x[i] = s.direction.x, out.y[i] = s.direction.y, out.z[i] = s.direction.z, out.pdf[i] = s.pdf;
+        out.r[i] = s.radiance.r, out.g[i] = s.radiance.g, out.b[i] = s.radiance.b;
+    }
+}
+
+}  // namespace envmis

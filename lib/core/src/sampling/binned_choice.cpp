@@ -1,0 +1,275 @@
+#include "binned_choice.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "detail/parallel.h"
+
+namespace envmis::detail {
+namespace {
+
+float texel_luminance(const Rgb& p, const LumaCoefficients& k) noexcept {
+    return std::min(luminance(p, k), std::numeric_limits<float>::max());
+}
+
+// Per cell, over its texels: sums of L w (w: the texel's relative solid angle, as the
+// plain density has it) and of w by histogram bucket, as suffix sums (bucket k holds
+// every texel of bucket k and above), the plain mass and the largest luminance.
+struct CellHistogram {
+    int64_t first = 0;     // bucket id of index 0
+    uint32_t buckets = 0;  // per cell; the last gathers every texel above
+    std::vector<double> suffix_l, suffix_w, total_l;
+    std::vector<float> max_l;
+
+    // Sum over the cell of max(L - t, 0) w, for t = 0 or a histogram edge in the window.
+    double above(size_t cell, float t) const noexcept {
+        if (t == 0) return total_l[cell];
+        const auto k = static_cast<int64_t>(std::bit_cast<uint32_t>(t) >> kHistogramShift) - first;
+        const size_t at = cell * buckets + static_cast<size_t>(std::clamp<int64_t>(k, 0, buckets - 1));
+        const double s = suffix_l[at] - static_cast<double>(t) * suffix_w[at];
+        // A texel above t must keep the cell's mass positive, whatever the rounding.
+        return max_l[cell] > t ? std::max(s, static_cast<double>(max_l[cell] - t) * 1e-30) : std::max(s, 0.0);
+    }
+};
+
+// The histograms of the cells, with a window of buckets from the lowest to the highest of
+// `thresholds` (positive histogram edges; at most 512 buckets, see clamp_thresholds).
+CellHistogram histogram(const EnvMap& plain, const CellGrid& grid, std::span<const float> thresholds) {
+    CellHistogram hist;
+    int64_t lo = std::numeric_limits<int64_t>::max(), hi = 0;
+    for (float t : thresholds) {
+        const int64_t id = std::bit_cast<uint32_t>(t) >> kHistogramShift;
+        if (t > 0) lo = std::min(lo, id), hi = std::max(hi, id);
+    }
+    hist.first = lo > hi ? 0 : lo;
+    hist.buckets = lo > hi ? 1 : static_cast<uint32_t>(hi - lo + 2);
+    const size_t cells = size_t{grid.cw} * grid.ch, b = hist.buckets;
+    hist.suffix_l.assign(cells * b, 0);
+    hist.suffix_w.assign(cells * b, 0);
+    hist.total_l.assign(cells, 0);
+    hist.max_l.assign(cells, 0);
+    const Rgb* pixels = plain.radiance().pixels.data();
+    const LumaCoefficients luma = plain.options().luma;
+    parallel_for(grid.ch, 1, [&](uint32_t r0, uint32_t r1) {
+        for (uint32_t cy = r0; cy < r1; ++cy)
+            for (uint32_t y = grid.row_edges[cy]; y < grid.row_edges[cy + 1]; ++y) {
+                const double w = row_weight(grid.mapping, y, grid.h);
+                for (uint32_t cx = 0; cx < grid.cw; ++cx) {
+                    const size_t cell = size_t{cy} * grid.cw + cx;
+                    for (uint32_t x = grid.column_edges[cx]; x < grid.column_edges[cx + 1]; ++x) {
+                        const float l = texel_luminance(pixels[size_t{y} * grid.w + x], luma);
+                        if (!(l > 0)) continue;
+                        hist.total_l[cell] += l * w;
+                        hist.max_l[cell] = std::max(hist.max_l[cell], l);
+                        const int64_t k =
+                            static_cast<int64_t>(std::bit_cast<uint32_t>(l) >> kHistogramShift) - hist.first;
+                        if (k < 0) continue;
+                        const size_t at = cell * b + static_cast<size_t>(std::min<int64_t>(k, b - 1));
+                        hist.suffix_l[at] += l * w;
+                        hist.suffix_w[at] += w;
+                    }
+                }
+            }
+        for (size_t cell = size_t{r0} * grid.cw; cell < size_t{r1} * grid.cw; ++cell)
+            for (size_t k = b - 1; k-- > 0;) {
+                hist.suffix_l[cell * b + k] += hist.suffix_l[cell * b + k + 1];
+                hist.suffix_w[cell * b + k] += hist.suffix_w[cell * b + k + 1];
+            }
+    });
+    return hist;
+}
+
+// Node grid for the choice: each cell cut into k x k nodes, at most 128 columns.
+struct Nodes {
+    uint32_t w = 0, h = 0, k = 1;
+    std::vector<double> sum_l, sum_w;  // per node: sum of L w and of w
+    std::vector<Vec3> direction;
+    std::vector<uint32_t> cell;
+    double steradians_per_weight = 0;  // solid angle of a texel of weight 1
+};
+
+Nodes nodes_of(const EnvMap& plain, const CellGrid& grid) {
+    Nodes n;
+    n.k = std::max(1u, std::min({128 / grid.cw, grid.w / grid.cw, grid.h / grid.ch, 4u}));
+    n.w = grid.cw * n.k, n.h = grid.ch * n.k;
+    n.sum_l.assign(size_t{n.w} * n.h, 0);
+    n.sum_w.assign(n.sum_l.size(), 0);
+    const Rgb* pixels = plain.radiance().pixels.data();
+    const LumaCoefficients luma = plain.options().luma;
+    parallel_for(n.h, 1, [&](uint32_t lo, uint32_t hi) {
+        for (uint32_t ny = lo; ny < hi; ++ny) {
+            const auto y0 = static_cast<uint32_t>((uint64_t{ny} * grid.h + n.h - 1) / n.h);
+            const auto y1 = static_cast<uint32_t>((uint64_t{ny + 1} * grid.h + n.h - 1) / n.h);
+            for (uint32_t y = y0; y < y1; ++y) {
+                const double w = row_weight(grid.mapping, y, grid.h);
+                for (uint32_t x = 0; x < grid.w; ++x) {
+                    const size_t node = size_t{ny} * n.w + static_cast<uint32_t>(uint64_t{x} * n.w / grid.w);
+                    n.sum_l[node] += texel_luminance(pixels[size_t{y} * grid.w + x], luma) * w;
+                    n.sum_w[node] += w;
+                }
+            }
+        }
+    });
+    for (uint32_t ny = 0; ny < n.h; ++ny)
+        for (uint32_t nx = 0; nx < n.w; ++nx) {
+            n.direction.push_back(image_direction(grid.mapping, {(nx + 0.5f) / n.w, (ny + 0.5f) / n.h}));
+            n.cell.push_back(ny / n.k * grid.cw + nx / n.k);
+        }
+    const double texels = static_cast<double>(grid.w) * grid.h;
+    n.steradians_per_weight = (grid.mapping == Mapping::equal_area ? 4 * kPi : 2 * kPi * kPi) / texels;
+    return n;
+}
+
+// Cosine-weighted mean luminance of the hemisphere around each bin's normal: E_b / pi.
+std::vector<double> hemisphere_means(const Nodes& n, const Geometry& geometry) {
+    std::vector<double> means(geometry.bin_normal.size());
+    for (size_t b = 0; b < means.size(); ++b) {
+        double l = 0, w = 0;
+        for (size_t i = 0; i < n.direction.size(); ++i) {
+            const double c = std::max(0.0f, dot(n.direction[i], geometry.bin_normal[b]));
+            l += n.sum_l[i] * c, w += n.sum_w[i] * c;
+        }
+        means[b] = w > 0 ? l / w : 0;
+    }
+    return means;
+}
+
+// The threshold alpha * mean on the histogram grid; within 2^-9 of the window's top
+// bucket count below the highest, so that a map of any dynamic range keeps its
+// histograms small (thresholds that low select nearly every texel anyway).
+float threshold_of(float alpha, double mean, float floor) noexcept {
+    if (alpha == 0 || !(mean > 0)) return 0;
+    return std::max(histogram_edge(static_cast<float>(alpha * mean)), floor);
+}
+
+// The lowest threshold a window ending at `highest` allows.
+float window_floor(float highest) noexcept {
+    constexpr uint32_t kMaxBuckets = 510;
+    const uint32_t id = std::bit_cast<uint32_t>(highest) >> kHistogramShift;
+    return id > kMaxBuckets ? std::bit_cast<float>((id - kMaxBuckets) << kHistogramShift) : 0.0f;
+}
+
+// Exact variance of one 1 + 1 balance MIS estimate at one normal, on the nodes: f and
+// p_bsdf per node in the hemisphere (`visible`), p_env from cell probabilities.
+struct Lobe {
+    std::vector<uint32_t> visible;
+    std::vector<double> f, p_bsdf;
+};
+
+Lobe lobe_at(const Nodes& n, Vec3 normal, float exponent) {
+    Lobe lobe;
+    for (uint32_t i = 0; i < n.direction.size(); ++i) {
+        const double c = dot(n.direction[i], normal);
+        if (!(c > 0) || !(n.sum_l[i] > 0)) continue;
+        const double l = n.sum_l[i] / n.sum_w[i];
+        const double p = exponent == 0 ? c / kPi : (exponent + 1) / (2 * kPi) * std::pow(c, exponent);
+        const double fc = exponent == 0 ? c / kPi : (exponent + 2) / (2 * kPi) * std::pow(c, exponent) * c;
+        lobe.visible.push_back(i), lobe.f.push_back(l * fc), lobe.p_bsdf.push_back(p);
+    }
+    return lobe;
+}
+
+double mis_variance(const Nodes& n, const Lobe& lobe, std::span<const double> cell_probability,
+                    std::span<const double> cell_mass) {
+    double a = 0, b_env = 0, b_bsdf = 0;
+    for (size_t j = 0; j < lobe.visible.size(); ++j) {
+        const uint32_t i = lobe.visible[j];
+        const double omega = n.sum_w[i] * n.steradians_per_weight;
+        const double share = cell_mass[n.cell[i]] > 0 ? n.sum_l[i] / cell_mass[n.cell[i]] : 0;
+        const double pe = cell_probability[n.cell[i]] * share / omega, pb = lobe.p_bsdf[j];
+        const double q = pe + pb, f = lobe.f[j];
+        a += f * f / q * omega;  // both techniques' second moments: f^2 (pe + pb) / q^2
+        b_env += f * pe / q * omega, b_bsdf += f * pb / q * omega;
+    }
+    return a - b_env * b_env - b_bsdf * b_bsdf;
+}
+
+// Cell probabilities of a density given by cell masses; empty if it has no mass.
+std::vector<double> probabilities(std::vector<double> mass) {
+    double total = 0;
+    for (double m : mass) total += m;
+    if (!(total > 0)) return {};
+    for (double& m : mass) m /= total;
+    return mass;
+}
+
+// Normals of a bin the choice looks at: its centre and four points halfway to its corners.
+std::vector<Vec3> bin_samples(uint32_t bin, uint32_t g) {
+    const float s = (bin % g + 0.5f) / g, t = (bin / g + 0.5f) / g, d = 0.25f / g;
+    return {octahedral_normal(s, t), octahedral_normal(s - d, t - d), octahedral_normal(s + d, t - d),
+            octahedral_normal(s - d, t + d), octahedral_normal(s + d, t + d)};
+}
+
+}  // namespace
+
+std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, const Geometry& geometry,
+                                   const BinnedOptions& options) {
+    const Nodes nodes = nodes_of(plain, grid);
+    const std::vector<double> means = hemisphere_means(nodes, geometry);
+    const uint32_t k = options.bins_per_side * options.bins_per_side;
+    const auto classes = static_cast<uint32_t>(options.lobe_exponents.size());
+    const std::vector<float> alphas = options.auto_alpha ? options.candidates : std::vector<float>{options.alpha};
+    const float highest_alpha = *std::max_element(alphas.begin(), alphas.end());
+    const float floor = window_floor(static_cast<float>(highest_alpha * *std::max_element(means.begin(), means.end())));
+    std::vector<float> thresholds;
+    for (uint32_t b = 0; b < k; ++b)
+        for (float a : alphas) thresholds.push_back(threshold_of(a, means[b], floor));
+    std::vector<BinChoice> choices(size_t{classes} * k);
+    if (!options.auto_alpha) {
+        for (size_t i = 0; i < choices.size(); ++i) choices[i] = {options.alpha, thresholds[i % k]};
+        return choices;
+    }
+    const CellHistogram hist = histogram(plain, grid, thresholds);
+    const size_t cells = size_t{grid.cw} * grid.ch;
+    const std::vector<double> plain_p = probabilities(hist.total_l);
+    parallel_for(k, 1, [&](uint32_t lo, uint32_t hi) {
+        std::vector<double> mass(cells);
+        for (uint32_t b = lo; b < hi; ++b) {
+            std::vector<std::vector<double>> p(alphas.size());
+            for (size_t j = 0; j < alphas.size(); ++j) {
+                for (size_t c = 0; c < cells; ++c)
+                    mass[c] = geometry.bound(b, c) * hist.above(c, thresholds[b * alphas.size() + j]);
+                p[j] = probabilities(mass);
+            }
+            for (uint32_t cls = 0; cls < classes; ++cls) {
+                std::vector<double> log_ratio(alphas.size(), 0);
+                for (Vec3 normal : bin_samples(b, options.bins_per_side)) {
+                    const Lobe lobe = lobe_at(nodes, normal, options.lobe_exponents[cls]);
+                    const double base = mis_variance(nodes, lobe, plain_p, hist.total_l);
+                    for (size_t j = 0; j < alphas.size(); ++j) {
+                        const double v = p[j].empty() ? 0 : mis_variance(nodes, lobe, p[j], hist.total_l);
+                        if (base > 0) log_ratio[j] += v > 0 ? std::log(v / base) : (p[j].empty() ? 1e9 : 0);
+                    }
+                }
+                const size_t best = std::min_element(log_ratio.begin(), log_ratio.end()) - log_ratio.begin();
+                choices[size_t{cls} * k + b] = log_ratio[best] < -1e-6
+                                                   ? BinChoice{alphas[best], thresholds[b * alphas.size() + best]}
+                                                   : BinChoice{-1, 0};
+            }
+        }
+    });
+    return choices;
+}
+
+std::vector<std::vector<float>> bin_masses(const EnvMap& plain, const CellGrid& grid, const Geometry& geometry,
+                                           const BinLayout& layout) {
+    std::vector<float> thresholds;
+    for (const BinChoice& c : layout.choices) thresholds.push_back(c.plain() ? 0.0f : c.threshold);
+    const CellHistogram hist = histogram(plain, grid, thresholds);
+    const size_t cells = size_t{grid.cw} * grid.ch, k = size_t{layout.bins_per_side} * layout.bins_per_side;
+    std::vector<std::vector<float>> masses(layout.choices.size(), std::vector<float>(cells));
+    parallel_for(static_cast<uint32_t>(masses.size()), 1, [&](uint32_t lo, uint32_t hi) {
+        for (uint32_t cb = lo; cb < hi; ++cb)
+            for (size_t c = 0; c < cells; ++c) {
+                const BinChoice& choice = layout.choices[cb];
+                const double bound = choice.plain() ? 1.0 : geometry.bound(static_cast<uint32_t>(cb % k), c);
+                const double s = hist.above(c, choice.plain() ? 0.0f : choice.threshold);
+                const auto m = static_cast<float>(bound * s);
+                masses[cb][c] = bound > 0 && s > 0 ? std::max(m, std::numeric_limits<float>::min()) : 0.0f;
+            }
+    });
+    return masses;
+}
+
+}  // namespace envmis::detail

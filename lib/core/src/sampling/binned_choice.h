@@ -1,0 +1,55 @@
+// Private parts of the binned build (binned.h): the cell grid and its geometry, the
+// per-bin thresholds and alphas, and the cell masses of every (class, bin).
+#pragma once
+
+#include <bit>
+#include <cstdint>
+#include <vector>
+
+#include "envmis/sampling/binned.h"
+
+namespace envmis::detail {
+
+// A w x h map cut into cw x ch cells; cell column c holds texel columns
+// [column_edges[c], column_edges[c + 1]), the same as floor(x cw / w) == c.
+struct CellGrid {
+    uint32_t w, h, cw, ch;
+    Mapping mapping;
+    std::vector<uint32_t> column_edges, row_edges;
+
+    CellGrid(uint32_t w, uint32_t h, uint32_t columns, uint32_t rows, Mapping mapping);
+};
+
+// Canonical directions and angular radii (upper bounds) of the cells and the bins.
+struct Geometry {
+    std::vector<Vec3> cell_direction, bin_normal;
+    std::vector<float> cell_radius, bin_radius;
+
+    Geometry(const CellGrid& grid, uint32_t bins_per_side);
+    // c_b: an upper bound of cos+(omega . n) for omega in the cell and n in the bin.
+    float bound(uint32_t bin, size_t cell) const noexcept;
+};
+
+// Thresholds are rounded to the edges of a luminance histogram whose buckets are the
+// float bit patterns shifted right by kHistogramShift (8 buckets an octave): the sum
+// over a cell of max(L - t, 0) is then exact from the buckets' sums.
+inline constexpr uint32_t kHistogramShift = 20;
+inline float histogram_edge(float t) noexcept {
+    const uint32_t half = 1u << (kHistogramShift - 1);
+    return std::bit_cast<float>(((std::bit_cast<uint32_t>(t) + half) >> kHistogramShift) << kHistogramShift);
+}
+inline bool on_histogram_edge(float t) noexcept {
+    return (std::bit_cast<uint32_t>(t) & ((1u << kHistogramShift) - 1)) == 0;
+}
+
+// The choice of every (class, bin), class-major, as BinnedOptions asks.
+std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, const Geometry& geometry,
+                                   const BinnedOptions& options);
+
+// The cell masses (cw ch floats) of every (class, bin) of the layout: c_b times the sum
+// over the cell of max(L - threshold, 0) times the texels' relative solid angle, or the
+// plain mass for a plain choice. Deterministic: the same for any number of threads.
+std::vector<std::vector<float>> bin_masses(const EnvMap& plain, const CellGrid& grid, const Geometry& geometry,
+                                           const BinLayout& layout);
+
+}  // namespace envmis::detail

@@ -1,0 +1,299 @@
+// Specification of the normal-aware binned sampler (binned.h): for normals at bin
+// centres, on bin borders and at the poles, on synthetic maps of both mappings.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+
+#include "envmis/sampling/binned.h"
+#include "maps.h"
+#include "stats.h"
+
+namespace envmis {
+namespace {
+
+using test::Rng;
+
+const double kLevel = test::sidak_level(0.01, 40);
+
+EnvMap plain_map(RgbImage image, Mapping mapping = Mapping::equirect) {
+    EnvMapOptions o;
+    o.compensation.enabled = false;
+    o.mapping = mapping;
+    return EnvMap(std::move(image), o);
+}
+
+// Normals that test the bins: two bin centres, points just either side of a bin border
+// (on both octahedral hemispheres) and both poles.
+std::vector<Vec3> test_normals(uint32_t g) {
+    const float edge = 3.0f / g, nudge = 1e-4f;
+    return {octahedral_normal(0.5f / g, 0.5f / g),
+            octahedral_normal(4.5f / g, 5.5f / g),
+            octahedral_normal(edge - nudge, 0.41f),
+            octahedral_normal(edge + nudge, 0.41f),
+            octahedral_normal(0.2f, edge - nudge),
+            octahedral_normal(0.2f, edge + nudge),
+            Vec3{0, 0, 1},
+            Vec3{0, 0, -1},
+            normalize(Vec3{0.3f, -0.5f, -0.8f})};
+}
+
+// Texel probabilities of a bin, from pdf_uv at texel centres: the image density is
+// constant over a texel, and pdf_uv turns it into solid angle with the sine at uv.
+std::vector<double> texel_probabilities(const BinView& bin, const EnvMap& plain) {
+    const uint32_t w = plain.width(), h = plain.height();
+    std::vector<double> p(size_t{w} * h);
+    for (uint32_t y = 0; y < h; ++y)
+        for (uint32_t x = 0; x < w; ++x) {
+            const Vec2 uv{(x + 0.5f) / w, (y + 0.5f) / h};
+            const double jacobian = plain.options().mapping == Mapping::equal_area
+                                        ? 4 * kPi
+                                        : 2 * kPi * kPi * sincos_half_turns(plain.view().turns, uv.y).sin;
+            p[size_t{y} * w + x] = bin.pdf_uv(uv) * jacobian / (double{w} * h);
+        }
+    return p;
+}
+
+void expect_samples_follow_pdf(const BinnedEnvMap& binned, Vec3 normal, uint32_t lobe, uint64_t seed) {
+    const BinnedEnvMapView view = binned.view();
+    const BinView bin = view.bin(normal, lobe);
+    const std::vector<double> p = texel_probabilities(bin, binned.plain());
+    EXPECT_NEAR(std::accumulate(p.begin(), p.end(), 0.0), 1.0, 1e-4);
+    const size_t n = std::max<size_t>(100000, 20 * p.size());
+    std::vector<double> expected(p.size()), observed(p.size());
+    for (size_t i = 0; i < p.size(); ++i) expected[i] = p[i] * n;
+    Rng rng(seed);
+    const uint32_t w = binned.plain().width(), h = binned.plain().height();
+    for (size_t i = 0; i < n; ++i) {
+        const EnvSample s = bin.sample(rng.uniform2());
+        ASSERT_EQ(s.pdf, bin.pdf_uv(s.uv));
+        observed[size_t{detail::cell_of(s.uv.y, h)} * w + detail::cell_of(s.uv.x, w)] += 1;
+    }
+    const auto chi = test::chi_square(expected, observed);
+    EXPECT_GT(chi.p_value, kLevel) << "normal " << normal.x << "," << normal.y << "," << normal.z << " lobe " << lobe
+                                   << ": " << chi.describe();
+}
+
+TEST(Binned, SamplesFollowTheirPdfForNormalsAtCentresBordersAndPoles) {
+    const BinnedEnvMap sun(plain_map(test::sun_sky_map(64, 32)));
+    const BinnedEnvMap noise(plain_map(test::random_map(48, 24, 3)));
+    uint64_t seed = 1;
+    for (Vec3 n : test_normals(10))
+        for (uint32_t lobe : {0u, 2u}) {
+            expect_samples_follow_pdf(sun, n, lobe, ++seed);
+            expect_samples_follow_pdf(noise, n, lobe, ++seed);
+        }
+}
+
+TEST(Binned, EqualAreaMapsFollowTheirPdf) {
+    const BinnedEnvMap map(plain_map(test::random_map(32, 32, 8), Mapping::equal_area));
+    uint64_t seed = 100;
+    for (Vec3 n : test_normals(10)) expect_samples_follow_pdf(map, n, 1, ++seed);
+}
+
+TEST(Binned, SolidAnglePdfIntegratesToOne) {
+    const BinnedEnvMap map(plain_map(test::sun_sky_map(64, 32)));
+    const BinnedEnvMapView view = map.view();
+    const uint32_t nt = 256, np = 512;
+    for (Vec3 n : test_normals(10)) {
+        double integral = 0;
+        for (uint32_t i = 0; i < nt; ++i) {
+            const double theta = kPi * (i + 0.5) / nt;
+            for (uint32_t j = 0; j < np; ++j) {
+                const double phi = 2 * kPi * (j + 0.5) / np;
+                const Vec3 d{static_cast<float>(std::sin(theta) * std::cos(phi)),
+                             static_cast<float>(std::sin(theta) * std::sin(phi)), static_cast<float>(std::cos(theta))};
+                integral += view.pdf(n, 0, d) * std::sin(theta);
+            }
+        }
+        EXPECT_NEAR(integral * (kPi / nt) * (2 * kPi / np), 1.0, 1e-3);
+    }
+}
+
+TEST(Binned, SampleAgreesWithPdfAndEvalFromItsDirection) {
+    const BinnedEnvMap map(plain_map(test::sun_sky_map(128, 64)));
+    const BinnedEnvMapView view = map.view();
+    Rng rng(9);
+    int edge_cases = 0;
+    const int n = 20000;
+    for (int i = 0; i < n; ++i) {
+        const Vec3 normal = octahedral_normal(rng.uniform(), rng.uniform());
+        const EnvSample s = view.sample(normal, i % 3, rng.uniform2());
+        ASSERT_GT(s.pdf, 0);
+        ASSERT_NEAR(length(s.direction), 1.0f, 1e-5f);
+        const EnvMapView::Lookup l = view.lookup(normal, i % 3, s.direction);
+        if (std::abs(l.pdf - s.pdf) > 1e-3f * s.pdf || l.radiance.r != s.radiance.r) ++edge_cases;
+    }
+    EXPECT_LT(edge_cases, n / 500);
+}
+
+TEST(Binned, InsideACellTexelsArePickedByThePlainDensity) {
+    const EnvMap plain = plain_map(test::random_map(64, 32, 5));
+    const BinnedEnvMap map(plain);
+    const BinnedEnvMapView view = map.view();
+    const BinView bin = view.bin({0, 0, 1}, 0);
+    const std::vector<double> p = texel_probabilities(bin, map.plain());
+    const std::vector<float> plain_density = plain.density();
+    for (uint32_t y = 0; y < 32; ++y)
+        for (uint32_t x = 1; x < 64; ++x) {
+            const size_t i = size_t{y} * 64 + x;
+            if (view.cell_column(x) != view.cell_column(x - 1) || p[i] == 0) continue;
+            EXPECT_NEAR(p[i] / p[i - 1], double{plain_density[i]} / plain_density[i - 1],
+                        3e-3 * plain_density[i] / plain_density[i - 1])  // fixed-point rounding of small texels
+                << x << "," << y;
+        }
+}
+
+// Coverage: pdf > 0 at every texel centre above the normal's horizon whose luminance is
+// above its bin's threshold (everywhere with light for an uncompensated bin).
+void expect_coverage(const BinnedEnvMap& map, uint32_t lobe) {
+    const BinnedEnvMapView view = map.view();
+    const EnvMap& plain = map.plain();
+    const uint32_t w = plain.width(), h = plain.height(), g = map.layout().bins_per_side;
+    const std::vector<float> density = plain.density();
+    int checked = 0;
+    for (int k = 0; k <= 400; ++k) {  // a sweep across many bin borders
+        const float t = k / 400.0f;
+        const Vec3 n = octahedral_normal(t, 0.5f + 0.45f * std::sin(9 * t));
+        const BinChoice& c = map.layout().choices[size_t{lobe} * g * g + normal_bin(n, g)];
+        for (uint32_t y = 0; y < h; ++y)
+            for (uint32_t x = 0; x < w; ++x) {
+                const Vec2 uv{(x + 0.5f) / w, (y + 0.5f) / h};
+                const Vec3 d = equirect_direction(uv);
+                const float l = density[size_t{y} * w + x] / row_sin_theta(y, h);
+                if (dot(d, n) <= 0 || !(l > (c.plain() ? 0 : c.threshold) * 1.001f)) continue;
+                ++checked;
+                ASSERT_GT(view.bin(n, lobe).pdf_uv(uv), 0)
+                    << "texel " << x << "," << y << " normal bin " << normal_bin(n, g);
+            }
+    }
+    EXPECT_GT(checked, 100);
+}
+
+TEST(Binned, PdfCoversWhatEveryNormalOfTheBinSeesAcrossBinBorders) {
+    expect_coverage(BinnedEnvMap(plain_map(test::sun_sky_map(64, 32))), 0);
+    expect_coverage(BinnedEnvMap(plain_map(test::random_map(64, 32, 2))), 2);
+    BinnedOptions uncompensated;
+    uncompensated.auto_alpha = false;
+    uncompensated.alpha = 0;
+    const BinnedEnvMap plain_bins(plain_map(test::random_map(64, 32, 2)), uncompensated);
+    EXPECT_TRUE(plain_bins.complete(0));
+    expect_coverage(plain_bins, 0);
+}
+
+TEST(Binned, CompensatedBinsAreIncomplete) {
+    BinnedOptions fixed;
+    fixed.auto_alpha = false;
+    fixed.alpha = 1;
+    EXPECT_FALSE(BinnedEnvMap(plain_map(test::sun_sky_map(64, 32)), fixed).complete(0));
+}
+
+TEST(Binned, BatchCallsAreBitIdenticalToSingleCalls) {
+    const BinnedEnvMap map(plain_map(test::sun_sky_map(64, 32)));
+    const BinnedEnvMapView view = map.view();
+    constexpr uint32_t n = 257;
+    Rng rng(4);
+    float nx[n], ny[n], nz[n], ux[n], uy[n], dx[n], dy[n], dz[n];
+    for (uint32_t i = 0; i < n; ++i) {
+        const Vec3 normal = octahedral_normal(rng.uniform(), rng.uniform());
+        nx[i] = normal.x, ny[i] = normal.y, nz[i] = normal.z, ux[i] = rng.uniform(), uy[i] = rng.uniform();
+        const Vec3 d = equirect_direction(rng.uniform2());
+        dx[i] = d.x, dy[i] = d.y, dz[i] = d.z;
+    }
+    float x[n], y[n], z[n], pdf[n], r[n], g[n], b[n];
+    sample_many(view, 1, {nx, ny, nz}, {ux, uy}, {x, y, z, pdf, r, g, b}, n);
+    for (uint32_t i = 0; i < n; ++i) {
+        const EnvSample s = view.sample({nx[i], ny[i], nz[i]}, 1, {ux[i], uy[i]});
+        ASSERT_EQ(s.direction.x, x[i]);
+        ASSERT_EQ(s.direction.z, z[i]);
+        ASSERT_EQ(s.pdf, pdf[i]);
+        ASSERT_EQ(s.radiance.g, g[i]);
+    }
+    lookup_many(view, 1, {nx, ny, nz}, {dx, dy, dz}, {r, g, b, pdf}, n);
+    for (uint32_t i = 0; i < n; ++i) {
+        const EnvMapView::Lookup l = view.lookup({nx[i], ny[i], nz[i]}, 1, {dx[i], dy[i], dz[i]});
+        ASSERT_EQ(l.pdf, pdf[i]);
+        ASSERT_EQ(l.radiance.b, b[i]);
+    }
+}
+
+TEST(Binned, RebuildingFromTheLayoutIsBitIdentical) {
+    const EnvMap plain = plain_map(test::sun_sky_map(96, 48));
+    const BinnedEnvMap built(plain);
+    const BinnedEnvMap rebuilt(plain, built.layout());
+    Rng rng(12);
+    for (int i = 0; i < 2000; ++i) {
+        const Vec3 n = octahedral_normal(rng.uniform(), rng.uniform());
+        const Vec2 u = rng.uniform2();
+        const EnvSample a = built.view().sample(n, i % 3, u), b = rebuilt.view().sample(n, i % 3, u);
+        ASSERT_EQ(a.pdf, b.pdf);
+        ASSERT_EQ(a.direction.x, b.direction.x);
+    }
+}
+
+TEST(Binned, NormalsFindTheirOctahedralBin) {
+    Rng rng(3);
+    for (int i = 0; i < 10000; ++i) {
+        const float s = rng.uniform(), t = rng.uniform();
+        const uint32_t expected =
+            std::min(9u, static_cast<uint32_t>(t * 10)) * 10 + std::min(9u, static_cast<uint32_t>(s * 10));
+        const uint32_t found = normal_bin(octahedral_normal(s, t), 10);
+        // Points within float rounding of a border may land either side.
+        if (found != expected) {
+            const float ds = std::abs(s * 10 - std::round(s * 10)), dt = std::abs(t * 10 - std::round(t * 10));
+            EXPECT_LT(std::min(ds, dt), 1e-4f);
+        }
+    }
+    EXPECT_EQ(normal_bin({0, 0, 0}, 10), 0u);
+    EXPECT_EQ(normal_bin({NAN, 0, 1}, 10), 0u);
+}
+
+TEST(Binned, LobeClassesPickTheNearestSharpness) {
+    const std::vector<float> e = {0, 20, 200};
+    EXPECT_EQ(lobe_class(e, 0), 0u);
+    EXPECT_EQ(lobe_class(e, 2), 0u);
+    EXPECT_EQ(lobe_class(e, 10), 1u);
+    EXPECT_EQ(lobe_class(e, 50), 1u);
+    EXPECT_EQ(lobe_class(e, 100), 2u);
+    EXPECT_EQ(lobe_class(e, 1e5f), 2u);
+}
+
+TEST(Binned, TinyBlackAndConstantMapsWork) {
+    for (RgbImage image : {test::constant_map(1, 1, {1, 1, 1}), test::constant_map(3, 2, {0, 0, 0}),
+                           test::constant_map(5, 3, {2, 2, 2}), test::random_map(2, 1, 9)}) {
+        const BinnedEnvMap map(plain_map(image));
+        const BinnedEnvMapView view = map.view();
+        Rng rng(1);
+        for (Vec3 n : test_normals(10)) {
+            const EnvSample s = view.sample(n, 0, rng.uniform2());
+            EXPECT_GT(s.pdf, 0) << image.width << "x" << image.height;
+            EXPECT_EQ(s.pdf, view.bin(n, 0).pdf_uv(s.uv));
+        }
+    }
+}
+
+TEST(Binned, RejectsCompensatedMapsAndInvalidOptionsAndLayouts) {
+    EXPECT_THROW(BinnedEnvMap(EnvMap(test::sun_sky_map(16, 8))), std::invalid_argument);
+    const EnvMap plain = plain_map(test::sun_sky_map(16, 8));
+    BinnedOptions o;
+    o.bins_per_side = 0;
+    EXPECT_THROW(BinnedEnvMap(plain, o), std::invalid_argument);
+    o = {};
+    o.lobe_exponents = {5, 20};
+    EXPECT_THROW(BinnedEnvMap(plain, o), std::invalid_argument);
+    o = {};
+    o.candidates = {-1};
+    EXPECT_THROW(BinnedEnvMap(plain, o), std::invalid_argument);
+    BinLayout layout = BinnedEnvMap(plain).layout();
+    layout.choices.pop_back();
+    EXPECT_THROW(BinnedEnvMap(plain, layout), std::invalid_argument);
+    layout = BinnedEnvMap(plain).layout();
+    layout.cell_columns = 17;
+    EXPECT_THROW(BinnedEnvMap(plain, layout), std::invalid_argument);
+    layout = BinnedEnvMap(plain).layout();
+    layout.choices[0] = {1, 0.3f};  // not on the histogram grid
+    EXPECT_THROW(BinnedEnvMap(plain, layout), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace envmis
