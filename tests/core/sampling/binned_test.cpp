@@ -49,7 +49,7 @@ std::vector<double> texel_probabilities(const BinView& bin, const EnvMap& plain)
             const double jacobian = plain.options().mapping == Mapping::equal_area
                                         ? 4 * kPi
                                         : 2 * kPi * kPi * sincos_half_turns(plain.view().turns, uv.y).sin;
-            p[size_t{y} * w + x] = bin.pdf_uv(uv) * jacobian / (double{w} * h);
+            p[size_t{y} * w + x] = bin.pdf_uv(uv) * jacobian / (static_cast<double>(w) * h);
         }
     return p;
 }

@@ -102,6 +102,21 @@ float Geometry::bound(uint32_t bin, size_t cell) const noexcept {
     return angle >= kPiF / 2 ? 0.0f : std::cos(angle);
 }
 
+float Geometry::weight(uint32_t bin, size_t cell) const noexcept {
+    const float b = bound(bin, cell);
+    if (b == 0) return 0;
+    // The cosine seen from halfway between the bin's centre and its edge, to the cell's
+    // centre: a typical normal of the bin rather than its most favourable one. On
+    // rooitou_park (exact variance, Lambert, 16 normals) the conservative bound itself
+    // gives 3.8x over mis-balance, this 5.8x; the floor keeps every cell that some
+    // normal of the bin may see positive, as coverage needs.
+    constexpr float kBinShare = 0.5f, kFloor = 0.1f;
+    const float angle =
+        std::acos(std::clamp(dot(bin_normal[bin], cell_direction[cell]), -1.0f, 1.0f)) - kBinShare * bin_radius[bin];
+    const float typical = angle <= 0 ? 1.0f : (angle >= kPiF / 2 ? 0.0f : std::cos(angle));
+    return std::max(typical, kFloor * b);
+}
+
 }  // namespace detail
 
 namespace {

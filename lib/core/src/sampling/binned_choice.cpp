@@ -81,6 +81,8 @@ CellHistogram histogram(const EnvMap& plain, const CellGrid& grid, std::span<con
 }
 
 // Node grid for the choice: each cell cut into k x k nodes, at most 128 columns.
+constexpr uint32_t kNodeColumns = 64;
+
 struct Nodes {
     uint32_t w = 0, h = 0, k = 1;
     std::vector<double> sum_l, sum_w;  // per node: sum of L w and of w
@@ -91,7 +93,7 @@ struct Nodes {
 
 Nodes nodes_of(const EnvMap& plain, const CellGrid& grid) {
     Nodes n;
-    n.k = std::max(1u, std::min({128 / grid.cw, grid.w / grid.cw, grid.h / grid.ch, 4u}));
+    n.k = std::max(1u, std::min({kNodeColumns / grid.cw, grid.w / grid.cw, grid.h / grid.ch, 4u}));
     n.w = grid.cw * n.k, n.h = grid.ch * n.k;
     n.sum_l.assign(size_t{n.w} * n.h, 0);
     n.sum_w.assign(n.sum_l.size(), 0);
@@ -157,11 +159,16 @@ struct Lobe {
     std::vector<double> f, p_bsdf;
 };
 
+constexpr double kNegligibleLog = -9.2;  // log(1e-4)
+
 Lobe lobe_at(const Nodes& n, Vec3 normal, float exponent) {
     Lobe lobe;
     for (uint32_t i = 0; i < n.direction.size(); ++i) {
         const double c = dot(n.direction[i], normal);
         if (!(c > 0) || !(n.sum_l[i] > 0)) continue;
+        // Directions where a glossy lobe is below 1e-4 of its peak add nothing that could
+        // rank candidates, and skipping them makes sharp lobes cheap to evaluate.
+        if (exponent > 0 && exponent * std::log(c) < kNegligibleLog) continue;
         const double l = n.sum_l[i] / n.sum_w[i];
         const double p = exponent == 0 ? c / kPi : (exponent + 1) / (2 * kPi) * std::pow(c, exponent);
         const double fc = exponent == 0 ? c / kPi : (exponent + 2) / (2 * kPi) * std::pow(c, exponent) * c;
@@ -229,7 +236,7 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
             std::vector<std::vector<double>> p(alphas.size());
             for (size_t j = 0; j < alphas.size(); ++j) {
                 for (size_t c = 0; c < cells; ++c)
-                    mass[c] = geometry.bound(b, c) * hist.above(c, thresholds[b * alphas.size() + j]);
+                    mass[c] = geometry.weight(b, c) * hist.above(c, thresholds[b * alphas.size() + j]);
                 p[j] = probabilities(mass);
             }
             for (uint32_t cls = 0; cls < classes; ++cls) {
@@ -263,7 +270,7 @@ std::vector<std::vector<float>> bin_masses(const EnvMap& plain, const CellGrid& 
         for (uint32_t cb = lo; cb < hi; ++cb)
             for (size_t c = 0; c < cells; ++c) {
                 const BinChoice& choice = layout.choices[cb];
-                const double bound = choice.plain() ? 1.0 : geometry.bound(static_cast<uint32_t>(cb % k), c);
+                const double bound = choice.plain() ? 1.0 : geometry.weight(static_cast<uint32_t>(cb % k), c);
                 const double s = hist.above(c, choice.plain() ? 0.0f : choice.threshold);
                 const auto m = static_cast<float>(bound * s);
                 masses[cb][c] = bound > 0 && s > 0 ? std::max(m, std::numeric_limits<float>::min()) : 0.0f;

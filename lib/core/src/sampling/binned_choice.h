@@ -28,6 +28,8 @@ struct Geometry {
     Geometry(const CellGrid& grid, uint32_t bins_per_side);
     // c_b: an upper bound of cos+(omega . n) for omega in the cell and n in the bin.
     float bound(uint32_t bin, size_t cell) const noexcept;
+    // The cosine factor a bin's cell masses carry: > 0 exactly where bound() is.
+    float weight(uint32_t bin, size_t cell) const noexcept;
 };
 
 // Thresholds are rounded to the edges of a luminance histogram whose buckets are the
@@ -46,7 +48,7 @@ inline bool on_histogram_edge(float t) noexcept {
 std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, const Geometry& geometry,
                                    const BinnedOptions& options);
 
-// The cell masses (cw ch floats) of every (class, bin) of the layout: c_b times the sum
+// The cell masses (cw ch floats) of every (class, bin) of the layout: the weight times the sum
 // over the cell of max(L - threshold, 0) times the texels' relative solid angle, or the
 // plain mass for a plain choice. Deterministic: the same for any number of threads.
 std::vector<std::vector<float>> bin_masses(const EnvMap& plain, const CellGrid& grid, const Geometry& geometry,
