@@ -186,7 +186,7 @@ void print_bins(std::ostream& out, const BinLayout& layout) {
         std::map<float, uint32_t> chosen;
         for (uint32_t b = 0; b < bins && (c * bins + b) < layout.choices.size(); ++b)
             ++chosen[std::max(layout.choices[c * bins + b].alpha, -1.0f)];
-        out << "  bin alphas    " << std::left << std::setw(10) << lobe_name(layout.lobe_exponents[c]) + ":"
+        out << "  bin alphas    " << std::left << std::setw(11) << lobe_name(layout.lobe_exponents[c]) + ":"
             << std::right;
         const char* separator = "";
         for (const auto& [alpha, count] : chosen) {
@@ -209,8 +209,20 @@ void print_bins_cost(std::ostream& out, const BinnedEnvMap& binned, double build
         static_cast<double>(plain.distribution().bytes()) + static_cast<double>(plain.radiance().pixels.size_bytes());
     const auto flags = out.flags();
     out << std::fixed << std::setprecision(1) << "  bins build    " << build_ms << " ms";
-    if (binned.choice_seconds() > 0) out << " (choosing alphas " << 1e3 * binned.choice_seconds() << " ms)";
+    if (binned.choice_seconds() > 0)
+        out << " (choosing alphas " << 1e3 * binned.choice_seconds() << " ms)";
+    else
+        out << " (rebuilt from the stored layout)";
     out << ", " << binned.bytes() << " bytes over the plain map (+" << 100 * binned.bytes() / plain_bytes << "%)\n";
+    // The summary's "complete pdf" is the plain map's; a compensated bin is incomplete.
+    bool all = true;
+    out << "  bins complete";
+    for (uint32_t c = 0; c < binned.classes(); ++c) {
+        out << (c ? ", " : " ") << lobe_name(binned.layout().lobe_exponents[c]) << " "
+            << (binned.complete(c) ? "yes" : "no");
+        all = all && binned.complete(c);
+    }
+    out << (all ? "\n" : " (where no: combine with BSDF sampling through MIS)\n");
     out.flags(flags);
 }
 

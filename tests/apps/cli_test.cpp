@@ -406,8 +406,10 @@ TEST_F(Cli, PrecomputeWithBinsWritesABinnedTableThatInfoDescribes) {
         EXPECT_TRUE(contains(r.out, line)) << "missing /" << line << "/" << r;
     const Result info = envmis({"info", "binned.envmis"});
     ASSERT_EQ(info.exit_code, 0) << info;
-    for (const char* line : {"binned.envmis: envmis table, format version 4", R"(bins +64 \(8 x 8)",
-                             R"(bin alphas +Phong 20: )", R"(bins build +[0-9.]+ ms, [0-9]+ bytes over the plain map)"})
+    for (const char* line :
+         {"binned.envmis: envmis table, format version 4", R"(bins +64 \(8 x 8)", R"(bin alphas +Phong 20: )",
+          R"(bins complete +diffuse (yes|no), Phong 20)",
+          R"(bins build +[0-9.]+ ms \(rebuilt from the stored layout\), [0-9]+ bytes over the plain map)"})
         EXPECT_TRUE(contains(info.out, line)) << "missing /" << line << "/" << info;
     const Result fixed = envmis(
         {"precompute", "map.exr", "-o", "fixed.envmis", "--bins", "1", "--no-compensate", "--cell-columns", "4"});
