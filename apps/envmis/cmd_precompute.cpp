@@ -60,15 +60,18 @@ void add_precompute_flags(CLI::App& sub, PrecomputeArgs& args) {
     sub.add_option("-o,--output", args.output, "Table file to write (.envmis)")->required();
     sub.add_flag("--compact", args.compact,
                  "Store the radiance in RGBE (4 bytes/texel instead of 16; density rebuilt on load); prints the error");
-    sub.add_option("--bins", args.bins,
-                   "Normal-aware table: K = g x g bins of normals, each with its own compensation (binned.h); the "
-                   "texels keep the plain density. --alpha auto chooses per bin, --alpha X fixes it, --no-compensate "
-                   "makes it 0")
-        ->type_name("K")
-        ->check(square_bins());
+    CLI::Option* bins =
+        sub.add_option(
+               "--bins", args.bins,
+               "Normal-aware table: K = g x g bins of normals, each with its own compensation (binned.h); the "
+               "texels keep the plain density. --alpha auto chooses per bin and lobe class, --alpha X (default 1) "
+               "fixes it for every bin, --no-compensate makes it 0")
+            ->type_name("K")
+            ->check(square_bins());
     sub.add_option("--cell-columns", args.cell_columns, "With --bins: columns of the bins' cell grid (0: width / 32)")
         ->type_name("N")
-        ->check(in_range(uint32_t{0}, uint32_t{4096}));
+        ->check(in_range(uint32_t{0}, uint32_t{4096}))
+        ->needs(bins);
     add_map_flags(sub, args.map);
 }
 
@@ -113,7 +116,6 @@ void run_precompute_binned(const PrecomputeArgs& args) {
 
 void run_precompute(const PrecomputeArgs& args) {
     if (args.bins != 0) return run_precompute_binned(args);
-    if (args.cell_columns != 0) throw std::runtime_error("--cell-columns needs --bins");
     const LoadedMap loaded = load_map(args.input, args.map);
     if (loaded.from_table) throw std::runtime_error(args.input + ": is already a table; give an image");
     const auto start = std::chrono::steady_clock::now();

@@ -298,6 +298,20 @@ struct Header {
     uint32_t bins_size = 0;  // of the bins section, without its checksum; 0: none
 };
 
+// The payload's size and the bins section's (`left` bytes follow the header), checked
+// against the file before anything is allocated for them.
+void check_payload_size(const Header& header, uint64_t left, const Cursor& in) {
+    const uint32_t bins = header.bins_size;
+    if (bins != 0 && (bins < bins_section_size(1, 1) || bins > kMaxBinsSection || bins % 4 != 0))
+        in.fail("invalid bins section size " + std::to_string(bins));
+    const uint64_t texels = uint64_t{header.w} * header.h;
+    const uint64_t payload = texels * (header.compact ? sizeof(uint32_t) : sizeof(float) + sizeof(Rgb)) + 8 +
+                             (bins == 0 ? 0 : uint64_t{bins} + 8);
+    if (payload > left)
+        in.fail("truncated: payload needs " + std::to_string(payload) + " bytes, " + std::to_string(left) + " left");
+    if (payload < left) in.fail(std::to_string(left - payload) + " bytes of trailing data after the payload");
+}
+
 // Parses and checks the header from `head`, the first bytes of a file of `file_size`
 // bytes (all of it, or at least the preamble, metadata and header checksum).
 Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::string_view name) {
@@ -381,18 +395,8 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
         in.fail("unknown fallback " + std::to_string(fallback));
     stats.fallback = static_cast<DensityFallback>(fallback);
 
-    // The payload's size, checked against the file before anything is allocated for it.
     out.payload_offset = in.position();
-    const uint64_t texels = uint64_t{w} * h;
-    if (out.bins_size != 0 &&
-        (out.bins_size < bins_section_size(1, 1) || out.bins_size > kMaxBinsSection || out.bins_size % 4 != 0))
-        in.fail("invalid bins section size " + std::to_string(out.bins_size));
-    const uint64_t payload = texels * (out.compact ? sizeof(uint32_t) : sizeof(float) + sizeof(Rgb)) + 8 +
-                             (out.bins_size == 0 ? 0 : out.bins_size + 8);
-    const uint64_t left = file_size - out.payload_offset;
-    if (payload > left)
-        in.fail("truncated: payload needs " + std::to_string(payload) + " bytes, " + std::to_string(left) + " left");
-    if (payload < left) in.fail(std::to_string(left - payload) + " bytes of trailing data after the payload");
+    check_payload_size(out, file_size - out.payload_offset, in);
     return out;
 }
 
