@@ -478,6 +478,11 @@ TEST_F(BinnedTableTest, CompactBinnedTablesRebuildTheBinsOverTheRoundedMap) {
     expect_identical_binned_samples(expected, binned_map(read_table(path)), 23, 10000);
 }
 
+TEST_F(BinnedTableTest, AnEmptyBinnedMapIsNotWritten) {
+    EXPECT_THROW(write_table(dir_ / "empty.envmis", BinnedEnvMap(), source_), TableError);
+    EXPECT_FALSE(fs::exists(dir_ / "empty.envmis"));
+}
+
 TEST_F(BinnedTableTest, TablesWithoutBinsHaveNoneAndCannotGiveABinnedMap) {
     const fs::path path = saved_table();
     Table table = read_table(path);

@@ -281,6 +281,12 @@ void write_table(const std::filesystem::path& path, const EnvMap& map, const Tab
 
 void write_table(const std::filesystem::path& path, const BinnedEnvMap& binned, const TableSource& source,
                  TableEncoding encoding) {
+    // Never write what the reader would refuse (a default-constructed BinnedEnvMap has no bins).
+    const BinLayout& layout = binned.layout();
+    const uint32_t g = layout.bins_per_side, classes = static_cast<uint32_t>(layout.lobe_exponents.size());
+    if (g < 1 || g > kMaxBinsPerSide || classes < 1 || classes > kMaxLobeClasses ||
+        layout.choices.size() != size_t{classes} * g * g)
+        throw TableError(path.string() + ": the binned map has no valid bins to write");
     write_map(path, binned.plain(), source, encoding, &binned.layout());
 }
 
