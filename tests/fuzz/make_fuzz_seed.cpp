@@ -41,6 +41,14 @@ int main(int argc, char** argv) {
         plain.axes = envmis::Axes::parse("y-up");
         envmis::write_table(dir / "uncompensated_16x8.envmis", envmis::EnvMap(sky(16, 8), plain), source);
 
+        // Version 4's bins section, after a full and after a compact payload.
+        envmis::BinnedOptions bins;
+        bins.bins_per_side = 2;
+        bins.cell_columns = 4;
+        const envmis::BinnedEnvMap binned(envmis::EnvMap(sky(16, 8), plain), bins);
+        envmis::write_table(dir / "binned_16x8.envmis", binned, source);
+        envmis::write_table(dir / "binned_compact_16x8.envmis", binned, source, envmis::TableEncoding::compact);
+
         // A black map: the uniform fallback.
         envmis::RgbImage black{8, 4, std::vector<envmis::Rgb>(32)};
         envmis::write_table(dir / "black_8x4.envmis", envmis::EnvMap(black), source);
