@@ -33,6 +33,7 @@ void add_map_flags(CLI::App& app, MapFlags& flags) {
            "--alpha",
            [&flags](const std::string& text) {
                flags.alpha_auto = text == "auto";
+               flags.alpha_given = true;
                if (!flags.alpha_auto) flags.alpha = std::strtof(text.c_str(), nullptr);
            },
            "Compensation strength: q = max(L - alpha * mean(L), 0); auto: the candidate with the lowest exact MIS "

@@ -26,8 +26,9 @@ namespace envmis::cli {
 struct MapFlags {
     bool no_compensate = false;
     float alpha = 1.0f;
-    bool alpha_auto = false;  // --alpha auto: choose_alpha() (alpha.h) picks it, map-wide
-    std::string colorspace;   // input colour space; empty: from the file
+    bool alpha_auto = false;   // --alpha auto: choose_alpha() (alpha.h) picks it, map-wide
+    bool alpha_given = false;  // --alpha was on the command line (binned tables default to auto)
+    std::string colorspace;    // input colour space; empty: from the file
     std::string working_space = "lin_rec709";
     std::string axes = "z-up";
     std::string mapping = "equirect";  // or "equal-area" (a square image)

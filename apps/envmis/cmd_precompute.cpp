@@ -64,8 +64,8 @@ void add_precompute_flags(CLI::App& sub, PrecomputeArgs& args) {
         sub.add_option(
                "--bins", args.bins,
                "Normal-aware table: K = g x g bins of normals, each with its own compensation (binned.h); the "
-               "texels keep the plain density. --alpha auto chooses per bin and lobe class, --alpha X (default 1) "
-               "fixes it for every bin, --no-compensate makes it 0")
+               "texels keep the plain density. --alpha auto (the default with --bins) chooses per bin and lobe class, "
+               "--alpha X fixes it for every bin, --no-compensate makes it 0")
             ->type_name("K")
             ->check(square_bins());
     sub.add_option("--cell-columns", args.cell_columns, "With --bins: columns of the bins' cell grid (0: width / 32)")
@@ -86,13 +86,13 @@ void print_precompute(const PrecomputeArgs& args, const LoadedMap& loaded, const
               << loaded.build_ms << " ms, write " << write_ms << " ms\n";
 }
 
-// The bins as the map flags ask: --alpha auto per bin, --alpha X or --no-compensate (0)
-// for every bin.
+// The bins as the map flags ask: --alpha auto per bin (also without --alpha: the choice
+// is what makes bins pay for every BSDF), --alpha X or --no-compensate (0) for every bin.
 BinnedOptions binned_options(const PrecomputeArgs& args) {
     BinnedOptions o;
     o.bins_per_side = static_cast<uint32_t>(std::lround(std::sqrt(static_cast<double>(args.bins))));
     o.cell_columns = args.cell_columns;
-    o.auto_alpha = args.map.alpha_auto && !args.map.no_compensate;
+    o.auto_alpha = (args.map.alpha_auto || !args.map.alpha_given) && !args.map.no_compensate;
     o.alpha = args.map.no_compensate ? 0.0f : args.map.alpha;
     return o;
 }
