@@ -62,6 +62,7 @@ struct Setup {
     std::vector<float> bsdf_alphas;
     CompensatedMaps compensated;
     std::shared_ptr<const BinnedEnvMap> binned;  // with a -bins technique
+    bool bins_auto = false;                      // its alpha chosen per bin
 
     StudyInputs inputs() const { return {plain, compensated, points, options, binned.get()}; }
     float alpha_of(const Bsdf& bsdf) const {
@@ -208,14 +209,17 @@ uint32_t bins_per_side(const CompareArgs& args, std::span<const Technique> techn
     return uses_bins(techniques) ? g : 0;
 }
 
-// The bins of the -bins techniques over a copy of the plain map: alpha chosen per bin
-// unless --alpha fixes it.
+// --alpha X fixes the bins' alpha; without it, or with auto, each bin chooses its own.
+bool bins_auto_alpha(const CompareArgs& args) {
+    return !(args.alpha_flag && args.alpha_flag->count() > 0 && !args.map.alpha_auto);
+}
+
+// The bins of the -bins techniques, over a copy of the plain map.
 std::shared_ptr<const BinnedEnvMap> build_bins(const CompareArgs& args, const EnvMap& plain, uint32_t g) {
     if (g == 0) return nullptr;
     BinnedOptions options;
     options.bins_per_side = g;
-    const bool fixed = args.alpha_flag && args.alpha_flag->count() > 0 && !args.map.alpha_auto;
-    options.auto_alpha = !fixed;
+    options.auto_alpha = bins_auto_alpha(args);
     options.alpha = args.map.alpha;
     return std::make_shared<const BinnedEnvMap>(EnvMap(plain), options);
 }
@@ -263,7 +267,8 @@ Setup prepare(const CompareArgs& args) {
             map_alpha,
             std::move(bsdf_alphas),
             std::move(compensated),
-            std::move(binned)};
+            std::move(binned),
+            bins_auto_alpha(args)};
 }
 
 // A RunControl that shows `label`'s progress on stderr and stops at Ctrl-C.
@@ -360,8 +365,7 @@ std::string header_line(const Setup& s, size_t points_done) {
            << o.allocation.total() << " for single techniques), alpha " << alpha.str() << ", seed " << o.seed
            << ", BSDF albedo " << albedo_text(o.bsdfs);
     if (s.binned)
-        header << ", " << s.binned->bins() << " normal bins (alpha "
-               << (s.binned->choice_seconds() > 0 ? "auto per bin" : "fixed") << ")";
+        header << ", " << s.binned->bins() << " normal bins (alpha " << (s.bins_auto ? "auto per bin" : "fixed") << ")";
     header << "\n";
     return header.str();
 }
@@ -395,6 +399,7 @@ nlohmann::json inputs_json(const Setup& s, size_t points_done) {
                              {"albedo", albedo_json(o.bsdfs)}};
     for (size_t b = 0; b < o.bsdfs.size(); ++b) inputs["bsdf_alpha"][o.bsdfs[b].name()] = s.bsdf_alphas[b];
     if (s.choice) inputs["alpha_choice"] = alpha_choice_json(*s.choice, o.bsdfs);
+    if (s.binned) inputs["bins"] = {{"count", s.binned->bins()}, {"alpha_auto", s.bins_auto}};
     for (size_t i = 0; i < points_done; ++i) {
         const ShadingPoint& p = s.points[i];
         inputs["points"].push_back(
