@@ -1,6 +1,7 @@
 // envmis compare IN: the variance study. Estimates direct lighting on analytic BSDFs with
 // every technique at equal sample count and reports how much MIS compensation gains.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -30,10 +31,14 @@ struct CompareArgs {
                        alpha_sweep;
     RenderOptions render;
     uint32_t spp = 1024, points = 16, threads = 0, env_samples = 1, bsdf_samples = 1, allocation_sweep = 0;
+    uint32_t bins = 0;  // --bins; 0: kDefaultBins where a -bins technique runs
     uint64_t seed = 1;
     bool exact = false;
     MapFlags map;
+    const CLI::Option* alpha_flag = nullptr;  // --alpha: given, it fixes the bins' alpha too
 };
+
+constexpr uint32_t kDefaultBins = 100;
 
 // The limits of the count flags, checked by in_range (cli.h), which refuses a negative value
 // instead of wrapping it.
@@ -56,8 +61,10 @@ struct Setup {
     float map_alpha = 0;
     std::vector<float> bsdf_alphas;
     CompensatedMaps compensated;
+    std::shared_ptr<const BinnedEnvMap> binned;  // with a -bins technique
+    bool bins_auto = false;                      // its alpha chosen per bin
 
-    StudyInputs inputs() const { return {plain, compensated, points, options}; }
+    StudyInputs inputs() const { return {plain, compensated, points, options, binned.get()}; }
     float alpha_of(const Bsdf& bsdf) const {
         for (size_t b = 0; b < options.bsdfs.size(); ++b)
             if (options.bsdfs[b].name() == bsdf.name()) return bsdf_alphas[b];
@@ -98,8 +105,12 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
     sub.add_option(
         "--techniques", args.techniques,
         "Techniques, comma-separated (default: env,bsdf,mis-balance,mis-power,mis-balance-comp,mis-power-comp,"
-        "mis-optimal-comp,mis-optimal-all; all: env,bsdf,mis-{balance,power,optimal,var}[-comp],"
-        "mis-{balance,optimal}-all,one-sample[-comp])");
+        "mis-optimal-comp,mis-optimal-all,mis-{balance,power,optimal}-bins; all: env,bsdf,"
+        "mis-{balance,power,optimal,var}[-comp],mis-{balance,optimal}-all,mis-{balance,power,optimal}-bins,"
+        "one-sample[-comp])");
+    sub.add_option("--bins", args.bins,
+                   "Normal bins K = g*g (1 to 4096; default 100) of the -bins techniques, which sample the bin of "
+                   "each point's normal; alpha per bin by exact variance unless --alpha X fixes it");
     sub.add_option("--spp", args.spp, "Estimates per shading point, BSDF and technique (1 to 2^32-1)")
         ->capture_default_str()
         ->check(in_range(uint32_t{1}, kMaxSpp));
@@ -141,14 +152,14 @@ void add_output_flags(CLI::App& sub, CompareArgs& args) {
 }
 
 void add_sweep_flags(CLI::App& sub, CompareArgs& args) {
-    CLI::Option* alpha_sweep = sub.add_option(
+    sub.add_option(
         "--alpha-sweep", args.alpha_sweep,
         "A0:A1:STEP: the study at every alpha A0, A0+STEP, ..., A1 for the techniques that depend on it (default "
         "mis-balance-comp, mis-power-comp, mis-optimal-comp; mis-balance as the baseline), instead of the normal "
         "table");
     sub.add_flag("--exact", args.exact,
-                 "With --alpha-sweep: also the exact, noise-free variance ratio of mis-balance-comp over mis-balance")
-        ->needs(alpha_sweep);
+                 "Also exact, noise-free variance ratios over mis-balance (quadrature, one subdivision): of every "
+                 "technique with fixed weights, or with --alpha-sweep of mis-balance-comp");
     sub.add_option(
            "--allocation-sweep", args.allocation_sweep,
            "N: the MIS techniques (default mis-balance, mis-balance-comp) at every split n_env:n_bsdf = k:(N-k) "
@@ -188,9 +199,35 @@ ComparisonOptions comparison_options(const CompareArgs& args, std::vector<Techni
     return options;
 }
 
+// g of --bins K = g * g; 0 (no bins) without a -bins technique.
+uint32_t bins_per_side(const CompareArgs& args, std::span<const Technique> techniques) {
+    const uint32_t k = args.bins ? args.bins : (uses_bins(techniques) ? kDefaultBins : 0);
+    const auto g = static_cast<uint32_t>(std::lround(std::sqrt(static_cast<double>(k))));
+    if (g * g != k || (k && g > 64))
+        throw std::runtime_error("--bins " + std::to_string(k) +
+                                 ": expected a square number g*g of normal bins, g 1 to 64 (e.g. 64, 100, 144)");
+    return uses_bins(techniques) ? g : 0;
+}
+
+// --alpha X fixes the bins' alpha; without it, or with auto, each bin chooses its own.
+bool bins_auto_alpha(const CompareArgs& args) {
+    return !(args.alpha_flag && args.alpha_flag->count() > 0 && !args.map.alpha_auto);
+}
+
+// The bins of the -bins techniques, over a copy of the plain map.
+std::shared_ptr<const BinnedEnvMap> build_bins(const CompareArgs& args, const EnvMap& plain, uint32_t g) {
+    if (g == 0) return nullptr;
+    BinnedOptions options;
+    options.bins_per_side = g;
+    options.auto_alpha = bins_auto_alpha(args);
+    options.alpha = args.map.alpha;
+    return std::make_shared<const BinnedEnvMap>(EnvMap(plain), options);
+}
+
 Setup prepare(const CompareArgs& args) {
     std::vector<Technique> requested;
     ComparisonOptions options = comparison_options(args, requested);
+    const uint32_t g = bins_per_side(args, options.techniques);
     std::vector<float> swept = args.alpha_sweep.empty() ? std::vector<float>{} : parse_alpha_sweep(args.alpha_sweep);
     // Each sweep's techniques, checked before any study runs.
     std::vector<Technique> alpha_techniques, allocation_techniques;
@@ -218,6 +255,7 @@ Setup prepare(const CompareArgs& args) {
     const float map_alpha = choice ? choice->alpha : fixed_alpha;
     std::vector<float> bsdf_alphas = choice ? choice->bsdf_alphas : std::vector<float>(options.bsdfs.size(), map_alpha);
     CompensatedMaps compensated = compensated_maps(plain, bsdf_alphas);
+    std::shared_ptr<const BinnedEnvMap> binned = build_bins(args, plain, g);
     return {std::move(map_name),
             std::move(plain),
             std::move(points),
@@ -228,7 +266,9 @@ Setup prepare(const CompareArgs& args) {
             std::move(choice),
             map_alpha,
             std::move(bsdf_alphas),
-            std::move(compensated)};
+            std::move(compensated),
+            std::move(binned),
+            bins_auto_alpha(args)};
 }
 
 // A RunControl that shows `label`'s progress on stderr and stops at Ctrl-C.
@@ -323,7 +363,10 @@ std::string header_line(const Setup& s, size_t points_done) {
            << (s.points.size() == 1 ? " shading point" : " shading points") << ", " << o.spp << " estimates each, "
            << o.allocation.env << " env + " << o.allocation.bsdf << " BSDF samples per estimate ("
            << o.allocation.total() << " for single techniques), alpha " << alpha.str() << ", seed " << o.seed
-           << ", BSDF albedo " << albedo_text(o.bsdfs) << "\n";
+           << ", BSDF albedo " << albedo_text(o.bsdfs);
+    if (s.binned)
+        header << ", " << s.binned->bins() << " normal bins (alpha " << (s.bins_auto ? "auto per bin" : "fixed") << ")";
+    header << "\n";
     return header.str();
 }
 
@@ -356,6 +399,7 @@ nlohmann::json inputs_json(const Setup& s, size_t points_done) {
                              {"albedo", albedo_json(o.bsdfs)}};
     for (size_t b = 0; b < o.bsdfs.size(); ++b) inputs["bsdf_alpha"][o.bsdfs[b].name()] = s.bsdf_alphas[b];
     if (s.choice) inputs["alpha_choice"] = alpha_choice_json(*s.choice, o.bsdfs);
+    if (s.binned) inputs["bins"] = {{"count", s.binned->bins()}, {"alpha_auto", s.bins_auto}};
     for (size_t i = 0; i < points_done; ++i) {
         const ShadingPoint& p = s.points[i];
         inputs["points"].push_back(
@@ -392,6 +436,32 @@ void write_comparison(const CompareArgs& args, const Setup& s, const Comparison&
         write_plot(args, w, "variance_vs_balance.png", variance_chart(c, s.map_name));
 }
 
+// --exact: per BSDF, each fixed-weight technique's exact variance over mis-balance's,
+// the geometric mean over points and the worst point.
+void write_exact(const Setup& s, Written& w) {
+    const StudyInputs inputs = s.inputs();
+    const Technique balance = Technique::parse("mis-balance");
+    std::cout << "exact var/mis: exact variance / that of mis-balance (quadrature, one subdivision), geometric mean "
+                 "over points (worst point)\n";
+    for (size_t b = 0; b < s.options.bsdfs.size(); ++b) {
+        const std::vector<double> baseline = exact_point_variances(inputs, balance, b, 1);
+        std::cout << "  " << s.options.bsdfs[b].name() << ":";
+        for (const Technique& t : s.options.techniques) {
+            if (t.adaptive() || t.mixture) continue;
+            const std::vector<double> v = exact_point_variances(inputs, t, b, 1);
+            double worst = 0;
+            for (size_t p = 0; p < v.size(); ++p)
+                if (v[p] > 0 && baseline[p] > 0) worst = std::max(worst, v[p] / baseline[p]);
+            const double mean = geometric_mean_ratios(v, baseline, 1).front();
+            char text[96];
+            std::snprintf(text, sizeof text, " %s %.3f (%.3f)", t.name().c_str(), mean, worst);
+            std::cout << text;
+            w.json["exact"][s.options.bsdfs[b].name()][t.name()] = {{"ratio", mean}, {"worst", worst}};
+        }
+        std::cout << "\n";
+    }
+}
+
 void write_alpha_sweep(const CompareArgs& args, const Setup& s, const AlphaSweep& sweep, size_t swept, Written& w) {
     const std::vector<float>* auto_alphas = s.choice ? &s.bsdf_alphas : nullptr;
     std::cout << "alpha sweep: " << swept << " values; var/mis: geometric mean over points of "
@@ -426,7 +496,7 @@ void write_allocation_sweep(const CompareArgs& args, const Setup& s, const Alloc
 void write_pictures(const CompareArgs& args, const Setup& s) {
     std::optional<CompensatedMaps> map_wide;
     if (s.choice) map_wide = compensated_maps(s.plain, std::vector<float>{s.map_alpha});
-    const StudyInputs inputs{s.plain, map_wide ? *map_wide : s.compensated, s.points, s.options};
+    const StudyInputs inputs{s.plain, map_wide ? *map_wide : s.compensated, s.points, s.options, s.binned.get()};
     const auto montage = render_comparison(inputs, args.render, args.images, s.map_name, {&interrupted(), {}});
     std::cout << "pictures: " << args.images << " (montage: " << montage.string() << ")\n";
 }
@@ -438,6 +508,7 @@ void write_compare(const CompareArgs& args, const Setup& s, const Outcome& outco
     if (s.choice) print_alpha_choice(std::cout, *s.choice, s.options.bsdfs);
     Written w{{{"inputs", inputs_json(s, points_done)}}, {}, {}};
     if (outcome.comparison) write_comparison(args, s, *outcome.comparison, w);
+    if (outcome.comparison && args.exact && outcome.comparison->points_done == s.points.size()) write_exact(s, w);
     if (outcome.alpha) write_alpha_sweep(args, s, *outcome.alpha, outcome.alphas_swept, w);
     if (outcome.allocation) write_allocation_sweep(args, s, *outcome.allocation, w);
     if ((outcome.alpha || outcome.allocation) && !args.csv.empty()) {
@@ -467,6 +538,7 @@ Subcommand add_compare(CLI::App& app) {
     add_output_flags(*sub, *args);
     add_sweep_flags(*sub, *args);
     add_map_flags(*sub, args->map);
+    args->alpha_flag = sub->get_option("--alpha");
     return {sub, [args] {
                 const Setup setup = prepare(*args);
                 write_compare(*args, setup, run_compare(*args, setup));

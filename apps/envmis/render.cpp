@@ -164,7 +164,8 @@ std::filesystem::path render_comparison(const StudyInputs& inputs, const RenderO
     io::write_exr(folder / "reference.exr", reference);
     std::vector<std::pair<std::string, RgbImage>> renders;
     for (const Technique& t : options.techniques) {
-        const DirectLightingEstimator estimator(inputs.plain, compensated, t, options.allocation);
+        const DirectLightingEstimator estimator =
+            study_estimator(inputs.plain, compensated, inputs.binned, t, options.allocation);
         renders.emplace_back(t.name(), render(scene, estimator, options.bsdfs, render_options.spp, options.seed,
                                               options.threads, control.stop));
         io::write_exr(folder / (t.name() + ".exr"), renders.back().second);

@@ -159,5 +159,37 @@ TEST(Compare, BsdfAlbedoIsShownAndSet) {
     fs::remove_all(dir);
 }
 
+// --bins takes a square number of normal bins; anything else fails with one line naming
+// the flag, before any study.
+TEST(Compare, BinsThatAreNotASquareNumberAreRefused) {
+    const fs::path dir = small_map_folder("envmis_compare_bins_test");
+    for (const std::string value : {"50", "2", "4097"}) {
+        const CliRun r = run_compare(dir, "--bins " + value + " --points 1 --spp 1 --techniques mis-balance-bins");
+        EXPECT_NE(r.exit_code, 0) << value << "\n" << r.out;
+        EXPECT_NE(r.out.find("--bins " + value + ": expected a square number"), std::string::npos) << r.out;
+        EXPECT_EQ(r.out.find("envmis compare:"), std::string::npos) << "--bins " << value << " started a run";
+    }
+    fs::remove_all(dir);
+}
+
+// The -bins techniques run through the table, the JSON and --exact, whose ratio of
+// mis-balance over itself is 1 and whose -bins ratio is a positive number.
+TEST(Compare, BinsTechniquesAreReportedWithTheirExactRatios) {
+    const fs::path dir = small_map_folder("envmis_compare_bins_run_test");
+    const CliRun r = run_compare(dir,
+                                 "--bins 16 --points 3 --spp 256 --bsdf lambert,ggx:0.1 --exact --json r.json "
+                                 "--techniques mis-balance,mis-balance-bins,mis-power-bins,mis-optimal-bins");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    EXPECT_NE(r.out.find("16 normal bins (alpha auto per bin)"), std::string::npos) << r.out;
+    const nlohmann::json results = nlohmann::json::parse(std::ifstream(dir / "r.json"));
+    EXPECT_EQ(results["results"].size(), 8u);
+    for (const char* bsdf : {"lambert", "ggx:0.1"}) {
+        EXPECT_DOUBLE_EQ(results["exact"][bsdf]["mis-balance"]["ratio"].get<double>(), 1.0);
+        EXPECT_GT(results["exact"][bsdf]["mis-balance-bins"]["ratio"].get<double>(), 0.0);
+        EXPECT_FALSE(results["exact"][bsdf].contains("mis-optimal-bins")) << "optimal MIS has no exact variance";
+    }
+    fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace envmis

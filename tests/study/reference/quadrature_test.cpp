@@ -78,5 +78,25 @@ TEST(Quadrature, ExactVarianceMatchesMeasuredVariance) {
         }
 }
 
+// The exact variance of a -bins technique is that of the bin the point picks: a normal
+// facing up and one facing down (another bin, another compensation) on the same map.
+TEST(Quadrature, ExactVarianceOfBinnedMisMatchesMeasuredVariance) {
+    const RgbImage image = test::random_map(64, 32, 3, 1.5f);
+    const BinnedEnvMap binned{EnvMap(image, plain())};
+    const Technique t = Technique::parse("mis-balance-bins");
+    const DirectLightingEstimator estimator(binned, t);
+    for (const ShadingPoint& p : {ShadingPoint{normalize(Vec3{0.1f, 0.2f, 1}), normalize(Vec3{0.5f, 0, 1})},
+                                  ShadingPoint{normalize(Vec3{0.3f, -0.2f, -1}), normalize(Vec3{0, 0.4f, -1})}})
+        for (const Bsdf& bsdf : {Bsdf::lambert(), Bsdf::phong(20)}) {
+            Pcg32 rng(11);
+            RunningStats stats;
+            for (int i = 0; i < 400000; ++i) stats.add(luminance(estimator.estimate(p, bsdf, rng), {}));
+            const double exact = exact_variance(binned, t, {}, bsdf, p, 8);
+            EXPECT_NEAR(stats.variance(), exact, 0.03 * exact) << bsdf.name() << " normal.z=" << p.normal.z;
+        }
+    // The plain map's overload refuses a -bins technique rather than use the wrong density.
+    EXPECT_THROW(exact_variance(binned.plain(), t, {}, Bsdf::lambert(), {}, 1), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace envmis

@@ -40,8 +40,9 @@ double relative_standard_error(const Cell& c) {
 
 std::vector<Technique> ComparisonOptions::default_techniques() {
     std::vector<Technique> t;
-    for (const char* name : {"env", "bsdf", "mis-balance", "mis-power", "mis-balance-comp", "mis-power-comp",
-                             "mis-optimal-comp", "mis-optimal-all"})
+    for (const char* name :
+         {"env", "bsdf", "mis-balance", "mis-power", "mis-balance-comp", "mis-power-comp", "mis-optimal-comp",
+          "mis-optimal-all", "mis-balance-bins", "mis-power-bins", "mis-optimal-bins"})
         t.push_back(Technique::parse(name));
     return t;
 }
@@ -78,16 +79,44 @@ Rgb average_estimate(const DirectLightingEstimator& estimator, const ShadingPoin
     return {static_cast<float>(r / spp), static_cast<float>(g / spp), static_cast<float>(b / spp)};
 }
 
+bool uses_bins(std::span<const Technique> techniques) {
+    return std::any_of(techniques.begin(), techniques.end(), [](const Technique& t) { return t.bins; });
+}
+
+DirectLightingEstimator study_estimator(const EnvMap& plain, const EnvMap& compensated, const BinnedEnvMap* binned,
+                                        const Technique& technique, Allocation allocation) {
+    if (!technique.bins) return {plain, compensated, technique, allocation};
+    if (!binned) throw std::invalid_argument(technique.name() + ": the study has no binned map");
+    return {*binned, technique, allocation};
+}
+
+std::vector<double> exact_point_variances(const StudyInputs& inputs, const Technique& technique, size_t bsdf,
+                                          int subdivisions) {
+    const Bsdf& b = inputs.options.bsdfs.at(bsdf);
+    if (technique.bins && !inputs.binned)
+        throw std::invalid_argument("exact_point_variances: " + technique.name() + " needs the binned map");
+    const EnvMap& sampled =
+        technique.compensated ? inputs.compensated.maps.at(inputs.compensated.of_bsdf.at(bsdf)) : inputs.plain;
+    std::vector<double> variances;
+    for (const ShadingPoint& point : inputs.points)
+        variances.push_back(
+            technique.bins
+                ? exact_variance(*inputs.binned, technique, inputs.options.allocation, b, point, subdivisions)
+                : exact_variance(sampled, technique, inputs.options.allocation, b, point, subdivisions));
+    return variances;
+}
+
 namespace {
 
 // The study with one compensated map for every BSDF.
-Comparison compare_one(const EnvMap& plain, const EnvMap& compensated, std::span<const ShadingPoint> points,
-                       const ComparisonOptions& options, const std::atomic<bool>* stop,
-                       const std::function<void(size_t, size_t)>& progress) {
+Comparison compare_one(const EnvMap& plain, const EnvMap& compensated, const BinnedEnvMap* binned,
+                       std::span<const ShadingPoint> points, const ComparisonOptions& options,
+                       const std::atomic<bool>* stop, const std::function<void(size_t, size_t)>& progress) {
     if (options.bsdfs.empty() || options.techniques.empty() || options.spp == 0 || points.empty())
         throw std::invalid_argument("compare: needs at least one BSDF, technique, shading point and sample");
     std::vector<DirectLightingEstimator> estimators;
-    for (const Technique& t : options.techniques) estimators.emplace_back(plain, compensated, t, options.allocation);
+    for (const Technique& t : options.techniques)
+        estimators.push_back(study_estimator(plain, compensated, binned, t, options.allocation));
     const size_t nb = options.bsdfs.size(), nt = options.techniques.size();
     const uint32_t threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
     const LumaCoefficients luma = plain.options().luma;
@@ -210,6 +239,10 @@ Comparison compare(const StudyInputs& inputs, const RunControl& control) {
     if (inputs.compensated.of_bsdf.size() != options.bsdfs.size())
         throw std::invalid_argument("compare: needs one compensated map per BSDF");
     const size_t runs = inputs.compensated.maps.size();
+    // Callers that only name the techniques get the default bins.
+    std::optional<BinnedEnvMap> own_bins;
+    if (!inputs.binned && uses_bins(options.techniques)) own_bins.emplace(EnvMap(inputs.plain));
+    const BinnedEnvMap* binned = inputs.binned ? inputs.binned : (own_bins ? &*own_bins : nullptr);
     std::vector<std::optional<BsdfComparison>> slots(options.bsdfs.size());
     Comparison merged{{}, inputs.points.size(), inputs.points.size()};
     for (size_t m = 0; m < runs; ++m) {
@@ -222,8 +255,8 @@ Comparison compare(const StudyInputs& inputs, const RunControl& control) {
         std::vector<size_t> slot;
         for (size_t b = 0; b < options.bsdfs.size(); ++b)
             if (inputs.compensated.of_bsdf[b] == m) run.bsdfs.push_back(options.bsdfs[b]), slot.push_back(b);
-        const Comparison c = compare_one(inputs.plain, inputs.compensated.maps[m], inputs.points, run, control.stop,
-                                         [&](size_t done, size_t total) {
+        const Comparison c = compare_one(inputs.plain, inputs.compensated.maps[m], binned, inputs.points, run,
+                                         control.stop, [&](size_t done, size_t total) {
                                              if (control.progress) control.progress(m * total + done, runs * total);
                                          });
         merged.points_done = std::min(merged.points_done, c.points_done);

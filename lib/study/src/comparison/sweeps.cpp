@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 #include "envmis/study/comparison/alpha.h"
@@ -80,7 +81,7 @@ std::vector<Technique> alpha_sweep_techniques(std::span<const Technique> request
         return list;
     }
     for (const Technique& t : requested)
-        if (t.compensated) add_unique(list, t);
+        if (t.compensated || t.bins) add_unique(list, t);
     return list;
 }
 
@@ -95,7 +96,16 @@ AlphaSweep run_alpha_sweep(const StudyInputs& inputs, std::span<const float> alp
     for (size_t i = 0; i < alphas.size(); ++i) {
         const CompensatedMaps compensated =
             compensated_maps(inputs.plain, std::vector<float>(options.bsdfs.size(), alphas[i]));
-        Comparison c = compare({inputs.plain, compensated, points, sweep_options(options)},
+        // The bins at the same fixed alpha, in the layout of the study's own.
+        std::optional<BinnedEnvMap> binned;
+        if (uses_bins(options.techniques)) {
+            BinnedOptions bins;
+            if (inputs.binned) bins.bins_per_side = inputs.binned->layout().bins_per_side;
+            bins.auto_alpha = false;
+            bins.alpha = alphas[i];
+            binned.emplace(EnvMap(inputs.plain), bins);
+        }
+        Comparison c = compare({inputs.plain, compensated, points, sweep_options(options), binned ? &*binned : nullptr},
                                run_control(control, i, alphas.size(), points.size()));
         if (c.points_done < points.size() || control.stopped()) {
             sweep.interrupted = true;

@@ -113,8 +113,13 @@ QuadratureResult reflected_radiance(const EnvMap& map, const Bsdf& bsdf, const S
     return result;
 }
 
-double exact_variance(const EnvMap& env, Technique technique, Allocation allocation, const Bsdf& bsdf,
-                      const ShadingPoint& point, int subdivisions) {
+namespace {
+
+// exact_variance with the environment technique's density `env_pdf(uv)` and the
+// radiance of `env`.
+template <class EnvPdf>
+double exact_variance_with(const EnvMap& env, EnvPdf&& env_pdf, Technique technique, Allocation allocation,
+                           const Bsdf& bsdf, const ShadingPoint& point, int subdivisions) {
     // First and second moments of the weighted contributions of each sampling technique.
     struct Moments {
         double env1 = 0, env2 = 0, bsdf1 = 0, bsdf2 = 0;
@@ -137,7 +142,7 @@ double exact_variance(const EnvMap& env, Technique technique, Allocation allocat
     const Moments m = integrate<Moments>(env, point, subdivisions, [&](Moments& acc, const Node& n) {
         const double f = luminance(multiply(n.radiance, bsdf.eval(wo, n.wi)), luma);
         if (f == 0) return;
-        const double p_env = env.pdf_uv(n.uv), p_bsdf = bsdf.pdf(wo, n.wi);
+        const double p_env = env_pdf(n.uv), p_bsdf = bsdf.pdf(wo, n.wi);
         if (strategy == Strategy::one_sample) {
             // total() draws z = f / Q from the mixture Q / total: the estimate's variance
             // is integral f^2 / Q - (integral f)^2 / total. Kept in the env moments.
@@ -164,6 +169,26 @@ double exact_variance(const EnvMap& env, Technique technique, Allocation allocat
     if (n_env > 0) variance += (m.env2 - m.env1 * m.env1) / n_env;
     if (n_bsdf > 0) variance += (m.bsdf2 - m.bsdf1 * m.bsdf1) / n_bsdf;
     return variance;
+}
+
+}  // namespace
+
+double exact_variance(const EnvMap& env, Technique technique, Allocation allocation, const Bsdf& bsdf,
+                      const ShadingPoint& point, int subdivisions) {
+    if (technique.bins)
+        throw std::invalid_argument("exact_variance: " + technique.name() + " samples a binned map: pass it");
+    return exact_variance_with(
+        env, [&](Vec2 uv) { return env.pdf_uv(uv); }, technique, allocation, bsdf, point, subdivisions);
+}
+
+double exact_variance(const BinnedEnvMap& binned, Technique technique, Allocation allocation, const Bsdf& bsdf,
+                      const ShadingPoint& point, int subdivisions) {
+    if (!technique.bins)
+        throw std::invalid_argument("exact_variance: " + technique.name() + " does not sample a binned map");
+    const BinnedEnvMapView view = binned.view();
+    const BinView bin = view.bin(point.normal, binned.lobe_class(bsdf.phong_exponent()));
+    return exact_variance_with(
+        binned.plain(), [&](Vec2 uv) { return bin.pdf_uv(uv); }, technique, allocation, bsdf, point, subdivisions);
 }
 
 }  // namespace envmis

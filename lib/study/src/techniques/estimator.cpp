@@ -28,6 +28,9 @@ constexpr Technique kAll[] = {
     {Strategy::mis, Heuristic::variance_aware, true},
     {Strategy::mis, Heuristic::balance, true, true},
     {Strategy::mis, Heuristic::optimal, true, true},
+    {Strategy::mis, Heuristic::balance, false, false, true},
+    {Strategy::mis, Heuristic::power, false, false, true},
+    {Strategy::mis, Heuristic::optimal, false, false, true},
     {Strategy::one_sample},
     {Strategy::one_sample, Heuristic::balance, true},
 };
@@ -104,6 +107,28 @@ float fixed_weight(const Technique& t, const float* q, int k) noexcept {
     return 0;
 }
 
+// The lanes' batch sampling and lookups: the map's batch functions, or single calls for
+// a bin (one point's density, which the batch functions' layout does not cover).
+void sample_lanes(const EnvMapView& env, PointArrays u, SampleArrays out, uint32_t n) noexcept {
+    sample_many(env, u, out, n);
+}
+void sample_lanes(const BinView& env, PointArrays u, SampleArrays out, uint32_t n) noexcept {
+    for (uint32_t l = 0; l < n; ++l) {
+        const EnvSample e = env.sample({u.x[l], u.y[l]});
+        out.x[l] = e.direction.x, out.y[l] = e.direction.y, out.z[l] = e.direction.z, out.pdf[l] = e.pdf;
+        out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b;
+    }
+}
+void lookup_lanes(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
+    lookup_many(env, in, out, n);
+}
+void lookup_lanes(const BinView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
+    for (uint32_t l = 0; l < n; ++l) {
+        const EnvMapView::Lookup e = env.lookup({in.x[l], in.y[l], in.z[l]});
+        out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b, out.pdf[l] = e.pdf;
+    }
+}
+
 // Estimates side by side, for the fixed-weight techniques over one density.
 constexpr uint32_t kLanes = 32;
 constexpr uint32_t kMaxLaneSamples = 8;  // per estimate; estimates that spend more go one at a time
@@ -125,10 +150,9 @@ bool runs_in_lanes(const Technique& t, const Allocation& a) noexcept {
 // (estimator_simd.h): the lanes are then padded to a multiple of eight with valid
 // points, whose results are dropped. See docs/performance-log.md for what each step
 // gained. kMaxLanes sizes the working arrays, which one estimate alone must not pay for.
-template <uint32_t kMaxLanes, BsdfKind K>
-[[gnu::flatten]] void estimate_lanes_of(const EnvMapView& env, const Technique& t, const Allocation& a,
-                                        const Frame& frame, Vec3 wo, Bsdf bsdf, Pcg32& rng,
-                                        std::span<Rgb> out) noexcept {
+template <uint32_t kMaxLanes, BsdfKind K, class Env>
+[[gnu::flatten]] void estimate_lanes_of(const Env& env, const Technique& t, const Allocation& a, const Frame& frame,
+                                        Vec3 wo, Bsdf bsdf, Pcg32& rng, std::span<Rgb> out) noexcept {
     bsdf.kind = K;
     const Counts counts = sample_counts(t, a);
     const auto n_env = static_cast<uint32_t>(counts.n[0]), n_bsdf = static_cast<uint32_t>(counts.n[1]);
@@ -173,7 +197,7 @@ template <uint32_t kMaxLanes, BsdfKind K>
             x[0] = e.direction.x, y[0] = e.direction.y, z[0] = e.direction.z, pdf[0] = e.pdf;
             r[0] = e.radiance.r, g[0] = e.radiance.g, bl[0] = e.radiance.b;
         } else {
-            sample_many(env, {u_x[j], u_y[j]}, {x, y, z, pdf, r, g, bl}, padded);
+            sample_lanes(env, {u_x[j], u_y[j]}, {x, y, z, pdf, r, g, bl}, padded);
         }
         if (simd_lambert) {
 #ifdef ENVMIS_AVX2_BATCHES
@@ -205,15 +229,15 @@ template <uint32_t kMaxLanes, BsdfKind K>
             const EnvMapView::Lookup e = env.lookup({x[0], y[0], z[0]});
             r[0] = e.radiance.r, g[0] = e.radiance.g, bl[0] = e.radiance.b, pdf[0] = e.pdf;
         } else {
-            lookup_many(env, {x, y, z}, {r, g, bl, pdf}, padded);
+            lookup_lanes(env, {x, y, z}, {r, g, bl, pdf}, padded);
         }
         add_lanes(1);
     }
     for (uint32_t l = 0; l < lanes; ++l) out[l] = {sum_r[l], sum_g[l], sum_b[l]};
 }
 
-template <uint32_t kMaxLanes>
-void estimate_lanes(const EnvMapView& env, const Technique& t, const Allocation& a, const Frame& frame, Vec3 wo,
+template <uint32_t kMaxLanes, class Env>
+void estimate_lanes(const Env& env, const Technique& t, const Allocation& a, const Frame& frame, Vec3 wo,
                     const Bsdf& bsdf, Pcg32& rng, std::span<Rgb> out) noexcept {
     switch (bsdf.kind) {
         case BsdfKind::lambert:
@@ -241,7 +265,7 @@ std::vector<Technique> Technique::all() { return {std::begin(kAll), std::end(kAl
 
 // The heuristic only matters to MIS, and compensation only to environment sampling.
 std::string Technique::name() const {
-    const std::string suffix = mixture ? "-all" : (compensated ? "-comp" : "");
+    const std::string suffix = mixture ? "-all" : (compensated ? "-comp" : (bins ? "-bins" : ""));
     switch (strategy) {
         case Strategy::env: return "env" + suffix;
         case Strategy::bsdf: return "bsdf";
@@ -251,13 +275,10 @@ std::string Technique::name() const {
     return "unknown";
 }
 
-DirectLightingEstimator::DirectLightingEstimator(const EnvMap& plain, const EnvMap& compensated, Technique technique,
-                                                 Allocation allocation)
-    : env_((technique.compensated ? compensated : plain).view()),
-      other_(plain.view()),
-      luma_(plain.options().luma),
-      technique_(technique),
-      allocation_(allocation) {
+namespace {
+
+// The sample counts every estimator is refused for.
+void check_allocation(const Technique& technique, const Allocation& allocation) {
     if (allocation.total() == 0) throw std::invalid_argument("an estimate needs at least one sample");
     if (allocation.env > std::numeric_limits<uint32_t>::max() - allocation.bsdf)
         throw std::invalid_argument("too many samples per estimate: " + std::to_string(allocation.env) + " + " +
@@ -266,6 +287,19 @@ DirectLightingEstimator::DirectLightingEstimator(const EnvMap& plain, const EnvM
     if (both && (allocation.env == 0 || allocation.bsdf == 0))
         throw std::invalid_argument(technique.name() +
                                     " needs at least one environment and one BSDF sample per estimate");
+}
+
+}  // namespace
+
+DirectLightingEstimator::DirectLightingEstimator(const EnvMap& plain, const EnvMap& compensated, Technique technique,
+                                                 Allocation allocation)
+    : env_((technique.compensated ? compensated : plain).view()),
+      other_(plain.view()),
+      luma_(plain.options().luma),
+      technique_(technique),
+      allocation_(allocation) {
+    check_allocation(technique, allocation);
+    if (technique.bins) throw std::invalid_argument(technique.name() + " samples a binned map: pass a BinnedEnvMap");
     const EnvMap& sampled = technique.compensated ? compensated : plain;
     if (technique.strategy == Strategy::env && !sampled.complete())
         throw std::invalid_argument(
@@ -280,14 +314,38 @@ DirectLightingEstimator::DirectLightingEstimator(const EnvMap& env, Technique te
         throw std::invalid_argument(technique.name() + " samples both the plain and the compensated map: pass both");
 }
 
+DirectLightingEstimator::DirectLightingEstimator(const BinnedEnvMap& binned, Technique technique, Allocation allocation)
+    : env_(binned.plain().view()),
+      other_(env_),
+      luma_(binned.plain().options().luma),
+      technique_(technique),
+      allocation_(allocation),
+      binned_(&binned),
+      binned_view_(binned.view()) {
+    check_allocation(technique, allocation);
+    if (!technique.bins || technique.strategy != Strategy::mis)
+        throw std::invalid_argument(technique.name() + " does not sample a binned map (expected mis-*-bins)");
+}
+
+BinView DirectLightingEstimator::bin_of(const ShadingPoint& point, const Bsdf& bsdf) const noexcept {
+    return binned_view_.bin(point.normal, binned_->lobe_class(bsdf.phong_exponent()));
+}
+
 Rgb DirectLightingEstimator::estimate(const ShadingPoint& point, const Bsdf& bsdf, Pcg32& rng,
                                       PointState& state) const noexcept {
+    if (technique_.bins) return estimate_with(bin_of(point, bsdf), point, bsdf, rng, state);
+    return estimate_with(env_, point, bsdf, rng, state);
+}
+
+template <class Env>
+Rgb DirectLightingEstimator::estimate_with(const Env& env, const ShadingPoint& point, const Bsdf& bsdf, Pcg32& rng,
+                                           PointState& state) const noexcept {
     const Frame frame = Frame::from_normal(point.normal);
     const Vec3 wo = frame.to_local(point.wo);
     const Technique t = technique_;
     if (runs_in_lanes(t, allocation_)) {
         Rgb sum;
-        estimate_lanes<1>(env_, t, allocation_, frame, wo, bsdf, rng, {&sum, 1});
+        estimate_lanes<1>(env, t, allocation_, frame, wo, bsdf, rng, {&sum, 1});
         return sum;
     }
     const Strategy s = t.strategy;
@@ -335,10 +393,11 @@ Rgb DirectLightingEstimator::estimate(const ShadingPoint& point, const Bsdf& bsd
     auto sample_env = [&] {
         // The mixture draws from either density with probability 1/2.
         const bool from_plain = t.mixture && rng.uniform() < 0.5f;
-        const EnvSample e = (from_plain ? other_ : env_).sample(rng.uniform2());
+        const Vec2 u = rng.uniform2();
+        const EnvSample e = from_plain ? other_.sample(u) : env.sample(u);
         if (!(e.pdf > 0)) return;
         const Vec3 wi = frame.to_local(e.direction);
-        const float p_second = t.mixture ? (from_plain ? env_ : other_).pdf(e.direction) : 0.0f;
+        const float p_second = t.mixture ? (from_plain ? env.pdf(e.direction) : other_.pdf(e.direction)) : 0.0f;
         const float p_plain = from_plain ? e.pdf : p_second, p_comp = from_plain ? p_second : e.pdf;
         const float p[2] = {t.mixture ? 0.5f * (p_plain + p_comp) : e.pdf, bsdf.pdf(wo, wi)};
         const float c[3] = {t.mixture ? p_plain : p[0], t.mixture ? p_comp : p[1], p[1]};
@@ -348,7 +407,7 @@ Rgb DirectLightingEstimator::estimate(const ShadingPoint& point, const Bsdf& bsd
         const BsdfSample b = bsdf.sample(wo, rng.uniform2());
         if (!(b.pdf > 0)) return;
         const Vec3 wi = frame.to_world(b.wi);
-        const EnvMapView::Lookup e = env_.lookup(wi);
+        const EnvMapView::Lookup e = env.lookup(wi);
         const float p_plain = t.mixture ? other_.pdf(wi) : 0.0f;
         const float p[2] = {t.mixture ? 0.5f * (p_plain + e.pdf) : e.pdf, b.pdf};
         const float c[3] = {t.mixture ? p_plain : p[0], t.mixture ? e.pdf : p[1], p[1]};
@@ -381,9 +440,15 @@ void DirectLightingEstimator::estimate(const ShadingPoint& point, const Bsdf& bs
     }
     const Frame frame = Frame::from_normal(point.normal);
     const Vec3 wo = frame.to_local(point.wo);
-    for (size_t first = 0; first < out.size(); first += kLanes)
-        estimate_lanes<kLanes>(env_, technique_, allocation_, frame, wo, bsdf, rng,
-                               out.subspan(first, std::min<size_t>(kLanes, out.size() - first)));
+    auto run = [&](const auto& env) {
+        for (size_t first = 0; first < out.size(); first += kLanes)
+            estimate_lanes<kLanes>(env, technique_, allocation_, frame, wo, bsdf, rng,
+                                   out.subspan(first, std::min<size_t>(kLanes, out.size() - first)));
+    };
+    if (technique_.bins)
+        run(bin_of(point, bsdf));
+    else
+        run(env_);
 }
 
 }  // namespace envmis

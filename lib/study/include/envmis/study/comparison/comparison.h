@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"
 #include "envmis/study/reference/quadrature.h"
 #include "envmis/study/shading/bsdf.h"
@@ -93,14 +94,33 @@ CompensatedMaps compensated_maps(const EnvMap& plain, std::span<const float> bsd
 
 // What a study runs on: the same map without compensation (`plain`, sampled by the
 // techniques that do not compensate, and the quadrature references' radiance) and with
-// it (`compensated`, each BSDF's own), the shading points and the options. The maps and
-// points are borrowed: they must outlive the call.
+// it (`compensated`, each BSDF's own), the shading points and the options; `binned`, the
+// normal-aware bins over `plain` that the -bins techniques sample (built from `plain`
+// with BinnedOptions{} where they are asked for and it is null). The maps and points are
+// borrowed: they must outlive the call.
 struct StudyInputs {
     const EnvMap& plain;
     const CompensatedMaps& compensated;
     std::span<const ShadingPoint> points;
     ComparisonOptions options;
+    const BinnedEnvMap* binned = nullptr;
 };
+
+// True if one of `techniques` samples a binned map.
+bool uses_bins(std::span<const Technique> techniques);
+
+// The estimator of `technique` in a study: over `binned` for a -bins technique (which
+// then must not be null), else over `plain` and `compensated`. Throws as
+// DirectLightingEstimator does, and std::invalid_argument for bins without a map.
+DirectLightingEstimator study_estimator(const EnvMap& plain, const EnvMap& compensated, const BinnedEnvMap* binned,
+                                        const Technique& technique, Allocation allocation);
+
+// The exact variance (quadrature.h, `subdivisions`) of one estimate by `technique` at
+// every point for BSDF number `bsdf` of inputs.options, over the map it samples (the
+// BSDF's compensated map, the plain map or inputs.binned, which a -bins technique
+// needs). Throws std::invalid_argument as exact_variance does.
+std::vector<double> exact_point_variances(const StudyInputs& inputs, const Technique& technique, size_t bsdf,
+                                          int subdivisions);
 
 // How a long run is watched and stopped: `stop` is checked between points (the run
 // returns what is done); `progress(done, total)` is called after each point, in units

@@ -45,8 +45,8 @@ struct AlphaSweep {
 };
 
 // The techniques an alpha sweep runs: mis-balance, mis-balance-comp and those of
-// `requested` that sample a compensated density; by default (`requested` empty) also
-// mis-power-comp and mis-optimal-comp.
+// `requested` that sample a compensated density or bins (at the sweep's fixed alpha); by default (`requested` empty)
+// also mis-power-comp and mis-optimal-comp.
 std::vector<Technique> alpha_sweep_techniques(std::span<const Technique> requested);
 
 // Runs inputs.options.techniques (see alpha_sweep_techniques) at every alpha, each with

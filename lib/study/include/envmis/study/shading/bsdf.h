@@ -55,6 +55,13 @@ struct Bsdf {
     std::string albedo_text() const;
     // The reflectance of lambert(), phong() and ggx() when none is given.
     static Rgb default_reflectance(BsdfKind kind);
+    // The lobe's sharpness as a Phong exponent (BinnedEnvMap::lobe_class): 0 for Lambert,
+    // n for Phong, 2 / alpha^2 - 2 for GGX (the Phong lobe of the same width; Walter et
+    // al. 2007).
+    float phong_exponent() const noexcept {
+        if (kind == BsdfKind::phong) return exponent;
+        return kind == BsdfKind::ggx ? max(0.0f, 2 / (alpha * alpha) - 2) : 0.0f;
+    }
 
     ENVMIS_HD Rgb eval(Vec3 wo, Vec3 wi) const noexcept;
     ENVMIS_HD float pdf(Vec3 wo, Vec3 wi) const noexcept;

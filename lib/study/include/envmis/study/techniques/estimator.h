@@ -22,6 +22,11 @@
 // A compensated density is zero where the radiance is not (envmap.h): sampling it
 // alone is biased, so an environment-only technique over an incomplete map is refused
 // at construction. Under MIS the BSDF technique covers what it leaves out.
+//
+// The -bins techniques sample a normal-aware density (sampling/binned.h): per estimate
+// call, the shading point's normal and the BSDF's lobe class pick one bin, whose density
+// both draws the environment samples and weighs the BSDF samples, so the MIS weights
+// match what was drawn.
 #pragma once
 
 #include <cstdint>
@@ -31,6 +36,7 @@
 #include <vector>
 
 #include "envmis/math/random.h"
+#include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"
 #include "envmis/study/shading/bsdf.h"
 #include "envmis/study/weights/mis_weights.h"
@@ -48,10 +54,14 @@ struct Technique {
     // compensated density (-all); optimal MIS then takes all three densities (plain,
     // compensated, BSDF) as control variates: a 3 x 3 system.
     bool mixture = false;
+    // The environment technique samples the bin of a BinnedEnvMap that the point's
+    // normal and the BSDF's lobe class pick (MIS only).
+    bool bins = false;
 
     // Names: env, env-comp, bsdf, mis-balance, mis-power, mis-optimal, mis-var, each
     // MIS name also with -comp, mis-balance-all and mis-optimal-all (the mixture),
-    // one-sample and one-sample-comp. Throws std::invalid_argument for other text.
+    // mis-balance-bins, mis-power-bins and mis-optimal-bins, one-sample and
+    // one-sample-comp. Throws std::invalid_argument for other text.
     static Technique parse(std::string_view name);
     static std::vector<Technique> all();
     std::string name() const;
@@ -109,6 +119,9 @@ public:
     // The same for a technique that needs one map (not the mixture): `env` is the map
     // it samples, plain or compensated.
     DirectLightingEstimator(const EnvMap& env, Technique technique, Allocation allocation = {});
+    // A -bins technique over `binned`, which must outlive the estimator. Throws
+    // std::invalid_argument for a technique without bins, and as above.
+    DirectLightingEstimator(const BinnedEnvMap& binned, Technique technique, Allocation allocation = {});
 
     // One estimate of L_o (RGB radiance), from allocation.total() samples drawn with
     // rng; adaptive techniques read and update `state`, the point's. noexcept and
@@ -122,7 +135,7 @@ public:
 
     // out.size() estimates at one point, the same as that many calls of the above in
     // a row (bit-identical, the same random numbers). The techniques with fixed weights
-    // (env, bsdf, mis-balance, mis-power, compensated or not) with at most 8 samples
+    // (env, bsdf, mis-balance, mis-power; plain, compensated or binned) with at most 8 samples
     // per estimate run up to 32 estimates side by side: the shading frame is built
     // once, and each step runs over all of them before the next, so their cache misses
     // overlap instead of following one another; on x86-64 CPUs with AVX2, eight of them
@@ -136,11 +149,19 @@ public:
     Allocation allocation() const noexcept { return allocation_; }
 
 private:
+    // The estimate with the environment density `env` (the map's, or a point's bin).
+    template <class Env>
+    Rgb estimate_with(const Env& env, const ShadingPoint& point, const Bsdf& bsdf, Pcg32& rng,
+                      PointState& state) const noexcept;
+    BinView bin_of(const ShadingPoint& point, const Bsdf& bsdf) const noexcept;
+
     EnvMapView env_;    // the sampled density
     EnvMapView other_;  // the plain density, which the mixture also samples
     LumaCoefficients luma_;
     Technique technique_;
     Allocation allocation_;
+    const BinnedEnvMap* binned_ = nullptr;  // with technique_.bins
+    BinnedEnvMapView binned_view_;
 };
 
 }  // namespace envmis

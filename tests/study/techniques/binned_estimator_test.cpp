@@ -1,0 +1,126 @@
+// Specification of the -bins techniques (estimator.h over sampling/binned.h): unbiased
+// against the quadrature reference for every lobe class and for normals on both
+// hemispheres, on a synthetic sun map and real maps; a batch of estimates equals the same
+// estimates one at a time; and only a binned map is accepted.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "envmis/io/image_io.h"
+#include "envmis/study/reference/quadrature.h"
+#include "envmis/study/statistics/statistics.h"
+#include "envmis/study/techniques/estimator.h"
+#include "maps.h"
+
+namespace envmis {
+namespace {
+
+EnvMap plain_map(const RgbImage& image, LumaCoefficients luma = {}) {
+    EnvMapOptions o;
+    o.luma = luma;
+    o.compensation.enabled = false;
+    return EnvMap(image, o);
+}
+
+EnvMap load_plain(const std::string& file) {
+    const io::LoadedImage image = io::load_image(std::string(ENVMIS_DATA_DIR) + "/envmaps/" + file);
+    return plain_map(image.image, image.luma);
+}
+
+std::vector<Technique> bins_techniques() {
+    std::vector<Technique> t;
+    for (const Technique& technique : Technique::all())
+        if (technique.bins) t.push_back(technique);
+    return t;
+}
+
+// Up, sideways, oblique and facing down (the lower hemisphere's bins), each seen off-axis.
+std::vector<ShadingPoint> points() {
+    return {{{0, 0, 1}, normalize(Vec3{0.3f, 0.2f, 1})},
+            {normalize(Vec3{0.7f, -0.2f, 0.3f}), normalize(Vec3{0.4f, 0.5f, 0.6f})},
+            {normalize(Vec3{-0.5f, 0.6f, 0.1f}), normalize(Vec3{-0.5f, 0.6f, 0.1f})},
+            {{0, 0, -1}, normalize(Vec3{0.2f, -0.1f, -1})}};
+}
+
+const Bsdf kBsdfs[] = {Bsdf::lambert(), Bsdf::phong(20), Bsdf::phong(200), Bsdf::ggx(0.1f)};
+
+// The standard error of the mean of n estimates from balance MIS's exact variance over
+// the same bin (a trustworthy one where rare bright samples make the sample variance
+// unreliable), or the sample variance where that is larger (power and optimal MIS).
+double standard_error(const BinnedEnvMap& binned, const Bsdf& bsdf, const ShadingPoint& p, const RunningStats& s) {
+    const double exact = exact_variance(binned, Technique::parse("mis-balance-bins"), {}, bsdf, p, 4);
+    return std::sqrt(std::max(exact, s.variance()) / static_cast<double>(s.count()));
+}
+
+void expect_unbiased(const std::string& name, const EnvMap& plain, uint64_t seed) {
+    const BinnedEnvMap binned{EnvMap(plain)};
+    for (const Bsdf& bsdf : kBsdfs)
+        for (const ShadingPoint& p : points()) {
+            const double reference = reflected_radiance(plain, bsdf, p, {1e-5, 32}).luminance;
+            for (const Technique& t : bins_techniques()) {
+                const DirectLightingEstimator estimator(binned, t);
+                Pcg32 rng(seed++);
+                PointState state;
+                RunningStats stats;
+                for (int i = 0; i < 40000; ++i)
+                    stats.add(luminance(estimator.estimate(p, bsdf, rng, state), plain.options().luma));
+                EXPECT_NEAR(stats.mean(), reference, 4 * standard_error(binned, bsdf, p, stats) + 1e-6 * reference)
+                    << name << " " << bsdf.name() << " " << t.name() << " normal.z=" << p.normal.z;
+            }
+        }
+}
+
+TEST(BinnedEstimator, IsUnbiasedOnASyntheticSunMap) {
+    expect_unbiased("sun", plain_map(test::sun_sky_map(256, 128)), 1);
+}
+TEST(BinnedEstimator, IsUnbiasedOnASunnyPhotographedMap) {
+    expect_unbiased("rooitou_park_1k.hdr", load_plain("rooitou_park_1k.hdr"), 1000);
+}
+TEST(BinnedEstimator, IsUnbiasedOnALossyExrWithNegativePixels) {
+    expect_unbiased("city.exr", load_plain("city.exr"), 2000);
+}
+
+TEST(BinnedEstimator, ManyEstimatesAtOnceEqualTheSameEstimatesOneAtATime) {
+    const BinnedEnvMap binned{plain_map(test::sun_sky_map(128, 64))};
+    for (const Bsdf& bsdf : kBsdfs)
+        for (const ShadingPoint& point : points())
+            for (const Allocation a : {Allocation{1, 1}, Allocation{2, 3}, Allocation{5, 4}})
+                for (const Technique& t : bins_techniques()) {
+                    const DirectLightingEstimator estimator(binned, t, a);
+                    Pcg32 rng(7), mine(7);
+                    PointState state, my_state;
+                    std::vector<Rgb> got(100);
+                    estimator.estimate(point, bsdf, rng, state, got);
+                    for (size_t i = 0; i < got.size(); ++i) {
+                        const Rgb expected = estimator.estimate(point, bsdf, mine, my_state);
+                        ASSERT_EQ(std::memcmp(&got[i], &expected, sizeof(Rgb)), 0)
+                            << t.name() << " " << bsdf.name() << " " << a.env << "+" << a.bsdf << " estimate " << i;
+                    }
+                    EXPECT_EQ(rng.uniform(), mine.uniform()) << t.name() << ": not the same random numbers";
+                }
+}
+
+TEST(BinnedEstimator, ABinsTechniqueNeedsABinnedMapAndOthersRefuseOne) {
+    const EnvMap plain = plain_map(test::sun_sky_map(64, 32));
+    const BinnedEnvMap binned{EnvMap(plain)};
+    EXPECT_THROW(DirectLightingEstimator(plain, Technique::parse("mis-balance-bins")), std::invalid_argument);
+    EXPECT_THROW(DirectLightingEstimator(binned, Technique::parse("mis-balance")), std::invalid_argument);
+    EXPECT_THROW(DirectLightingEstimator(binned, Technique::parse("mis-balance-bins"), {0, 2}), std::invalid_argument);
+    EXPECT_NO_THROW(DirectLightingEstimator(binned, Technique::parse("mis-optimal-bins"), {2, 1}));
+}
+
+TEST(BinnedEstimator, LobeClassFollowsTheBsdfsSharpness) {
+    EXPECT_EQ(Bsdf::lambert().phong_exponent(), 0.0f);
+    EXPECT_EQ(Bsdf::phong(200).phong_exponent(), 200.0f);
+    EXPECT_NEAR(Bsdf::ggx(0.1f).phong_exponent(), 198.0f, 1e-2f);
+    const BinnedEnvMap binned{plain_map(test::sun_sky_map(64, 32))};
+    EXPECT_EQ(binned.lobe_class(Bsdf::lambert().phong_exponent()), 0u);
+    EXPECT_EQ(binned.lobe_class(Bsdf::phong(20).phong_exponent()), 1u);
+    EXPECT_EQ(binned.lobe_class(Bsdf::ggx(0.1f).phong_exponent()), 2u);
+}
+
+}  // namespace
+}  // namespace envmis
