@@ -22,6 +22,7 @@
 #include <string_view>
 
 #include "envmis/math/math.h"
+#include "envmis/sampling/binned.h"
 #include "envmis/study/shading/frame.h"
 
 namespace envmis {
@@ -56,11 +57,11 @@ struct Bsdf {
     // The reflectance of lambert(), phong() and ggx() when none is given.
     static Rgb default_reflectance(BsdfKind kind);
     // The lobe's sharpness as a Phong exponent (BinnedEnvMap::lobe_class): 0 for Lambert,
-    // n for Phong, 2 / alpha^2 - 2 for GGX (the Phong lobe of the same width; Walter et
-    // al. 2007).
+    // n for Phong, ggx_lobe_exponent(alpha) for GGX (binned.h: the Phong lobe of
+    // reflected directions as wide as GGX's).
     float phong_exponent() const noexcept {
         if (kind == BsdfKind::phong) return exponent;
-        return kind == BsdfKind::ggx ? max(0.0f, 2 / (alpha * alpha) - 2) : 0.0f;
+        return kind == BsdfKind::ggx ? max(0.0f, ggx_lobe_exponent(alpha)) : 0.0f;
     }
 
     ENVMIS_HD Rgb eval(Vec3 wo, Vec3 wi) const noexcept;
