@@ -51,6 +51,13 @@ struct Bsdf {
     // reflectance, followed by ":ALBEDO" otherwise ("lambert:0.5"; a non-grey one as
     // ":R/G/B", which parse() does not read).
     std::string name() const;
+    // The Phong exponent of about this lobe's sharpness, the key of binned.h's lobe
+    // classes: 0 for Lambert, 2 / alpha^2 - 2 for GGX (the Phong exponent whose lobe
+    // matches a Beckmann-like one of that roughness).
+    float phong_exponent() const noexcept {
+        if (kind == BsdfKind::phong) return exponent;
+        return kind == BsdfKind::ggx ? max(0.0f, 2 / (alpha * alpha) - 2) : 0.0f;
+    }
     // The reflectance as text: "0.8" when grey, "0.95/0.64/0.54" otherwise.
     std::string albedo_text() const;
     // The reflectance of lambert(), phong() and ggx() when none is given.
