@@ -144,6 +144,7 @@ LoadedMap load_map(const std::string& path, const MapFlags& flags) {
         LoadedMap loaded{std::move(table.map), std::move(table.source), true, "envmis table"};
         loaded.table_version = table.version;
         loaded.mapped = table.mapped;
+        loaded.bins = std::move(table.bins);
         loaded.load_ms = milliseconds_since(start);
         return loaded;
     }
@@ -175,8 +176,59 @@ LoadedMap load_map(const std::string& path, const MapFlags& flags) {
     return loaded;
 }
 
-void print_summary(std::ostream& out, const LoadedMap& loaded) {
-    const EnvMap& m = loaded.map;
+namespace {
+
+std::string lobe_name(float exponent) {
+    if (exponent == 0) return "diffuse";
+    std::ostringstream name;
+    name << "Phong " << exponent;
+    return name.str();
+}
+
+// The bins' grids and lobe classes, and per class how many bins chose each alpha.
+void print_bins(std::ostream& out, const BinLayout& layout) {
+    const uint32_t g = layout.bins_per_side, bins = g * g;
+    out << "  bins          " << bins << " (" << g << " x " << g << " octahedral grid of normals), cells "
+        << layout.cell_columns << " x " << layout.cell_rows << ", lobe classes";
+    for (size_t c = 0; c < layout.lobe_exponents.size(); ++c)
+        out << (c ? ", " : " ") << lobe_name(layout.lobe_exponents[c]);
+    out << "\n";
+    for (size_t c = 0; c < layout.lobe_exponents.size(); ++c) {
+        // Plain (alpha < 0) sorts first, then the alphas ascending.
+        std::map<float, uint32_t> chosen;
+        for (uint32_t b = 0; b < bins && (c * bins + b) < layout.choices.size(); ++b)
+            ++chosen[std::max(layout.choices[c * bins + b].alpha, -1.0f)];
+        out << "  bin alphas    " << std::left << std::setw(10) << lobe_name(layout.lobe_exponents[c]) + ":"
+            << std::right;
+        const char* separator = "";
+        for (const auto& [alpha, count] : chosen) {
+            out << separator << count << " ";
+            if (alpha < 0)
+                out << "plain";
+            else
+                out << "alpha " << alpha;
+            separator = ", ";
+        }
+        out << "\n";
+    }
+}
+
+}  // namespace
+
+void print_bins_cost(std::ostream& out, const BinnedEnvMap& binned, double build_ms) {
+    const EnvMap& plain = binned.plain();
+    const double plain_bytes =
+        static_cast<double>(plain.distribution().bytes()) + static_cast<double>(plain.radiance().pixels.size_bytes());
+    const auto flags = out.flags();
+    out << std::fixed << std::setprecision(1) << "  bins build    " << build_ms << " ms";
+    if (binned.choice_seconds() > 0) out << " (choosing alphas " << 1e3 * binned.choice_seconds() << " ms)";
+    out << ", " << binned.bytes() << " bytes over the plain map (+" << 100 * binned.bytes() / plain_bytes << "%)\n";
+    out.flags(flags);
+}
+
+void print_summary(std::ostream& out, const LoadedMap& loaded) { print_summary(out, loaded, loaded.map); }
+
+void print_summary(std::ostream& out, const LoadedMap& loaded, const EnvMap& m) {
     const EnvMapStats& s = m.stats();
     const EnvMapOptions& o = m.options();
     const double texels = static_cast<double>(m.width()) * m.height();
@@ -197,7 +249,7 @@ void print_summary(std::ostream& out, const LoadedMap& loaded) {
         out << "  compensation  alpha " << o.compensation.alpha << ", threshold " << s.threshold << ", zeroed "
             << s.zeroed_texels << " texels with radiance (" << 100.0 * s.zeroed_texels / texels << "%)\n";
     else
-        out << "  compensation  off\n";
+        out << "  compensation  " << (loaded.bins ? "per bin (below)" : "off") << "\n";
     if (const auto& c = loaded.alpha_choice)
         out << "  alpha auto    " << c->alpha << " of " << c->candidates.size()
             << " candidates, by the exact variance of mis-balance-comp over mis-balance on a " << c->width << "x"
@@ -209,6 +261,7 @@ void print_summary(std::ostream& out, const LoadedMap& loaded) {
     out << "  memory        " << std::setprecision(3) << m.distribution().bytes() / texels
         << " bytes/texel (distribution) + " << sizeof(Rgb) << " (radiance)\n";
     out.flags(flags);
+    if (loaded.bins) print_bins(out, *loaded.bins);
 }
 
 Progress::Progress(std::string label, uint64_t total)

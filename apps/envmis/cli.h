@@ -85,13 +85,20 @@ struct LoadedMap {
     uint32_t channels = 3;
     double load_ms = 0, build_ms = 0;
     std::optional<AlphaChoice> alpha_choice = {};  // with --alpha auto, for an image
+    std::optional<BinLayout> bins = {};            // a binned table's bins (map: the plain map)
 };
 
 // Reads a table (recognised by its magic) or loads an image and builds its map.
 LoadedMap load_map(const std::string& path, const MapFlags& flags);
 
-// The summary that precompute and info print.
+// The summary that precompute and info print, of `loaded`'s map or of `map` (precompute
+// --bins moves loaded.map into its BinnedEnvMap); with the bins' layout if it has one.
 void print_summary(std::ostream& out, const LoadedMap& loaded);
+void print_summary(std::ostream& out, const LoadedMap& loaded, const EnvMap& map);
+
+// What a binned map's bins cost: the time to build (or rebuild) them and their bytes
+// over the plain map.
+void print_bins_cost(std::ostream& out, const BinnedEnvMap& binned, double build_ms);
 
 double milliseconds_since(std::chrono::steady_clock::time_point start);
 

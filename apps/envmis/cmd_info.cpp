@@ -1,4 +1,5 @@
 // envmis info FILE: describe a table or an HDR image.
+#include <chrono>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -15,6 +16,18 @@ struct InfoArgs {
     MapFlags map;
 };
 
+// Rebuilds a binned table's bins (as a renderer loading it would), to check that they
+// fit the map and to say what they cost.
+void print_bins_rebuild(const InfoArgs& args, const LoadedMap& loaded) {
+    const auto start = std::chrono::steady_clock::now();
+    try {
+        const BinnedEnvMap binned(loaded.map, *loaded.bins);
+        print_bins_cost(std::cout, binned, milliseconds_since(start));
+    } catch (const std::invalid_argument& e) {
+        throw TableError(args.input + ": bins do not fit the map: " + e.what());
+    }
+}
+
 void print_info(const InfoArgs& args, const LoadedMap& loaded) {
     std::cout << args.input << ": ";
     if (loaded.from_table)
@@ -23,6 +36,7 @@ void print_info(const InfoArgs& args, const LoadedMap& loaded) {
     else
         std::cout << "image, " << loaded.channels << " channels\n";
     print_summary(std::cout, loaded);
+    if (loaded.bins) print_bins_rebuild(args, loaded);
     std::cout << std::fixed << std::setprecision(1) << "  time          load " << loaded.load_ms << " ms"
               << (loaded.from_table ? " (includes rebuilding the sampler)" : "") << ", build " << loaded.build_ms
               << " ms\n";

@@ -1,5 +1,6 @@
 // envmis precompute IN -o OUT.envmis: build a map's sampler and save it as a table.
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -34,30 +35,90 @@ struct PrecomputeArgs {
     std::string input, output;
     MapFlags map;
     bool compact = false;
+    uint32_t bins = 0;  // K = g^2 normal bins (sampling/binned.h); 0: a single density
+    uint32_t cell_columns = 0;
 };
+
+// --bins: a square number g^2 with g 1 to 64 (binned.h's grid of normals), digits only.
+CLI::Validator square_bins() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            uint32_t k = 0;
+            const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), k);
+            const auto g = static_cast<uint32_t>(std::lround(std::sqrt(static_cast<double>(k))));
+            if (error == std::errc() && end == text.data() + text.size() && k >= 1 && k <= 4096 && g * g == k)
+                return {};
+            return text +
+                   ": expected a square number of bins (g x g octahedral grid) from 1 to 4096, such as 64, "
+                   "100 or 144";
+        },
+        "K");
+}
 
 void add_precompute_flags(CLI::App& sub, PrecomputeArgs& args) {
     sub.add_option("input", args.input, "HDR image (EXR, .hdr, .pfm, TIFF, ...)")->required();
     sub.add_option("-o,--output", args.output, "Table file to write (.envmis)")->required();
     sub.add_flag("--compact", args.compact,
                  "Store the radiance in RGBE (4 bytes/texel instead of 16; density rebuilt on load); prints the error");
+    sub.add_option("--bins", args.bins,
+                   "Normal-aware table: K = g x g bins of normals, each with its own compensation (binned.h); the "
+                   "texels keep the plain density. --alpha auto chooses per bin, --alpha X fixes it, --no-compensate "
+                   "makes it 0")
+        ->type_name("K")
+        ->check(square_bins());
+    sub.add_option("--cell-columns", args.cell_columns, "With --bins: columns of the bins' cell grid (0: width / 32)")
+        ->type_name("N")
+        ->check(in_range(uint32_t{0}, uint32_t{4096}));
     add_map_flags(sub, args.map);
 }
 
-void print_precompute(const PrecomputeArgs& args, const LoadedMap& loaded, double write_ms) {
+// `map` is loaded.map, or the plain map of `binned` (which then holds it).
+void print_precompute(const PrecomputeArgs& args, const LoadedMap& loaded, const EnvMap& map,
+                      const BinnedEnvMap* binned, double bins_ms, double write_ms) {
     std::cout << "envmis precompute: " << args.input << " -> " << args.output << "\n";
-    print_summary(std::cout, loaded);
-    if (args.compact) print_compact_error(std::cout, loaded.map);
+    print_summary(std::cout, loaded, map);
+    if (binned) print_bins_cost(std::cout, *binned, bins_ms);
+    if (args.compact) print_compact_error(std::cout, map);
     std::cout << std::fixed << std::setprecision(1) << "  time          load " << loaded.load_ms << " ms, build "
               << loaded.build_ms << " ms, write " << write_ms << " ms\n";
 }
 
+// The bins as the map flags ask: --alpha auto per bin, --alpha X or --no-compensate (0)
+// for every bin.
+BinnedOptions binned_options(const PrecomputeArgs& args) {
+    BinnedOptions o;
+    o.bins_per_side = static_cast<uint32_t>(std::lround(std::sqrt(static_cast<double>(args.bins))));
+    o.cell_columns = args.cell_columns;
+    o.auto_alpha = args.map.alpha_auto && !args.map.no_compensate;
+    o.alpha = args.map.no_compensate ? 0.0f : args.map.alpha;
+    return o;
+}
+
+// With --bins the table's texels hold the plain map, and the compensation the flags ask
+// for goes into the bins.
+void run_precompute_binned(const PrecomputeArgs& args) {
+    MapFlags plain = args.map;
+    plain.no_compensate = true;
+    plain.alpha_auto = false;
+    LoadedMap loaded = load_map(args.input, plain);
+    if (loaded.from_table) throw std::runtime_error(args.input + ": is already a table; give an image");
+    const auto build_start = std::chrono::steady_clock::now();
+    const BinnedEnvMap binned(std::move(loaded.map), binned_options(args));
+    const double bins_ms = milliseconds_since(build_start);
+    loaded.bins = binned.layout();
+    const auto start = std::chrono::steady_clock::now();
+    write_table(args.output, binned, loaded.source, args.compact ? TableEncoding::compact : TableEncoding::full);
+    print_precompute(args, loaded, binned.plain(), &binned, bins_ms, milliseconds_since(start));
+}
+
 void run_precompute(const PrecomputeArgs& args) {
+    if (args.bins != 0) return run_precompute_binned(args);
+    if (args.cell_columns != 0) throw std::runtime_error("--cell-columns needs --bins");
     const LoadedMap loaded = load_map(args.input, args.map);
     if (loaded.from_table) throw std::runtime_error(args.input + ": is already a table; give an image");
     const auto start = std::chrono::steady_clock::now();
     write_table(args.output, loaded.map, loaded.source, args.compact ? TableEncoding::compact : TableEncoding::full);
-    print_precompute(args, loaded, milliseconds_since(start));
+    print_precompute(args, loaded, loaded.map, nullptr, 0, milliseconds_since(start));
 }
 
 }  // namespace

@@ -173,7 +173,7 @@ std::vector<std::string> with_map_flags(std::vector<std::string> options) {
 
 INSTANTIATE_TEST_SUITE_P(
     Subcommands, CliHelp,
-    testing::Values(HelpCase{"precompute", with_map_flags({"input", "-o,--output"})},
+    testing::Values(HelpCase{"precompute", with_map_flags({"input", "-o,--output", "--bins", "--cell-columns"})},
                     HelpCase{"info", with_map_flags({"input"})},
                     HelpCase{"sample", with_map_flags({"input", "-n,--count", "--seed", "-o,--output"})},
                     HelpCase{"visualize",
@@ -247,7 +247,7 @@ TEST_F(Cli, InfoDescribesATableAndTheImageItCameFrom) {
     ASSERT_EQ(envmis({"precompute", (kBundled / "studio.exr").string(), "-o", "studio.envmis"}).exit_code, 0);
     const Result table = envmis({"info", "studio.envmis"});
     ASSERT_EQ(table.exit_code, 0) << table;
-    EXPECT_TRUE(contains(table.out, "studio.envmis: envmis table, format version 3")) << table;
+    EXPECT_TRUE(contains(table.out, "studio.envmis: envmis table, format version 4")) << table;
     expect_studio_summary(table);
 
     const Result image = envmis({"info", (kBundled / "studio.exr").string()});
@@ -422,15 +422,49 @@ INSTANTIATE_TEST_SUITE_P(
                                  for (char& b : bytes) b = static_cast<char>((x = x * 1664525u + 1013904223u) >> 24);
                                  write_file(p, bytes);
                              }},
-                    BadInput{"TableOfANewerVersion", "newer.envmis", "version 4.*newer",
+                    BadInput{"TableOfANewerVersion", "newer.envmis", "version 5.*newer",
                              [](Cli& t, const fs::path& p) {
                                  // The format version: uint32, little-endian, at byte 8.
                                  t.damaged_table(
-                                     p, [](std::string& bytes) { bytes.replace(8, 4, std::string("\x04\0\0\0", 4)); });
+                                     p, [](std::string& bytes) { bytes.replace(8, 4, std::string("\x05\0\0\0", 4)); });
                              }},
                     BadInput{"Folder", "folder.exr", "directory",
                              [](Cli&, const fs::path& p) { fs::create_directory(p); }}),
     [](const testing::TestParamInfo<BadInput>& info) { return info.param.name; });
+
+// --bins K: the texels keep the plain density and each of K bins of normals its own
+// compensation; precompute and info describe the bins and what they cost.
+TEST_F(Cli, PrecomputeWithBinsWritesABinnedTableThatInfoDescribes) {
+    write_exr(file("map.exr"), gradient(64, 32));
+    const Result r = envmis({"precompute", "map.exr", "-o", "binned.envmis", "--bins", "64", "--alpha", "auto"});
+    ASSERT_EQ(r.exit_code, 0) << r;
+    EXPECT_EQ(r.err, "") << r;
+    for (const char* line :
+         {R"(compensation +per bin)", R"(bins +64 \(8 x 8 octahedral grid of normals\), cells 2 x 1)",
+          R"(bin alphas +diffuse: +[0-9]+ )", R"(bin alphas +Phong 200: +[0-9]+ )",
+          R"(bins build +[0-9.]+ ms \(choosing alphas [0-9.]+ ms\), [0-9]+ bytes over the plain )"
+          R"(map \(\+[0-9.]+%\))"})
+        EXPECT_TRUE(contains(r.out, line)) << "missing /" << line << "/" << r;
+    const Result info = envmis({"info", "binned.envmis"});
+    ASSERT_EQ(info.exit_code, 0) << info;
+    for (const char* line : {"binned.envmis: envmis table, format version 4", R"(bins +64 \(8 x 8)",
+                             R"(bin alphas +Phong 20: )", R"(bins build +[0-9.]+ ms, [0-9]+ bytes over the plain map)"})
+        EXPECT_TRUE(contains(info.out, line)) << "missing /" << line << "/" << info;
+    const Result fixed = envmis(
+        {"precompute", "map.exr", "-o", "fixed.envmis", "--bins", "1", "--no-compensate", "--cell-columns", "4"});
+    ASSERT_EQ(fixed.exit_code, 0) << fixed;
+    EXPECT_TRUE(contains(fixed.out, R"(bins +1 \(1 x 1 octahedral grid of normals\), cells 4 x 2)")) << fixed;
+    EXPECT_TRUE(contains(fixed.out, R"(bin alphas +diffuse: +1 alpha 0\n)")) << fixed;
+}
+
+TEST_F(Cli, PrecomputeRefusesBinsThatAreNotASquareNumberInOneLineAndWritesNothing) {
+    write_exr(file("map.exr"), gradient(16, 8));
+    for (const char* bins : {"50", "-1", "99999999", "0", "4225", "8x8"}) {
+        const Result r = envmis({"precompute", "map.exr", "-o", "out.envmis", "--bins", bins});
+        expect_one_line_error(r, "--bins", std::string(bins) + ": expected a square number of bins");
+        EXPECT_EQ(listing(), std::set<std::string>{"map.exr"}) << r;
+    }
+}
 
 TEST_F(Cli, PrecomputeRefusesATableWithOneLine) {
     small_table("t.envmis");

@@ -130,6 +130,13 @@ INSTANTIATE_TEST_SUITE_P(
         BadFlag{"SampleInfiniteAlpha", sample({"--alpha", "inf"}), "--alpha"},
         BadFlag{"PrecomputeNegativeAlpha", {"precompute", kStudio, "-o", "out.envmis", "--alpha", "-0.5"}, "--alpha"},
         BadFlag{"PrecomputeNanAlpha", {"precompute", kStudio, "-o", "out.envmis", "--alpha", "nan"}, "--alpha"},
+        // precompute: --bins a square number 1 to 4096, --cell-columns 0 to 4096.
+        BadFlag{"PrecomputeBinsNotASquare", {"precompute", kStudio, "-o", "out.envmis", "--bins", "50"}, "--bins"},
+        BadFlag{"PrecomputeNegativeBins", {"precompute", kStudio, "-o", "out.envmis", "--bins", "-1"}, "--bins"},
+        BadFlag{"PrecomputeBinsAbove4096", {"precompute", kStudio, "-o", "out.envmis", "--bins", "99999999"}, "--bins"},
+        BadFlag{"PrecomputeCellColumnsAbove4096",
+                {"precompute", kStudio, "-o", "out.envmis", "--bins", "64", "--cell-columns", "4097"},
+                "--cell-columns"},
         BadFlag{"InfoNegativeAlpha", {"info", kStudio, "--alpha", "-1"}, "--alpha"},
         BadFlag{"VisualizeNegativeAlpha", visualize({"--alpha", "-1"}), "--alpha"}),
     [](const testing::TestParamInfo<BadFlag>& info) { return info.param.name; });

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -221,11 +222,19 @@ void reseal(std::vector<char>& bytes) {
     std::memcpy(bytes.data() + kPreamble + m, &digest, sizeof digest);
 }
 
-// The same table as an older version writes it: no metadata padding; version 1 also
-// has a reserved 0 where later versions keep the mapping.
+// The same table (without bins) as an older version writes it: no bins-section size;
+// before version 3 no metadata padding; version 1 also has a reserved 0 where later
+// versions keep the mapping.
 std::vector<char> as_version(std::vector<char> bytes, uint32_t version) {
-    const uint32_t m = u32_at(bytes, kMetadataSizeAt), unpadded = static_cast<uint32_t>(unpadded_metadata(bytes));
+    const uint32_t m = u32_at(bytes, kMetadataSizeAt);
+    uint32_t unpadded = static_cast<uint32_t>(unpadded_metadata(bytes));
+    EXPECT_EQ(u32_at(bytes, kPreamble + unpadded), 0u) << "a table with bins has no older version";
     bytes.erase(bytes.begin() + kPreamble + unpadded, bytes.begin() + kPreamble + m);
+    if (version == 3) {
+        const uint32_t padding = (8 - unpadded % 8) % 8;
+        bytes.insert(bytes.begin() + kPreamble + unpadded, padding, 0);
+        unpadded += padding;
+    }
     const uint64_t total = bytes.size();
     std::memcpy(bytes.data() + kVersionAt, &version, sizeof version);
     std::memcpy(bytes.data() + kTotalSizeAt, &total, sizeof total);
@@ -259,6 +268,20 @@ TEST_F(TableTest, VersionTwoTablesStillRead) {
     write_bytes(path, as_version(bytes_of(path), 2));
     const Table loaded = read_table(path);
     EXPECT_FALSE(loaded.mapped);
+    expect_identical_samples(map_, loaded.map, 5, 1000);
+}
+
+// Version 3 is version 4 without the bins-section size: such tables read, in place from
+// a mapping, and have no bins.
+TEST_F(TableTest, VersionThreeTablesStillReadFromAMapping) {
+    const fs::path path = saved_table();
+    write_bytes(path, as_version(bytes_of(path), 3));
+    const Table loaded = read_table(path);
+    EXPECT_EQ(loaded.version, 3u);
+#if defined(__unix__) || defined(__APPLE__)
+    EXPECT_TRUE(loaded.mapped);
+#endif
+    EXPECT_FALSE(loaded.bins);
     expect_identical_samples(map_, loaded.map, 5, 1000);
 }
 
@@ -352,6 +375,179 @@ TEST(TableParse, InMemoryBytesGiveTheSameErrors) {
     EXPECT_THROW(parse_table(empty, "mem"), TableError);
     const std::vector<std::byte> junk(100, std::byte{0x89});
     EXPECT_THROW(parse_table(junk, "mem"), TableError);
+}
+
+// ---------------------------------------------------------------------------------
+// Binned tables (version 4): the plain map, then the bins' layout with its checksum.
+
+EnvMap plain_sky() {
+    EnvMapOptions o;
+    o.compensation.enabled = false;
+    o.axes = Axes::parse("y-up");
+    return EnvMap(test::sun_sky_map(96, 48), o);
+}
+
+BinnedEnvMap small_binned(EnvMap plain) {
+    BinnedOptions o;
+    o.bins_per_side = 4;
+    return BinnedEnvMap(std::move(plain), o);
+}
+
+// `loaded` samples exactly as `expected`, for every lobe class and normals across all bins.
+void expect_identical_binned_samples(const BinnedEnvMap& expected, const BinnedEnvMap& loaded, uint64_t seed, int n) {
+    ASSERT_EQ(loaded.classes(), expected.classes());
+    const BinnedEnvMapView a = expected.view(), b = loaded.view();
+    test::Rng rng(seed);
+    for (int i = 0; i < n; ++i) {
+        const Vec3 normal = octahedral_normal(rng.uniform(), rng.uniform());
+        const uint32_t lobe = static_cast<uint32_t>(i) % expected.classes();
+        const Vec2 u = rng.uniform2();
+        const EnvSample x = a.sample(normal, lobe, u), y = b.sample(normal, lobe, u);
+        ASSERT_EQ(std::memcmp(&x, &y, sizeof x), 0) << "sample " << i;
+        ASSERT_EQ(a.pdf(normal, lobe, x.direction), b.pdf(normal, lobe, x.direction));
+    }
+}
+
+void expect_same_layout(const BinLayout& a, const BinLayout& b) {
+    EXPECT_EQ(a.bins_per_side, b.bins_per_side);
+    EXPECT_EQ(a.cell_columns, b.cell_columns);
+    EXPECT_EQ(a.cell_rows, b.cell_rows);
+    EXPECT_EQ(a.lobe_exponents, b.lobe_exponents);
+    ASSERT_EQ(a.choices.size(), b.choices.size());
+    for (size_t i = 0; i < a.choices.size(); ++i) {
+        EXPECT_EQ(a.choices[i].alpha, b.choices[i].alpha) << i;
+        EXPECT_EQ(a.choices[i].threshold, b.choices[i].threshold) << i;
+    }
+}
+
+class BinnedTableTest : public TableTest {
+protected:
+    fs::path saved_binned_table() {
+        binned_ = small_binned(plain_sky());
+        const fs::path path = dir_ / "binned.envmis";
+        write_table(path, binned_, source_);
+        return path;
+    }
+    BinnedEnvMap binned_;
+};
+
+// Offset of the bins-section size in the metadata block (after the three strings).
+size_t bins_size_at(const std::vector<char>& bytes) { return kPreamble + unpadded_metadata(bytes); }
+
+// The bins section (without its checksum): where it starts and its size.
+std::pair<size_t, size_t> bins_section_of(const std::vector<char>& bytes) {
+    const size_t size = u32_at(bytes, bins_size_at(bytes));
+    return {bytes.size() - 8 - size, size};
+}
+
+// Recomputes the bins section's checksum after an edit of it.
+void reseal_bins(std::vector<char>& bytes) {
+    const auto [at, size] = bins_section_of(bytes);
+    const uint64_t digest = hash64(std::as_bytes(std::span(bytes.data() + at, size)));
+    std::memcpy(bytes.data() + at + size, &digest, sizeof digest);
+}
+
+TEST_F(BinnedTableTest, BinnedTablesRoundTripBitIdenticallyMappedOrCopied) {
+    const fs::path path = saved_binned_table();
+    for (TableLoading loading : {TableLoading::map, TableLoading::copy}) {
+        Table table = read_table(path, loading);
+        EXPECT_EQ(table.version, 4u);
+        ASSERT_TRUE(table.bins);
+        expect_same_layout(*table.bins, binned_.layout());
+        const BinnedEnvMap loaded = binned_map(std::move(table));
+        expect_identical_binned_samples(binned_, loaded, 21, 20000);
+        expect_identical_samples(binned_.plain(), loaded.plain(), 22, 1000);
+    }
+#if defined(__unix__) || defined(__APPLE__)
+    EXPECT_TRUE(read_table(path).mapped);
+#endif
+    const std::vector<char> bytes = bytes_of(path);
+    const Table parsed = parse_table(std::as_bytes(std::span(bytes)), "mem");
+    ASSERT_TRUE(parsed.bins);
+    expect_same_layout(*parsed.bins, binned_.layout());
+}
+
+// A compact binned table holds the RGBE-rounded plain map; the bins are rebuilt over it
+// from the stored layout.
+TEST_F(BinnedTableTest, CompactBinnedTablesRebuildTheBinsOverTheRoundedMap) {
+    const BinnedEnvMap binned = small_binned(plain_sky());
+    const fs::path path = dir_ / "compact.envmis";
+    write_table(path, binned, source_, TableEncoding::compact);
+    const BinnedEnvMap expected(EnvMap(rgbe_round(binned.plain().radiance()), binned.plain().options()),
+                                binned.layout());
+    expect_identical_binned_samples(expected, binned_map(read_table(path)), 23, 10000);
+}
+
+TEST_F(BinnedTableTest, TablesWithoutBinsHaveNoneAndCannotGiveABinnedMap) {
+    const fs::path path = saved_table();
+    Table table = read_table(path);
+    EXPECT_EQ(table.version, kTableVersion);
+    EXPECT_FALSE(table.bins);
+    try {
+        binned_map(std::move(table));
+        ADD_FAILURE() << "a table without bins gave a binned map";
+    } catch (const TableError& e) {
+        EXPECT_NE(std::string(e.what()).find(path.string() + ": has no bins"), std::string::npos) << e.what();
+    }
+}
+
+TEST_F(BinnedTableTest, DamagedBinsSectionsAreRejectedNamingTheProblem) {
+    const fs::path path = saved_binned_table();
+    const std::vector<char> good = bytes_of(path);
+    const auto [at, size] = bins_section_of(good);
+    ASSERT_EQ(size, 16 + 4 * 3 + 8 * 3 * 16u);
+    std::vector<char> bytes = good;
+    bytes[at + size / 2] ^= 0x10;
+    write_bytes(path, bytes);
+    expect_rejected(path, "corrupted bins section");
+    for (size_t cut : {size_t{1}, size_t{8}, size / 2}) {
+        write_bytes(path, {good.begin(), good.end() - static_cast<std::ptrdiff_t>(cut)});
+        expect_rejected(path, "truncated");
+    }
+    const auto field = [&](size_t offset, uint32_t value, const std::string& problem) {
+        bytes = good;
+        std::memcpy(bytes.data() + at + offset, &value, sizeof value);
+        reseal_bins(bytes);
+        write_bytes(path, bytes);
+        expect_rejected(path, problem);
+    };
+    field(0, 65, "65 bins per side, not 1 to 64");
+    field(0, 5, "does not hold 3 lobe classes of 25 bins");
+    field(4, 97, "cell grid 97x");
+    field(8, 0, "does not fit a 96x48 map");
+    field(12, 9, "9 lobe classes, not 1 to 8");
+    field(16, std::bit_cast<uint32_t>(1.0f), "lobe exponents");
+    field(16 + 12 + 4, std::bit_cast<uint32_t>(NAN), "not finite");
+    field(16 + 12 + 4, std::bit_cast<uint32_t>(-1.0f), "threshold is negative");
+}
+
+TEST_F(BinnedTableTest, ImplausibleBinsSectionSizesAreRejectedBeforeReading) {
+    const fs::path path = saved_binned_table();
+    std::vector<char> bytes = bytes_of(path);
+    const uint32_t huge = 1u << 30;
+    std::memcpy(bytes.data() + bins_size_at(bytes), &huge, sizeof huge);
+    reseal(bytes);
+    write_bytes(path, bytes);
+    expect_rejected(path, "invalid bins section size 1073741824");
+}
+
+// A layout the parser accepts but the map's rebuild refuses (a threshold between the
+// histogram's edges): binned_map names the file.
+TEST_F(BinnedTableTest, BinsThatDoNotFitTheMapAreATableError) {
+    const fs::path path = saved_binned_table();
+    std::vector<char> bytes = bytes_of(path);
+    const auto [at, size] = bins_section_of(bytes);
+    const float odd = 0.123456789f;
+    std::memcpy(bytes.data() + at + 16 + 12 + 4, &odd, sizeof odd);
+    reseal_bins(bytes);
+    write_bytes(path, bytes);
+    try {
+        binned_map(read_table(path));
+        ADD_FAILURE() << "an off-edge threshold was accepted";
+    } catch (const TableError& e) {
+        EXPECT_NE(std::string(e.what()).find(path.string() + ": bins do not fit the map"), std::string::npos)
+            << e.what();
+    }
 }
 
 }  // namespace

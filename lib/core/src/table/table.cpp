@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <optional>
@@ -31,6 +32,11 @@ constexpr uint32_t kFlagCompact = 2;  // payload: RGBE radiance only (TableEncod
 // Version 3 pads the metadata block with zeros to a multiple of this, so that the payload's
 // arrays are aligned in the file and a mapping of it can be used in place.
 constexpr uint32_t kMetadataAlignment = 8;
+// Version 4's bins section (BinLayout): four u32 (bins per side g, cell columns, cell
+// rows, classes C), C lobe exponents, then C g^2 (alpha, threshold) pairs, all 4 bytes.
+constexpr uint32_t kMaxBinsPerSide = 64, kMaxCellSide = 4096, kMaxLobeClasses = 8;
+constexpr uint32_t bins_section_size(uint32_t g, uint32_t classes) { return 16 + 4 * classes + 8 * classes * g * g; }
+constexpr uint32_t kMaxBinsSection = bins_section_size(kMaxBinsPerSide, kMaxLobeClasses);
 
 // RGBE (Ward 1991): three 8-bit mantissas sharing the exponent of the largest channel,
 // rounded to nearest. Byte 3 is the exponent + 128; 0 means black.
@@ -116,7 +122,7 @@ private:
 };
 
 std::vector<std::byte> metadata_block(const EnvMap& map, const EnvMapStats& s, const TableSource& source,
-                                      TableEncoding encoding) {
+                                      TableEncoding encoding, uint32_t bins_size) {
     const EnvMapOptions& o = map.options();
     ByteWriter w;
     w.put(map.width());
@@ -140,7 +146,22 @@ std::vector<std::byte> metadata_block(const EnvMap& map, const EnvMapStats& s, c
     w.put_string(source.name);
     w.put_string(source.input_colorspace);
     w.put_string(source.working_colorspace);
+    w.put(bins_size);
     w.bytes.resize((w.bytes.size() + kMetadataAlignment - 1) / kMetadataAlignment * kMetadataAlignment);
+    return std::move(w.bytes);
+}
+
+std::vector<std::byte> bins_section(const BinLayout& layout) {
+    ByteWriter w;
+    w.put(layout.bins_per_side);
+    w.put(layout.cell_columns);
+    w.put(layout.cell_rows);
+    w.put(static_cast<uint32_t>(layout.lobe_exponents.size()));
+    for (float e : layout.lobe_exponents) w.put(e);
+    for (const BinChoice& c : layout.choices) {
+        w.put(c.alpha);
+        w.put(c.threshold);
+    }
     return std::move(w.bytes);
 }
 
@@ -159,15 +180,17 @@ namespace {
 
 // Writes the preamble, `metadata`, the header checksum, the payload of `payload_size`
 // bytes that for_each_chunk(use) hands to `use` in order (it is called twice: for the
-// payload checksum, then to write), and the payload checksum; atomically.
+// payload checksum, then to write), the payload checksum, and `bins` with its checksum
+// unless empty; atomically.
 template <class ForEachChunk>
 void write_file(const std::filesystem::path& path, const std::vector<std::byte>& metadata, uint64_t payload_size,
-                ForEachChunk&& for_each_chunk) {
+                const std::vector<std::byte>& bins, ForEachChunk&& for_each_chunk) {
     ByteWriter head;
     for (std::byte b : kMagic) head.put(b);
     head.put(kTableVersion);
     head.put(kByteOrderMark);
-    head.put(uint64_t{kPreambleSize + metadata.size() + 8 + payload_size + 8});
+    const uint64_t bins_size = bins.empty() ? 0 : bins.size() + 8;
+    head.put(uint64_t{kPreambleSize + metadata.size() + 8 + payload_size + 8 + bins_size});
     head.put(static_cast<uint32_t>(metadata.size()));
     head.put(uint32_t{0});
     head.bytes.insert(head.bytes.end(), metadata.begin(), metadata.end());
@@ -175,7 +198,7 @@ void write_file(const std::filesystem::path& path, const std::vector<std::byte>&
 
     Hasher payload_hash;
     for_each_chunk([&](std::span<const std::byte> bytes) { payload_hash.update(bytes); });
-    const uint64_t payload_digest = payload_hash.digest();
+    const uint64_t payload_digest = payload_hash.digest(), bins_digest = hash64(bins);
     try {
         write_file_atomically(path, [&](std::ostream& out) {
             auto write = [&](std::span<const std::byte> bytes) {
@@ -184,6 +207,10 @@ void write_file(const std::filesystem::path& path, const std::vector<std::byte>&
             write(head.bytes);
             for_each_chunk(write);
             write(std::as_bytes(std::span(&payload_digest, 1)));
+            if (!bins.empty()) {
+                write(bins);
+                write(std::as_bytes(std::span(&bins_digest, 1)));
+            }
         });
     } catch (const std::runtime_error& e) {
         throw TableError(e.what());
@@ -204,12 +231,17 @@ RgbImage rgbe_round(RgbImageView image) {
     return out;
 }
 
-void write_table(const std::filesystem::path& path, const EnvMap& map, const TableSource& source,
-                 TableEncoding encoding) {
+namespace {
+
+// The plain map's table, with `layout`'s bins section if not null.
+void write_map(const std::filesystem::path& path, const EnvMap& map, const TableSource& source, TableEncoding encoding,
+               const BinLayout* layout) {
     for (const std::string* s : {&source.name, &source.input_colorspace, &source.working_colorspace})
         if (s->size() > kMaxStringSize)
             throw TableError(path.string() + ": metadata string longer than " + std::to_string(kMaxStringSize) +
                              " bytes");
+    const std::vector<std::byte> bins = layout ? bins_section(*layout) : std::vector<std::byte>{};
+    const auto bins_size = static_cast<uint32_t>(bins.size());
     const auto& radiance = map.radiance().pixels;
     if (encoding == TableEncoding::compact) {
         // The table holds the rounded map: its statistics (Lbar, threshold) are the
@@ -223,21 +255,33 @@ void write_table(const std::filesystem::path& path, const EnvMap& map, const Tab
         detail::parallel_for(map.height(), 16, [&](uint32_t lo, uint32_t hi) {
             for (size_t i = size_t{lo} * w; i < size_t{hi} * w; ++i) rgbe[i] = rgbe_encode(radiance[i]);
         });
-        write_file(path, metadata_block(map, stats, source, encoding), rgbe.size() * sizeof(uint32_t),
+        write_file(path, metadata_block(map, stats, source, encoding, bins_size), rgbe.size() * sizeof(uint32_t), bins,
                    [&](auto&& use) { use(as_bytes_of<uint32_t>(rgbe)); });
         return;
     }
     // The density is computed a row at a time, twice (for the checksum, then to write):
     // cheaper than holding a copy of the map's size.
     std::vector<float> row(map.width());
-    write_file(path, metadata_block(map, map.stats(), source, encoding),
-               radiance.size() * (sizeof(float) + sizeof(Rgb)), [&](auto&& use) {
+    write_file(path, metadata_block(map, map.stats(), source, encoding, bins_size),
+               radiance.size() * (sizeof(float) + sizeof(Rgb)), bins, [&](auto&& use) {
                    for (uint32_t y = 0; y < map.height(); ++y) {
                        map.density_row(y, row);
                        use(as_bytes_of<float>(row));
                    }
                    use(as_bytes_of<Rgb>(radiance));
                });
+}
+
+}  // namespace
+
+void write_table(const std::filesystem::path& path, const EnvMap& map, const TableSource& source,
+                 TableEncoding encoding) {
+    write_map(path, map, source, encoding, nullptr);
+}
+
+void write_table(const std::filesystem::path& path, const BinnedEnvMap& binned, const TableSource& source,
+                 TableEncoding encoding) {
+    write_map(path, binned.plain(), source, encoding, &binned.layout());
 }
 
 namespace {
@@ -251,6 +295,7 @@ struct Header {
     bool compact = false;  // payload: RGBE radiance only
     uint32_t version = 0;
     uint64_t payload_offset = 0;
+    uint32_t bins_size = 0;  // of the bins section, without its checksum; 0: none
 };
 
 // Parses and checks the header from `head`, the first bytes of a file of `file_size`
@@ -311,6 +356,7 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
     source.name = meta.take_string("source name");
     source.input_colorspace = meta.take_string("input colour space");
     source.working_colorspace = meta.take_string("working colour space");
+    if (version >= 4) out.bins_size = meta.take<uint32_t>("bins section size");
 
     in.take_bytes(metadata_size, "metadata");
     if (in.take<uint64_t>("header checksum") != header_digest) in.fail("corrupted header (checksum mismatch)");
@@ -338,7 +384,11 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
     // The payload's size, checked against the file before anything is allocated for it.
     out.payload_offset = in.position();
     const uint64_t texels = uint64_t{w} * h;
-    const uint64_t payload = texels * (out.compact ? sizeof(uint32_t) : sizeof(float) + sizeof(Rgb)) + 8;
+    if (out.bins_size != 0 &&
+        (out.bins_size < bins_section_size(1, 1) || out.bins_size > kMaxBinsSection || out.bins_size % 4 != 0))
+        in.fail("invalid bins section size " + std::to_string(out.bins_size));
+    const uint64_t payload = texels * (out.compact ? sizeof(uint32_t) : sizeof(float) + sizeof(Rgb)) + 8 +
+                             (out.bins_size == 0 ? 0 : out.bins_size + 8);
     const uint64_t left = file_size - out.payload_offset;
     if (payload > left)
         in.fail("truncated: payload needs " + std::to_string(payload) + " bytes, " + std::to_string(left) + " left");
@@ -350,11 +400,53 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
     throw TableError(std::string(name) + ": " + problem);
 }
 
+// Checks a bins section (`section`, whose checksum is `digest`) field by field against
+// what remains of it and against the header's map, before anything is sized from it.
+BinLayout parse_bins(std::span<const std::byte> section, uint64_t digest, const Header& header, std::string_view name) {
+    if (hash64(section) != digest) fail(name, "corrupted bins section (checksum mismatch)");
+    Cursor in(section, name);
+    BinLayout layout;
+    layout.bins_per_side = in.take<uint32_t>("bins per side");
+    layout.cell_columns = in.take<uint32_t>("bin cell columns");
+    layout.cell_rows = in.take<uint32_t>("bin cell rows");
+    const auto classes = in.take<uint32_t>("lobe classes");
+    const uint32_t g = layout.bins_per_side;
+    if (g < 1 || g > kMaxBinsPerSide) in.fail("bins section: " + std::to_string(g) + " bins per side, not 1 to 64");
+    if (layout.cell_columns < 1 || layout.cell_columns > std::min(header.w, kMaxCellSide) || layout.cell_rows < 1 ||
+        layout.cell_rows > std::min(header.h, kMaxCellSide))
+        in.fail("bins section: cell grid " + std::to_string(layout.cell_columns) + "x" +
+                std::to_string(layout.cell_rows) + " does not fit a " + std::to_string(header.w) + "x" +
+                std::to_string(header.h) + " map (at most 4096 a side)");
+    if (classes < 1 || classes > kMaxLobeClasses)
+        in.fail("bins section: " + std::to_string(classes) + " lobe classes, not 1 to 8");
+    if (section.size() != bins_section_size(g, classes))
+        in.fail("bins section of " + std::to_string(section.size()) + " bytes does not hold " +
+                std::to_string(classes) + " lobe classes of " + std::to_string(g * g) + " bins (" +
+                std::to_string(bins_section_size(g, classes)) + " bytes)");
+    for (uint32_t c = 0; c < classes; ++c) {
+        const auto e = in.take<float>("lobe exponent");
+        if (!std::isfinite(e) || (c == 0 ? e != 0 : !(e >= layout.lobe_exponents.back())))
+            in.fail("bins section: lobe exponents must be finite, ascending, the first 0");
+        layout.lobe_exponents.push_back(e);
+    }
+    layout.choices.resize(size_t{classes} * g * g);
+    for (BinChoice& choice : layout.choices) {
+        choice.alpha = in.take<float>("bin alpha");
+        choice.threshold = in.take<float>("bin threshold");
+        if (!std::isfinite(choice.alpha) || !std::isfinite(choice.threshold) || choice.threshold < 0)
+            in.fail("bins section: a bin's alpha or threshold is not finite, or its threshold is negative");
+    }
+    return layout;
+}
+
 // The table of the map that `build` makes, its errors reported as the file's.
 template <class Build>
-Table checked_table(std::string_view name, uint32_t version, TableSource source, Build&& build) {
+Table checked_table(std::string_view name, const Header& header, std::optional<BinLayout> bins, Build&& build) {
     try {
-        return {build(), std::move(source), version};
+        Table table{build(), header.source, header.version};
+        table.bins = std::move(bins);
+        table.name = name;
+        return table;
     } catch (const std::invalid_argument& e) {
         fail(name, std::string("inconsistent contents: ") + e.what());
     }
@@ -380,6 +472,13 @@ Table read_payload(Header header, Read&& read, std::string_view name) {
     }
     read(&digest, sizeof digest);
     if (digest != payload_hash.digest()) fail(name, "corrupted payload (checksum mismatch)");
+    std::optional<BinLayout> bins;
+    if (header.bins_size != 0) {
+        std::vector<std::byte> section(header.bins_size);
+        read(section.data(), section.size());
+        read(&digest, sizeof digest);
+        bins = parse_bins(section, digest, header, name);
+    }
     if (header.compact) {
         const uint32_t w = header.w;
         detail::parallel_for(header.h, 16, [&](uint32_t lo, uint32_t hi) {
@@ -393,11 +492,11 @@ Table read_payload(Header header, Read&& read, std::string_view name) {
             }
         });
     }
-    return checked_table(name, header.version, std::move(header.source),
+    return checked_table(name, header, std::move(bins),
                          [&] { return EnvMap(std::move(radiance), std::move(density), header.options, header.stats); });
 }
 
-// A full version 3 payload in a file mapping, used in place: the map borrows the
+// A full payload (version 3 or later) in a file mapping, used in place: the map borrows the
 // radiance from the mapping, which it keeps alive; only the density is copied, into the
 // buffer that becomes the CDF table. Null if the payload cannot be used in place (compact,
 // or an older version whose arrays may be misaligned).
@@ -422,12 +521,19 @@ std::optional<Table> read_mapped_payload(Header header, const std::shared_ptr<co
     }
     payload_hash.update(radiance_bytes);
     uint64_t digest = 0;
-    std::memcpy(&digest, payload.data() + density_bytes.size() + radiance_bytes.size(), sizeof digest);
+    const size_t digest_at = density_bytes.size() + radiance_bytes.size();
+    std::memcpy(&digest, payload.data() + digest_at, sizeof digest);
     if (digest != payload_hash.digest()) fail(name, "corrupted payload (checksum mismatch)");
+    std::optional<BinLayout> bins;
+    if (header.bins_size != 0) {
+        const auto section = payload.subspan(digest_at + sizeof digest, header.bins_size);
+        std::memcpy(&digest, section.data() + section.size(), sizeof digest);
+        bins = parse_bins(section, digest, header, name);
+    }
     const RgbImageView radiance{
         header.w, header.h,
         std::span(reinterpret_cast<const Rgb*>(radiance_bytes.data()), static_cast<size_t>(texels))};
-    Table table = checked_table(name, header.version, std::move(header.source), [&] {
+    Table table = checked_table(name, header, std::move(bins), [&] {
         return EnvMap(radiance, file, std::move(density), header.options, header.stats);
     });
     table.mapped = true;
@@ -481,6 +587,16 @@ Table read_table(const std::filesystem::path& path, TableLoading loading) {
                 throw TableError(describe_errno(path, "read"));
         },
         path.string());
+}
+
+BinnedEnvMap binned_map(Table&& table) {
+    const std::string name = table.name.empty() ? "table" : table.name;
+    if (!table.bins) fail(name, "has no bins (write it with precompute --bins)");
+    try {
+        return BinnedEnvMap(std::move(table.map), *table.bins);
+    } catch (const std::invalid_argument& e) {
+        fail(name, std::string("bins do not fit the map: ") + e.what());
+    }
 }
 
 bool looks_like_table(const std::filesystem::path& path) noexcept {

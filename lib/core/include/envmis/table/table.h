@@ -1,9 +1,10 @@
 // Table files: a built EnvMap saved to disk, readable with envmis::core alone.
 //
-// The format (version 3; versions 1 and 2 are read too) is specified in docs/table-format.md: a fixed preamble (magic,
+// The format (version 4; versions 1 to 3 are read too) is specified in docs/table-format.md: a fixed preamble (magic,
 // version, byte order, total size), a metadata block with the build options and the
 // source's name and content hash, a header checksum, then the payload (the image
-// density q sin(theta) and the RGB radiance, both float32) and a payload checksum.
+// density q sin(theta) and the RGB radiance, both float32) and a payload checksum, and,
+// for a binned map (sampling/binned.h), the bins' layout with its own checksum.
 // The sampling structures are derived data and are rebuilt on load by the same code
 // that built them, so a loaded table samples bit-identically to the saved one, and no
 // index read from a file can ever address memory.
@@ -15,16 +16,20 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 
+#include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"
 
 namespace envmis {
 
-inline constexpr uint32_t kTableVersion = 3;
+// Every table is written as version 4, with or without bins: a version 3 reader would
+// misread the bins-section size that version 4 adds to the metadata.
+inline constexpr uint32_t kTableVersion = 4;
 
 // Where a table's map came from.
 struct TableSource {
@@ -39,6 +44,11 @@ struct Table {
     TableSource source;
     uint32_t version = 0;  // the file's format version
     bool mapped = false;   // the map borrows its radiance from a mapping of the file
+    // The bins of a binned map (version 4 tables written from a BinnedEnvMap): `map` is
+    // then the plain map they were built over. Checked against the map's size when read;
+    // binned_map rebuilds them.
+    std::optional<BinLayout> bins;
+    std::string name;  // the file's path (parse_table: its `name`), for error messages
 };
 
 // A table file that cannot be read; what() names the file and the problem.
@@ -62,6 +72,13 @@ enum class TableEncoding { full, compact };
 void write_table(const std::filesystem::path& path, const EnvMap& map, const TableSource& source,
                  TableEncoding encoding = TableEncoding::full);
 
+// A binned map: its plain map (as the overload above writes it) and its BinLayout, from
+// which the reader rebuilds the bins bit-identically. A compact table holds the
+// RGBE-rounded plain map and loads as BinnedEnvMap(EnvMap(rgbe_round(radiance),
+// options), layout).
+void write_table(const std::filesystem::path& path, const BinnedEnvMap& binned, const TableSource& source,
+                 TableEncoding encoding = TableEncoding::full);
+
 // The radiance a compact table stores: each pixel rounded to RGBE and back.
 RgbImage rgbe_round(RgbImageView image);
 
@@ -83,6 +100,10 @@ Table read_table(const std::filesystem::path& path, TableLoading loading = Table
 
 // The same checks on bytes already in memory; `name` appears in error messages.
 Table parse_table(std::span<const std::byte> bytes, std::string_view name);
+
+// Moves the table's map into the BinnedEnvMap its bins describe. Throws TableError,
+// naming the table, if it has no bins or they do not fit its map.
+BinnedEnvMap binned_map(Table&& table);
 
 // True if the file starts with the table magic (cheap; does not validate the rest).
 bool looks_like_table(const std::filesystem::path& path) noexcept;
