@@ -92,9 +92,11 @@ CLI::Validator bins_validator() {
             const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), k);
             const uint32_t g = bins_per_side(k);
             if (error == std::errc() && end == text.data() + text.size() && g >= 1 && g <= 64 && g * g == k) return {};
-            return "'" + text + "': expected a square number of bins, 1 to 4096 (1, 4, 9, ..., 100, ...)";
+            return text +
+                   ": expected a square number of bins (g x g octahedral grid) from 1 to 4096, such as 64, "
+                   "100 or 144";
         },
-        "SQUARE");
+        "K");
 }
 
 namespace {
