@@ -103,13 +103,18 @@ struct BinPanel {
     std::string title, description;  // the panel's (short: it is cut to the panel), the command's
 };
 
-std::optional<BinPanel> bin_panel(const VisualizeArgs& args, const EnvMap& plain) {
+// A binned table's own bins, else bins built here (--bins) over the plain map.
+std::optional<BinPanel> bin_panel(const VisualizeArgs& args, const LoadedMap& loaded, const EnvMap& plain) {
     if (args.normal.empty()) return std::nullopt;
     BinnedOptions options;
     options.bins_per_side = bins_per_side(args.bins);
     const Vec3 n = *parse_normal(args.normal);  // the flag's validator has accepted it
     const Bsdf bsdf = Bsdf::parse(args.lobe);
-    BinPanel p{std::make_unique<BinnedEnvMap>(EnvMap(plain), options), n, 0, {}};
+    BinPanel p{loaded.bins ? std::make_unique<BinnedEnvMap>(EnvMap(plain), *loaded.bins)
+                           : std::make_unique<BinnedEnvMap>(EnvMap(plain), options),
+               n,
+               0,
+               {}};
     p.lobe = p.binned->lobe_class(bsdf.phong_exponent());
     const uint32_t lobe = p.lobe;
     const float exponent = p.binned->layout().lobe_exponents[lobe];
@@ -117,7 +122,8 @@ std::optional<BinPanel> bin_panel(const VisualizeArgs& args, const EnvMap& plain
     title.precision(2);
     title << "binned, n=(" << n.x << "," << n.y << "," << n.z << ")";
     description << "binned panel: normal (" << n.x << ", " << n.y << ", " << n.z << "), " << bsdf.name()
-                << " -> lobe class " << lobe << " (Phong " << exponent << "), " << args.bins << " bins\n";
+                << " -> lobe class " << lobe << " (Phong " << exponent << "), " << p.binned->bins() << " bins"
+                << (loaded.bins ? " (the table's)\n" : "\n");
     p.title = title.str();
     p.description = description.str();
     return p;
@@ -177,7 +183,7 @@ Visualization visualize(const std::string& name, const Densities& d, const std::
 void run_visualize(const VisualizeArgs& args) {
     const LoadedMap loaded = load_map(args.input, args.map);
     const Densities densities{loaded.map, opposite_density(loaded.map)};
-    const std::optional<BinPanel> bin = bin_panel(args, densities.plain());
+    const std::optional<BinPanel> bin = bin_panel(args, loaded, densities.plain());
     const Visualization v = visualize(loaded.source.name, densities, bin, args.panel_width);
     io::write_png(args.output, v.picture);
     std::printf("envmis visualize: %s -> %s (%ux%u panels, pdf scale %.3g to %.3g per sr)\n", args.input.c_str(),
