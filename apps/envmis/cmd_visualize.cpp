@@ -110,11 +110,10 @@ std::optional<BinPanel> bin_panel(const VisualizeArgs& args, const LoadedMap& lo
     options.bins_per_side = bins_per_side(args.bins);
     const Vec3 n = *parse_normal(args.normal);  // the flag's validator has accepted it
     const Bsdf bsdf = Bsdf::parse(args.lobe);
-    BinPanel p{loaded.bins ? std::make_unique<BinnedEnvMap>(EnvMap(plain), *loaded.bins)
-                           : std::make_unique<BinnedEnvMap>(EnvMap(plain), options),
-               n,
-               0,
-               {}};
+    BinPanel p;
+    p.binned = loaded.bins ? std::make_unique<BinnedEnvMap>(EnvMap(plain), *loaded.bins)
+                           : std::make_unique<BinnedEnvMap>(EnvMap(plain), options);
+    p.normal = n;
     p.lobe = p.binned->lobe_class(bsdf.phong_exponent());
     const uint32_t lobe = p.lobe;
     const float exponent = p.binned->layout().lobe_exponents[lobe];
