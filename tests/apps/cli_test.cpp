@@ -315,13 +315,13 @@ TEST_F(Cli, VisualizeWithANormalAddsTheBinnedPanelToTheSamePicture) {
         auto in = OIIO::ImageInput::open(file(png).string());
         return in ? in->spec().width : 0;
     };
-    const Result plain = envmis({"visualize", map, "-o", "plain.png", "--panel-width", "128"});
+    const Result plain = envmis({"visualize", map, "-o", "plain.png", "--panel-width", "512"});
     ASSERT_EQ(plain.exit_code, 0) << plain;
-    const Result r = envmis({"visualize", map, "-o", "binned.png", "--panel-width", "128", "--normal", "0,0,2",
+    const Result r = envmis({"visualize", map, "-o", "binned.png", "--panel-width", "512", "--normal", "0,0,2",
                              "--bins", "16", "--lobe", "ggx:0.2"});
     ASSERT_EQ(r.exit_code, 0) << r;
     EXPECT_TRUE(contains(r.out, "binned.png")) << r;
-    EXPECT_GE(width("binned.png"), width("plain.png") + 128) << r;  // one more panel
+    EXPECT_GE(width("binned.png"), width("plain.png") + 512) << r;  // one more panel
 }
 
 TEST_F(Cli, BenchWithBinsAddsTheBinnedSamplerAgainstTodaysMaps) {
