@@ -1,13 +1,17 @@
 // Google Benchmark: the guided-CDF sampler (EnvMap) against the textbook float-CDF
-// sampler (reference::TextbookEnvMap), building and sampling the same synthetic sky.
+// sampler (reference::TextbookEnvMap), building and sampling the same synthetic sky; and
+// the binned sampler (BinnedEnvMap, 100 bins, lobe class 0) against today's EnvMap,
+// plain and compensated, with a random shading normal per call.
 // Run with --benchmark_repetitions=5 --benchmark_report_aggregates_only=true for medians.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <random>
 #include <vector>
 
+#include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"
 #include "envmis/study/comparison/comparison.h"
 #include "envmis/study/techniques/estimator.h"
@@ -36,14 +40,23 @@ const std::vector<envmis::Vec2>& uniforms() {
     return us;
 }
 
-template <class Sampler>
+// Today's map, compensated (the default) or plain (what the binned sampler builds on).
+template <bool kCompensated = true>
+envmis::EnvMapOptions options() {
+    envmis::EnvMapOptions o;
+    o.compensation.enabled = kCompensated;
+    return o;
+}
+envmis::EnvMapOptions plain_options() { return options<false>(); }
+
+template <class Sampler, bool kCompensated = true>
 void build(benchmark::State& state) {
     const envmis::RgbImage& image = sky(static_cast<uint32_t>(state.range(0)));
     for (auto _ : state) {
         state.PauseTiming();
         envmis::RgbImage copy = image;
         state.ResumeTiming();
-        Sampler s(std::move(copy), envmis::EnvMapOptions{});
+        Sampler s(std::move(copy), options<kCompensated>());
         benchmark::DoNotOptimize(s);
     }
     state.counters["Mtexels/s"] = benchmark::Counter(
@@ -55,9 +68,9 @@ void build(benchmark::State& state) {
 EnvMapView hot_path(const EnvMap& map) { return map.view(); }
 const TextbookEnvMap& hot_path(const TextbookEnvMap& map) { return map; }
 
-template <class Sampler>
+template <class Sampler, bool kCompensated = true>
 void sample(benchmark::State& state) {
-    const Sampler s(sky(static_cast<uint32_t>(state.range(0))), envmis::EnvMapOptions{});
+    const Sampler s(sky(static_cast<uint32_t>(state.range(0))), options<kCompensated>());
     const auto& sampler = hot_path(s);
     const auto& us = uniforms();
     size_t i = 0;
@@ -70,28 +83,43 @@ void sample(benchmark::State& state) {
 // The guided sampler through sample_many, kBatch points a call (as the estimator's lanes
 // or a wavefront renderer ask): the points are the same as sample's, stored as the
 // batch call reads them; the counter is the time per sample.
-void sample_batch(benchmark::State& state) {
-    constexpr size_t kBatch = 64;
-    const EnvMap map(sky(static_cast<uint32_t>(state.range(0))), envmis::EnvMapOptions{});
-    const EnvMapView view = map.view();
-    const auto coordinate = [](float envmis::Vec2::*c) {
-        std::vector<float> v;
-        for (const envmis::Vec2 u : uniforms()) v.push_back(u.*c);
-        return v;
-    };
-    static const std::vector<float> ux = coordinate(&envmis::Vec2::x), uy = coordinate(&envmis::Vec2::y);
-    std::vector<float> out(7 * kBatch);
-    float* o = out.data();
-    const envmis::SampleArrays arrays{
-        o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch, o + 4 * kBatch, o + 5 * kBatch, o + 6 * kBatch};
-    size_t first = 0;
-    for (auto _ : state) {
-        envmis::sample_many(view, {ux.data() + first, uy.data() + first}, arrays, kBatch);
-        benchmark::DoNotOptimize(o);
-        first = (first + kBatch) & (ux.size() - 1);
-    }
+constexpr size_t kBatch = 64;
+const std::vector<envmis::Vec3>& directions();
+const std::vector<envmis::Vec3>& normals();
+struct BatchPoints {
+    std::vector<float> ux, uy, nx, ny, nz;
+};
+const BatchPoints& batch_points() {
+    static const BatchPoints p = [] {
+        BatchPoints b;
+        for (const envmis::Vec2 u : uniforms()) b.ux.push_back(u.x), b.uy.push_back(u.y);
+        for (const envmis::Vec3 n : normals()) b.nx.push_back(n.x), b.ny.push_back(n.y), b.nz.push_back(n.z);
+        return b;
+    }();
+    return p;
+}
+envmis::SampleArrays sample_arrays(float* o) {
+    return {o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch, o + 4 * kBatch, o + 5 * kBatch, o + 6 * kBatch};
+}
+void per_sample(benchmark::State& state) {
     state.counters["per_sample"] = benchmark::Counter(
         static_cast<double>(kBatch), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+template <bool kCompensated>
+void sample_batch(benchmark::State& state) {
+    const EnvMap map(sky(static_cast<uint32_t>(state.range(0))), options<kCompensated>());
+    const EnvMapView view = map.view();
+    const BatchPoints& p = batch_points();
+    std::vector<float> out(7 * kBatch);
+    const envmis::SampleArrays arrays = sample_arrays(out.data());
+    size_t first = 0;
+    for (auto _ : state) {
+        envmis::sample_many(view, {p.ux.data() + first, p.uy.data() + first}, arrays, kBatch);
+        benchmark::DoNotOptimize(out.data());
+        first = (first + kBatch) & (p.ux.size() - 1);
+    }
+    per_sample(state);
 }
 
 // Uniformly distributed directions, made before timing: the pdf benchmark times the
@@ -109,9 +137,78 @@ const std::vector<envmis::Vec3>& directions() {
     return ds;
 }
 
-template <class Sampler>
+// The binned sampler over the plain map of sky(w), built once per width for all its
+// benchmarks (a build at 8k takes seconds).
+const envmis::BinnedEnvMap& binned(uint32_t w) {
+    static std::map<uint32_t, envmis::BinnedEnvMap> maps;
+    auto it = maps.find(w);
+    if (it == maps.end()) it = maps.emplace(w, envmis::BinnedEnvMap(EnvMap(sky(w), plain_options()))).first;
+    return it->second;
+}
+
+// Shading normals, uniform on the sphere and independent of the points and directions:
+// the binned benchmarks pay for finding each call's bin.
+const std::vector<envmis::Vec3>& normals() {
+    static const std::vector<envmis::Vec3> ns = [] {
+        std::vector<envmis::Vec3> v = directions();
+        std::rotate(v.begin(), v.begin() + 12345, v.end());
+        return v;
+    }();
+    return ns;
+}
+
+void build_bins(benchmark::State& state) {
+    const EnvMap plain(sky(static_cast<uint32_t>(state.range(0))), plain_options());
+    for (auto _ : state) {
+        state.PauseTiming();
+        EnvMap copy = plain;
+        state.ResumeTiming();
+        envmis::BinnedEnvMap b(std::move(copy));
+        benchmark::DoNotOptimize(b);
+    }
+}
+
+void sample_binned(benchmark::State& state) {
+    const envmis::BinnedEnvMapView view = binned(static_cast<uint32_t>(state.range(0))).view();
+    const auto& us = uniforms();
+    const auto& ns = normals();
+    size_t i = 0;
+    for (auto _ : state) {
+        const size_t k = i++ & (us.size() - 1);
+        const envmis::EnvSample e = view.sample(ns[k], 0, us[k]);
+        benchmark::DoNotOptimize(e);
+    }
+}
+
+void sample_binned_batch(benchmark::State& state) {
+    const envmis::BinnedEnvMapView view = binned(static_cast<uint32_t>(state.range(0))).view();
+    const BatchPoints& p = batch_points();
+    std::vector<float> out(7 * kBatch);
+    const envmis::SampleArrays arrays = sample_arrays(out.data());
+    size_t first = 0;
+    for (auto _ : state) {
+        envmis::sample_many(view, 0, {p.nx.data() + first, p.ny.data() + first, p.nz.data() + first},
+                            {p.ux.data() + first, p.uy.data() + first}, arrays, kBatch);
+        benchmark::DoNotOptimize(out.data());
+        first = (first + kBatch) & (p.ux.size() - 1);
+    }
+    per_sample(state);
+}
+
+void pdf_binned(benchmark::State& state) {
+    const envmis::BinnedEnvMapView view = binned(static_cast<uint32_t>(state.range(0))).view();
+    const auto& ds = directions();
+    const auto& ns = normals();
+    size_t i = 0;
+    for (auto _ : state) {
+        const size_t k = i++ & (ds.size() - 1);
+        benchmark::DoNotOptimize(view.pdf(ns[k], 0, ds[k]));
+    }
+}
+
+template <class Sampler, bool kCompensated = true>
 void pdf(benchmark::State& state) {
-    const Sampler s(sky(static_cast<uint32_t>(state.range(0))), envmis::EnvMapOptions{});
+    const Sampler s(sky(static_cast<uint32_t>(state.range(0))), options<kCompensated>());
     const auto& sampler = hot_path(s);
     const auto& ds = directions();
     size_t i = 0;
@@ -147,7 +244,17 @@ BENCHMARK(build<EnvMap>)->Name("build/guided")->Apply(sizes);
 BENCHMARK(build<TextbookEnvMap>)->Name("build/textbook")->Apply(sizes);
 BENCHMARK(sample<EnvMap>)->Name("sample/guided")->Apply(sizes_ns);
 BENCHMARK(sample<TextbookEnvMap>)->Name("sample/textbook")->Apply(sizes_ns);
-BENCHMARK(sample_batch)->Name("sample/guided-many")->Apply(sizes_ns);
+BENCHMARK(sample_batch<true>)->Name("sample/guided-many")->Apply(sizes_ns);
+// Binned against today's map, plain and compensated (guided above); build/bins is the
+// bins alone, on top of a plain map's build.
+BENCHMARK(build<EnvMap, false>)->Name("build/plain")->Apply(sizes);
+BENCHMARK(build_bins)->Name("build/bins")->Apply(sizes);
+BENCHMARK(sample<EnvMap, false>)->Name("sample/plain")->Apply(sizes_ns);
+BENCHMARK(sample_batch<false>)->Name("sample/plain-many")->Apply(sizes_ns);
+BENCHMARK(sample_binned)->Name("sample/binned")->Apply(sizes_ns);
+BENCHMARK(sample_binned_batch)->Name("sample/binned-many")->Apply(sizes_ns);
+BENCHMARK(pdf<EnvMap, false>)->Name("pdf/plain")->Apply(sizes_ns);
+BENCHMARK(pdf_binned)->Name("pdf/binned")->Apply(sizes_ns);
 BENCHMARK(pdf<EnvMap>)->Name("pdf/guided")->Apply(sizes_ns);
 BENCHMARK(pdf<TextbookEnvMap>)->Name("pdf/textbook")->Apply(sizes_ns);
 BENCHMARK_CAPTURE(estimate, mis_balance_lambert, "mis-balance", envmis::Bsdf::lambert())

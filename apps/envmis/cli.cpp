@@ -86,6 +86,20 @@ CLI::Validator size_validator(bool single, uint32_t min_side, uint32_t max_side)
         "");
 }
 
+CLI::Validator bins_validator() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            uint32_t k = 0;
+            const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), k);
+            const uint32_t g = bins_per_side(k);
+            if (error == std::errc() && end == text.data() + text.size() && g >= 1 && g <= 64 && g * g == k) return {};
+            return text +
+                   ": expected a square number of bins (g x g octahedral grid) from 1 to 4096, such as 64, "
+                   "100 or 144";
+        },
+        "K");
+}
+
 namespace {
 // A signal handler can reach only static storage.
 std::atomic<bool> g_interrupted{false};

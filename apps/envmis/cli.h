@@ -5,6 +5,7 @@
 #include <atomic>
 #include <charconv>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -16,6 +17,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"
 #include "envmis/study/comparison/alpha.h"
 #include "envmis/table/table.h"
@@ -65,6 +67,13 @@ std::optional<Size> parse_size(const std::string& text, bool single, uint32_t mi
                                uint32_t max_side = kMaxCells1D);
 // A validator for such a flag, saying what it expects when it refuses a value.
 CLI::Validator size_validator(bool single, uint32_t min_side = 1, uint32_t max_side = kMaxCells1D);
+
+// A bin count flag (--bins K): a square number g^2 with g 1 to 64, as BinnedOptions
+// takes it; its side g.
+CLI::Validator bins_validator();
+inline uint32_t bins_per_side(uint32_t bins) {
+    return static_cast<uint32_t>(std::lround(std::sqrt(static_cast<double>(bins))));
+}
 
 // A map ready to sample, and where it came from.
 struct LoadedMap {

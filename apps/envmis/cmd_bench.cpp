@@ -1,11 +1,15 @@
-// envmis bench [IN | --size WxH]: build and sampling speed of the guided-CDF sampler
-// against the textbook float-CDF sampler, measured in the same run on the same map.
+// envmis bench [IN | --size WxH] [--bins K]: build and sampling speed of the guided-CDF
+// sampler against the textbook float-CDF sampler, measured in the same run on the same
+// map; with --bins, also the binned sampler (binned.h) against today's EnvMap, plain and
+// compensated: what a renderer pays for normal-aware sampling.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <random>
+#include <tuple>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -42,12 +46,17 @@ double ns_per_call(const std::vector<Input>& inputs, Call&& call) {
 // a batch of kBatch.
 constexpr uint32_t kBatch = 64;
 struct BatchInputs {
-    std::vector<float> ux, uy, x, y, z;
+    std::vector<float> ux, uy, x, y, z, nx, ny, nz;  // n: the shading normals (binned)
     std::vector<float> out = std::vector<float>(7 * kBatch);
 
-    BatchInputs(const std::vector<Vec2>& us, const std::vector<Vec3>& directions) {
+    BatchInputs(const std::vector<Vec2>& us, const std::vector<Vec3>& directions,
+                const std::vector<Vec3>& normals = {}) {
         for (const Vec2 u : us) ux.push_back(u.x), uy.push_back(u.y);
         for (const Vec3 d : directions) x.push_back(d.x), y.push_back(d.y), z.push_back(d.z);
+        for (const Vec3 n : normals) nx.push_back(n.x), ny.push_back(n.y), nz.push_back(n.z);
+    }
+    SampleArrays sample_out(float* o) const {
+        return {o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch, o + 4 * kBatch, o + 5 * kBatch, o + 6 * kBatch};
     }
     // ns per sample (per lookup) over all inputs, kBatch at a time (the rest, fewer).
     template <class Call>
@@ -63,9 +72,20 @@ struct BatchInputs {
     }
     double sample_cost(const EnvMapView& view) {
         return ns_per_item(ux.size(), [&](size_t first, uint32_t n, float* o) {
-            sample_many(view, {ux.data() + first, uy.data() + first},
-                        {o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch, o + 4 * kBatch, o + 5 * kBatch, o + 6 * kBatch},
-                        n);
+            sample_many(view, {ux.data() + first, uy.data() + first}, sample_out(o), n);
+        });
+    }
+    double sample_cost(const BinnedEnvMapView& view, uint32_t lobe) {
+        return ns_per_item(ux.size(), [&](size_t first, uint32_t n, float* o) {
+            sample_many(view, lobe, {nx.data() + first, ny.data() + first, nz.data() + first},
+                        {ux.data() + first, uy.data() + first}, sample_out(o), n);
+        });
+    }
+    double lookup_cost(const BinnedEnvMapView& view, uint32_t lobe) {
+        return ns_per_item(x.size(), [&](size_t first, uint32_t n, float* o) {
+            lookup_many(view, lobe, {nx.data() + first, ny.data() + first, nz.data() + first},
+                        {x.data() + first, y.data() + first, z.data() + first},
+                        {o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch}, n);
         });
     }
     double lookup_cost(const EnvMapView& view) {
@@ -76,15 +96,16 @@ struct BatchInputs {
     }
 };
 
-// A sampler built `repeats` times (the last one kept) and the median build time.
-template <class Sampler>
-std::pair<std::unique_ptr<Sampler>, double> build_repeatedly(const RgbImage& image, int repeats,
-                                                             const std::function<Sampler(RgbImage&)>& build,
+// A sampler built `repeats` times from copies of `source` (the copy untimed; the last
+// sampler kept) and the median build time.
+template <class Sampler, class Source>
+std::pair<std::unique_ptr<Sampler>, double> build_repeatedly(const Source& source, int repeats,
+                                                             const std::function<Sampler(Source&)>& build,
                                                              Progress& progress, int& step) {
     std::vector<double> builds;
     std::unique_ptr<Sampler> sampler;
     for (int r = 0; r < repeats; ++r) {
-        RgbImage copy = image;
+        Source copy = source;
         const auto start = std::chrono::steady_clock::now();
         sampler = std::make_unique<Sampler>(build(copy));
         builds.push_back(milliseconds_since(start));
@@ -98,6 +119,7 @@ struct BenchArgs {
     std::string input, size = "8192x4096";
     int repeats = 5;
     uint32_t samples = 1u << 20;
+    uint32_t bins = 0;  // 0: no binned measurement
     bool json = false, no_compensate = false;
 };
 
@@ -119,6 +141,11 @@ void add_bench_flags(CLI::App& sub, BenchArgs& args) {
         ->capture_default_str()
         ->check(in_range(uint32_t{1}, kMaxBenchSamples));
     sub.add_flag("--no-compensate", args.no_compensate, "Measure the uncompensated density");
+    sub.add_option("--bins", args.bins,
+                   "Also measure the binned sampler with K bins (square number) against today's EnvMap, plain and "
+                   "compensated: build, memory, sample and pdf with a random normal per call (lobe class 0)")
+        ->type_name("K")
+        ->check(bins_validator());
     sub.add_flag("--json", args.json, "Print one JSON object instead of text lines");
 }
 
@@ -138,21 +165,27 @@ BenchMap bench_map(const BenchArgs& args) {
     return {to_image(load_map(args.input, flags).map.radiance()), args.input};
 }
 
-// The random points every sampler is timed on: u for sampling, directions for the pdf.
+// The random points every sampler is timed on: u for sampling, directions for the pdf,
+// and (with `normals`) a shading normal per call for the binned sampler, whose cost
+// includes finding the normal's bin.
 struct BenchPoints {
     std::vector<Vec2> us;
-    std::vector<Vec3> directions;
+    std::vector<Vec3> directions, normals;
 };
 
-BenchPoints bench_points(uint32_t n) {
+BenchPoints bench_points(uint32_t n, bool normals) {
     std::mt19937_64 rng(7);
     auto uniform = [&rng] { return static_cast<float>(rng() >> 40) * 0x1p-24f; };
-    BenchPoints points{std::vector<Vec2>(n), std::vector<Vec3>(n)};
+    auto sphere = [&](std::vector<Vec3>& v) {
+        for (Vec3& d : v) {
+            const float z = 1 - 2 * uniform(), phi = 2 * kPiF * uniform(), r = std::sqrt(std::max(0.0f, 1 - z * z));
+            d = {r * std::cos(phi), r * std::sin(phi), z};
+        }
+    };
+    BenchPoints points{std::vector<Vec2>(n), std::vector<Vec3>(n), std::vector<Vec3>(normals ? n : 0)};
     for (Vec2& u : points.us) u = {uniform(), uniform()};
-    for (Vec3& d : points.directions) {
-        const float z = 1 - 2 * uniform(), phi = 2 * kPiF * uniform(), r = std::sqrt(std::max(0.0f, 1 - z * z));
-        d = {r * std::cos(phi), r * std::sin(phi), z};
-    }
+    sphere(points.directions);
+    sphere(points.normals);
     return points;
 }
 
@@ -203,9 +236,9 @@ CallTimes time_calls(const EnvMap& guided, const reference::TextbookEnvMap& text
 BenchResult measure(const RgbImage& image, const EnvMapOptions& options, const BenchPoints& points, int repeats) {
     Progress progress("bench", 3 * repeats);
     int step = 0;
-    const auto [guided, guided_build] = build_repeatedly<EnvMap>(
+    const auto [guided, guided_build] = build_repeatedly<EnvMap, RgbImage>(
         image, repeats, [&](RgbImage& copy) { return EnvMap(std::move(copy), options); }, progress, step);
-    const auto [textbook, textbook_build] = build_repeatedly<reference::TextbookEnvMap>(
+    const auto [textbook, textbook_build] = build_repeatedly<reference::TextbookEnvMap, RgbImage>(
         image, repeats, [&](RgbImage&) { return reference::TextbookEnvMap(image, options); }, progress, step);
     const CallTimes c = time_calls(*guided, *textbook, points, repeats, progress, step);
     const double texels = static_cast<double>(image.width) * image.height;
@@ -223,7 +256,128 @@ BenchResult measure(const RgbImage& image, const EnvMapOptions& options, const B
     return result;
 }
 
-void print_bench_json(const BenchArgs& args, const BenchMap& map, const BenchResult& result) {
+// The binned sampler against today's EnvMap, plain and compensated (the binned one
+// samples texels by the plain map's density; the compensated one is what a global table
+// holds). Kinds of call: single sample, single pdf, sample_many, lookup_many; every
+// sampler gets the same (u, normal) and (direction, normal) inputs, today's ignoring the
+// normal, so that only the sampler differs.
+enum Today { kPlain, kCompensated };
+constexpr const char* kCallNames[4] = {"sample", "pdf", "batch_sample", "batch_lookup"};
+struct BinnedResult {
+    uint32_t bins = 0, cells_w = 0, cells_h = 0;
+    double build_ms[3] = {}, bytes[3] = {};  // plain, compensated, bins (bins alone)
+    double ns[3][4] = {};                    // per sampler and kind of call
+    double ratio[2][4] = {};                 // binned over plain, over compensated
+};
+
+// ns per call of the three samplers, back to back in each repeat; lobe class 0.
+void time_binned_calls(const EnvMapView (&today)[2], const BinnedEnvMapView& binned, const BenchPoints& points,
+                       int repeats, Progress& progress, int& step, BinnedResult& result) {
+    std::vector<std::pair<Vec2, Vec3>> samples;
+    std::vector<std::pair<Vec3, Vec3>> pdfs;
+    for (size_t i = 0; i < points.us.size(); ++i)
+        samples.emplace_back(points.us[i], points.normals[i]),
+            pdfs.emplace_back(points.directions[i], points.normals[i]);
+    const auto sum = [](const EnvSample& s) { return s.pdf + s.direction.x + s.radiance.r; };
+    BatchInputs batch(points.us, points.directions, points.normals);
+    std::vector<double> ns[3][4], ratio[2][4];
+    for (int r = 0; r < repeats; ++r) {
+        double t[3][4];
+        for (int k = 0; k < 2; ++k) {
+            t[k][0] = ns_per_call(samples, [&](const auto& in) { return sum(today[k].sample(in.first)); });
+            t[k][1] = ns_per_call(pdfs, [&](const auto& in) { return today[k].pdf(in.first); });
+            t[k][2] = batch.sample_cost(today[k]);
+            t[k][3] = batch.lookup_cost(today[k]);
+        }
+        t[2][0] = ns_per_call(samples, [&](const auto& in) { return sum(binned.sample(in.second, 0, in.first)); });
+        t[2][1] = ns_per_call(pdfs, [&](const auto& in) { return binned.pdf(in.second, 0, in.first); });
+        t[2][2] = batch.sample_cost(binned, 0);
+        t[2][3] = batch.lookup_cost(binned, 0);
+        for (int c = 0; c < 4; ++c) {
+            for (int k = 0; k < 3; ++k) ns[k][c].push_back(t[k][c]);
+            for (int k = 0; k < 2; ++k) ratio[k][c].push_back(t[2][c] / t[k][c]);
+        }
+        progress.update(++step);
+    }
+    for (int c = 0; c < 4; ++c) {
+        for (int k = 0; k < 3; ++k) result.ns[k][c] = median(ns[k][c]);
+        for (int k = 0; k < 2; ++k) result.ratio[k][c] = median(ratio[k][c]);
+    }
+}
+
+BinnedResult measure_binned(const RgbImage& image, uint32_t bins, const BenchPoints& points, int repeats) {
+    Progress progress("bench --bins", 4 * repeats);
+    int step = 0;
+    BinnedResult result;
+    std::unique_ptr<EnvMap> today[2];
+    for (int k : {kPlain, kCompensated}) {
+        EnvMapOptions options;
+        options.compensation.enabled = k == kCompensated;
+        std::tie(today[k], result.build_ms[k]) = build_repeatedly<EnvMap, RgbImage>(
+            image, repeats, [&](RgbImage& copy) { return EnvMap(std::move(copy), options); }, progress, step);
+        result.bytes[k] = static_cast<double>(today[k]->distribution().bytes()) +
+                          static_cast<double>(sizeof(Rgb)) * image.width * image.height;
+    }
+    BinnedOptions options;
+    options.bins_per_side = bins_per_side(bins);
+    const auto [binned, bins_ms] = build_repeatedly<BinnedEnvMap, EnvMap>(
+        *today[kPlain], repeats, [&](EnvMap& copy) { return BinnedEnvMap(std::move(copy), options); }, progress, step);
+    result.bins = bins;
+    result.cells_w = binned->layout().cell_columns, result.cells_h = binned->layout().cell_rows;
+    result.build_ms[2] = bins_ms;
+    result.bytes[2] = static_cast<double>(binned->bytes());
+    const BinnedEnvMapView binned_view = binned->view();
+    const EnvMapView views[2] = {today[kPlain]->view(), today[kCompensated]->view()};
+    time_binned_calls(views, binned_view, points, repeats, progress, step, result);
+    return result;
+}
+
+// What a binned precompute costs over today's (a plain map, then its bins, against the
+// compensated map), and the bins' memory over today's map (density and radiance).
+double binned_build_ratio(const BinnedResult& b) {
+    return (b.build_ms[kPlain] + b.build_ms[2]) / b.build_ms[kCompensated];
+}
+double binned_memory_ratio(const BinnedResult& b) { return b.bytes[2] / b.bytes[kCompensated]; }
+constexpr const char* kBinnedSamplers[3] = {"plain", "compensated", "binned"};
+
+nlohmann::json binned_json(const BinnedResult& b) {
+    nlohmann::json j = {{"bins", b.bins}, {"cells", {b.cells_w, b.cells_h}}, {"lobe_class", 0}};
+    for (int k = 0; k < 3; ++k) {
+        nlohmann::json s = {{"sampler", kBinnedSamplers[k]}, {"build_ms", b.build_ms[k]}, {"bytes", b.bytes[k]}};
+        for (int c = 0; c < 4; ++c) s[std::string("ns_per_") + kCallNames[c]] = b.ns[k][c];
+        j["samplers"].push_back(s);
+    }
+    for (int k = 0; k < 2; ++k)
+        for (int c = 0; c < 4; ++c) j[std::string("binned_over_") + kBinnedSamplers[k]][kCallNames[c]] = b.ratio[k][c];
+    j["binned_over_compensated"]["build"] = binned_build_ratio(b);
+    j["binned_over_compensated"]["memory"] = binned_memory_ratio(b);
+    return j;
+}
+
+void print_binned_text(const BinnedResult& b) {
+    std::printf(
+        "binned bins=%u cells=%ux%u lobe_class=0 (a random normal per call; bins' build_ms and bytes "
+        "exclude their plain map)\n",
+        b.bins, b.cells_w, b.cells_h);
+    for (int k = 0; k < 3; ++k)
+        std::printf(
+            "sampler=%s build_ms=%.1f ns_per_sample=%.1f ns_per_pdf=%.1f ns_per_batch_sample=%.1f "
+            "ns_per_batch_lookup=%.1f bytes=%.0f\n",
+            kBinnedSamplers[k], b.build_ms[k], b.ns[k][0], b.ns[k][1], b.ns[k][2], b.ns[k][3], b.bytes[k]);
+    for (int k = 0; k < 2; ++k) {
+        std::printf("binned_over_%s sample=%.2fx pdf=%.2fx batch_sample=%.2fx batch_lookup=%.2fx", kBinnedSamplers[k],
+                    b.ratio[k][0], b.ratio[k][1], b.ratio[k][2], b.ratio[k][3]);
+        if (k == kCompensated)
+            std::printf(" build=%.2fx memory=%.2f%%", binned_build_ratio(b), 100 * binned_memory_ratio(b));
+        std::printf("\n");
+    }
+    std::printf(
+        "(binned over today's: time or bytes, median of the ratios within each repeat; build: plain map "
+        "plus bins over the compensated map)\n");
+}
+
+void print_bench_json(const BenchArgs& args, const BenchMap& map, const BenchResult& result,
+                      const std::optional<BinnedResult>& binned) {
     nlohmann::json j = {{"map", map.name},
                         {"width", map.image.width},
                         {"height", map.image.height},
@@ -241,10 +395,12 @@ void print_bench_json(const BenchArgs& args, const BenchMap& map, const BenchRes
                                 {"pdf", result.pdf},
                                 {"batch_sample", result.batch_sample},
                                 {"batch_pdf", result.batch_pdf}};
+    if (binned) j["binned"] = binned_json(*binned);
     std::cout << j.dump(2) << "\n";
 }
 
-void print_bench_text(const BenchArgs& args, const BenchMap& map, const BenchResult& result) {
+void print_bench_text(const BenchArgs& args, const BenchMap& map, const BenchResult& result,
+                      const std::optional<BinnedResult>& binned) {
     std::printf("map=%s size=%ux%u compensated=%d repeats=%d samples=%u (medians)\n", map.name.c_str(), map.image.width,
                 map.image.height, !args.no_compensate, args.repeats, args.samples);
     for (const Timing& t : result.timings)
@@ -254,17 +410,21 @@ void print_bench_text(const BenchArgs& args, const BenchMap& map, const BenchRes
         "speedup_vs_textbook build=%.2fx sample=%.2fx pdf=%.2fx batch_sample=%.2fx "
         "batch_pdf=%.2fx (sample, pdf: median of the ratios within each repeat)\n",
         result.build, result.sample, result.pdf, result.batch_sample, result.batch_pdf);
+    if (binned) print_binned_text(*binned);
 }
 
 void run_bench(const BenchArgs& args) {
     const BenchMap map = bench_map(args);
     EnvMapOptions options;
     options.compensation.enabled = !args.no_compensate;
-    const BenchResult result = measure(map.image, options, bench_points(args.samples), args.repeats);
+    const BenchPoints points = bench_points(args.samples, args.bins > 0);
+    const BenchResult result = measure(map.image, options, points, args.repeats);
+    std::optional<BinnedResult> binned;
+    if (args.bins > 0) binned = measure_binned(map.image, args.bins, points, args.repeats);
     if (args.json)
-        print_bench_json(args, map, result);
+        print_bench_json(args, map, result, binned);
     else
-        print_bench_text(args, map, result);
+        print_bench_text(args, map, result, binned);
 }
 
 }  // namespace

@@ -39,35 +39,18 @@ struct PrecomputeArgs {
     uint32_t cell_columns = 0;
 };
 
-// --bins: a square number g^2 with g 1 to 64 (binned.h's grid of normals), digits only.
-CLI::Validator square_bins() {
-    return CLI::Validator(
-        [](std::string& text) -> std::string {
-            uint32_t k = 0;
-            const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), k);
-            const auto g = static_cast<uint32_t>(std::lround(std::sqrt(static_cast<double>(k))));
-            if (error == std::errc() && end == text.data() + text.size() && k >= 1 && k <= 4096 && g * g == k)
-                return {};
-            return text +
-                   ": expected a square number of bins (g x g octahedral grid) from 1 to 4096, such as 64, "
-                   "100 or 144";
-        },
-        "K");
-}
-
 void add_precompute_flags(CLI::App& sub, PrecomputeArgs& args) {
     sub.add_option("input", args.input, "HDR image (EXR, .hdr, .pfm, TIFF, ...)")->required();
     sub.add_option("-o,--output", args.output, "Table file to write (.envmis)")->required();
     sub.add_flag("--compact", args.compact,
                  "Store the radiance in RGBE (4 bytes/texel instead of 16; density rebuilt on load); prints the error");
     CLI::Option* bins =
-        sub.add_option(
-               "--bins", args.bins,
-               "Normal-aware table: K = g x g bins of normals, each with its own compensation (binned.h); the "
-               "texels keep the plain density. --alpha auto (the default with --bins) chooses per bin and lobe class, "
-               "--alpha X fixes it for every bin, --no-compensate makes it 0")
+        sub.add_option("--bins", args.bins,
+                       "Normal-aware table: K = g x g bins of normals, each with its own compensation (binned.h); "
+                       "the texels keep the plain density. --alpha auto (the default with --bins) chooses per bin "
+                       "and lobe class, --alpha X fixes it for every bin, --no-compensate makes it 0")
             ->type_name("K")
-            ->check(square_bins());
+            ->check(bins_validator());
     sub.add_option("--cell-columns", args.cell_columns, "With --bins: columns of the bins' cell grid (0: width / 32)")
         ->type_name("N")
         ->check(in_range(uint32_t{0}, uint32_t{4096}))
@@ -90,7 +73,7 @@ void print_precompute(const PrecomputeArgs& args, const LoadedMap& loaded, const
 // is what makes bins pay for every BSDF), --alpha X or --no-compensate (0) for every bin.
 BinnedOptions binned_options(const PrecomputeArgs& args) {
     BinnedOptions o;
-    o.bins_per_side = static_cast<uint32_t>(std::lround(std::sqrt(static_cast<double>(args.bins))));
+    o.bins_per_side = bins_per_side(args.bins);
     o.cell_columns = args.cell_columns;
     o.auto_alpha = (args.map.alpha_auto || !args.map.alpha_given) && !args.map.no_compensate;
     o.alpha = args.map.no_compensate ? 0.0f : args.map.alpha;

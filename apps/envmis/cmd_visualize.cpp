@@ -1,25 +1,50 @@
-// envmis visualize IN -o out.png: the map and its sampling densities, side by side.
+// envmis visualize IN -o out.png [--normal X,Y,Z [--bins K] [--lobe BSDF]]: the map and
+// its sampling densities, side by side; with --normal, also the density that the binned
+// sampler (binned.h) draws from at a shading point with that normal.
 #include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
+#include <span>
+#include <sstream>
 #include <vector>
 
 #include "cli.h"
 #include "envmis/io/image_io.h"
 #include "envmis/pictures/picture.h"
+#include "envmis/study/shading/bsdf.h"
 
 namespace envmis::cli {
 namespace {
 
 // Solid-angle pdf at every texel centre (per steradian): proportional to q, the
 // compensated or plain luminance, without the sin(theta) of the image-space density.
-std::vector<float> pdf_image(const EnvMap& map) {
-    const uint32_t w = map.width(), h = map.height();
+template <class Density>
+std::vector<float> pdf_image(const Density& density, uint32_t w, uint32_t h) {
     std::vector<float> pdf(size_t{w} * h);
     for (uint32_t y = 0; y < h; ++y)
-        for (uint32_t x = 0; x < w; ++x) pdf[size_t{y} * w + x] = map.pdf_uv({(x + 0.5f) / w, (y + 0.5f) / h});
+        for (uint32_t x = 0; x < w; ++x) pdf[size_t{y} * w + x] = density.pdf_uv({(x + 0.5f) / w, (y + 0.5f) / h});
     return pdf;
+}
+std::vector<float> pdf_image(const EnvMap& map) { return pdf_image(map, map.width(), map.height()); }
+
+// A shading normal "X,Y,Z": three finite numbers, not all zero (it is normalised).
+std::optional<Vec3> parse_normal(const std::string& text) {
+    float v[3];
+    const char* p = text.data();
+    const char* end = text.data() + text.size();
+    for (int i = 0; i < 3; ++i) {
+        if (i > 0 && (p == end || *p++ != ',')) return std::nullopt;
+        const auto [next, error] = std::from_chars(p, end, v[i]);
+        if (error != std::errc() || !std::isfinite(v[i])) return std::nullopt;
+        p = next;
+    }
+    const Vec3 n{v[0], v[1], v[2]};
+    if (p != end || !(length(n) > 0) || !std::isfinite(length(n))) return std::nullopt;
+    return normalize(n);
 }
 
 // The arguments of `envmis visualize`.
@@ -27,6 +52,8 @@ struct VisualizeArgs {
     std::string input, output;
     uint32_t panel_width = 512;
     MapFlags map;
+    std::string normal, lobe = "lambert";  // normal empty: no binned panel
+    uint32_t bins = 100;
 };
 
 void add_visualize_flags(CLI::App& sub, VisualizeArgs& args) {
@@ -35,7 +62,70 @@ void add_visualize_flags(CLI::App& sub, VisualizeArgs& args) {
     sub.add_option("--panel-width", args.panel_width, "Width of each panel in pixels")
         ->capture_default_str()
         ->check(in_range(uint32_t{64}, uint32_t{4096}));
+    sub.add_option("--normal", args.normal,
+                   "Also show the density the binned sampler draws from at a shading point with this normal "
+                   "(world frame; normalised)")
+        ->type_name("X,Y,Z")
+        ->check(CLI::Validator(
+            [](std::string& text) -> std::string {
+                if (parse_normal(text)) return {};
+                return "'" + text + "': expected X,Y,Z, three finite numbers, not all zero";
+            },
+            ""));
+    sub.add_option("--bins", args.bins, "Bins of the binned sampler (with --normal)")
+        ->type_name("K")
+        ->capture_default_str()
+        ->check(bins_validator());
+    sub.add_option("--lobe", args.lobe,
+                   "The shading point's BSDF, which picks the bin's lobe class (with --normal): lambert, phong:N "
+                   "or ggx:A")
+        ->type_name("BSDF")
+        ->capture_default_str()
+        ->check(CLI::Validator(
+            [](std::string& text) -> std::string {
+                try {
+                    Bsdf::parse(text);
+                    return {};
+                } catch (const std::invalid_argument& e) {
+                    return "'" + text + "': " + e.what();
+                }
+            },
+            ""));
     add_map_flags(sub, args.map);
+}
+
+// The binned sampler over the map's plain density and the bin that `normal` picks for
+// `lobe`'s class, with what the picture says about it.
+struct BinPanel {
+    std::unique_ptr<BinnedEnvMap> binned;
+    Vec3 normal;
+    uint32_t lobe = 0;
+    std::string title, description;  // the panel's (short: it is cut to the panel), the command's
+};
+
+// A binned table's own bins, else bins built here (--bins) over the plain map.
+std::optional<BinPanel> bin_panel(const VisualizeArgs& args, const LoadedMap& loaded, const EnvMap& plain) {
+    if (args.normal.empty()) return std::nullopt;
+    BinnedOptions options;
+    options.bins_per_side = bins_per_side(args.bins);
+    const Vec3 n = *parse_normal(args.normal);  // the flag's validator has accepted it
+    const Bsdf bsdf = Bsdf::parse(args.lobe);
+    BinPanel p;
+    p.binned = loaded.bins ? std::make_unique<BinnedEnvMap>(EnvMap(plain), *loaded.bins)
+                           : std::make_unique<BinnedEnvMap>(EnvMap(plain), options);
+    p.normal = n;
+    p.lobe = p.binned->lobe_class(bsdf.phong_exponent());
+    const uint32_t lobe = p.lobe;
+    const float exponent = p.binned->layout().lobe_exponents[lobe];
+    std::ostringstream title, description;
+    title.precision(2);
+    title << "binned, n=(" << n.x << "," << n.y << "," << n.z << ")";
+    description << "binned panel: normal (" << n.x << ", " << n.y << ", " << n.z << "), " << bsdf.name()
+                << " -> lobe class " << lobe << " (Phong " << exponent << "), " << p.binned->bins() << " bins"
+                << (loaded.bins ? " (the table's)\n" : "\n");
+    p.title = title.str();
+    p.description = description.str();
+    return p;
 }
 
 // The two densities of a map: `loaded` is one of them, `other` the other one, built here.
@@ -59,35 +149,45 @@ struct Visualization {
     pictures::ColourScale scale;
 };
 
-Visualization visualize(const std::string& name, const Densities& d, uint32_t panel_width) {
+Visualization visualize(const std::string& name, const Densities& d, const std::optional<BinPanel>& bin,
+                        uint32_t panel_width) {
     const uint32_t w = d.loaded.width(), h = d.loaded.height();
     const uint32_t pw = std::min(panel_width, std::max(w, 64u));
     const uint32_t ph = std::max(1u, static_cast<uint32_t>(static_cast<uint64_t>(pw) * h / w));
-    const std::vector<float> pdfs[2] = {pictures::resize(pdf_image(d.plain()), w, h, pw, ph),
-                                        pictures::resize(pdf_image(d.compensated()), w, h, pw, ph)};
-    const pictures::ColourScale scale = pictures::shared_log_scale({pdfs[0], pdfs[1]});
+    std::vector<std::vector<float>> pdfs = {pictures::resize(pdf_image(d.plain()), w, h, pw, ph),
+                                            pictures::resize(pdf_image(d.compensated()), w, h, pw, ph)};
+    if (bin) {
+        const BinnedEnvMapView view = bin->binned->view();  // the bin points into it
+        pdfs.push_back(pictures::resize(pdf_image(view.bin(bin->normal, bin->lobe), w, h), w, h, pw, ph));
+    }
+    const std::vector<std::span<const float>> spans(pdfs.begin(), pdfs.end());
+    const pictures::ColourScale scale = pictures::shared_log_scale(spans);
 
     char caption[256];
     std::snprintf(caption, sizeof caption,
                   "%s  %ux%u  mean luminance %.3g  alpha %.3g: compensation zeroes %.1f%% of texels", name.c_str(), w,
                   h, d.compensated().stats().mean_luminance, d.compensated().options().compensation.alpha,
                   100.0 * d.compensated().stats().zeroed_texels / (static_cast<double>(w) * h));
-    const pictures::Panel panels[] = {
+    std::vector<pictures::Panel> panels = {
         {pictures::tonemap(pictures::resize(d.loaded.radiance(), pw, ph), 0, d.plain().options().luma),
          "radiance (tone-mapped)", false},
         {pictures::false_colour(pdfs[0], pw, ph, scale), "pdf without compensation", true},
         {pictures::false_colour(pdfs[1], pw, ph, scale), "pdf with compensation", true}};
-    const io::Image8 bar = pictures::colour_bar(scale, "solid-angle pdf [1/sr]", 2 * pw);
+    if (bin) panels.push_back({pictures::false_colour(pdfs[2], pw, ph, scale), bin->title, true});
+    const io::Image8 bar =
+        pictures::colour_bar(scale, "solid-angle pdf [1/sr]", static_cast<uint32_t>(pdfs.size()) * pw);
     return {pictures::montage(panels, caption, &bar), pw, ph, scale};
 }
 
 void run_visualize(const VisualizeArgs& args) {
     const LoadedMap loaded = load_map(args.input, args.map);
     const Densities densities{loaded.map, opposite_density(loaded.map)};
-    const Visualization v = visualize(loaded.source.name, densities, args.panel_width);
+    const std::optional<BinPanel> bin = bin_panel(args, loaded, densities.plain());
+    const Visualization v = visualize(loaded.source.name, densities, bin, args.panel_width);
     io::write_png(args.output, v.picture);
     std::printf("envmis visualize: %s -> %s (%ux%u panels, pdf scale %.3g to %.3g per sr)\n", args.input.c_str(),
                 args.output.c_str(), v.panel_width, v.panel_height, v.scale.lo, v.scale.hi);
+    if (bin) std::fputs(bin->description.c_str(), stdout);
 }
 
 }  // namespace
@@ -95,7 +195,9 @@ void run_visualize(const VisualizeArgs& args) {
 Subcommand add_visualize(CLI::App& app) {
     auto args = std::make_shared<VisualizeArgs>();
     CLI::App* sub = app.add_subcommand(
-        "visualize", "One labelled PNG: the tone-mapped map, its density without and with compensation (shared scale)");
+        "visualize",
+        "One labelled PNG: the tone-mapped map, its density without and with compensation and, with --normal, the "
+        "binned density at that normal (shared scale)");
     add_visualize_flags(*sub, *args);
     return {sub, [args] { run_visualize(*args); }};
 }

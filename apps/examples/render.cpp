@@ -11,9 +11,16 @@
 // `--no-compensate`. A compensated density is zero over the dim parts of the map, so it
 // must be combined with BSDF sampling; `--technique env` refuses such a table.
 //
+// --bins samples normal-aware densities (envmis/sampling/binned.h) instead of one global
+// one: the table must hold bins (`envmis precompute MAP -o T.envmis --bins K`). At each
+// shading point the environment technique samples the bin that the surface normal and
+// the BSDF's lobe class pick, and the MIS weight of the BSDF sample uses that same bin's
+// pdf, so both weights describe the densities that were actually sampled. The lobe class
+// of each material is found once (Scene::set_lobe_classes), not per shading point.
+//
 // Usage:
 //   envmis_example_render TABLE -o OUT.exr [--size WxH] [--spp N] [--seed S] [--threads T]
-//                         [--technique mis|env|bsdf]
+//                         [--technique mis|env|bsdf] [--bins]
 //       writes OUT.exr (linear RGB, the table's working colour space) and a tone-mapped
 //       OUT.png. The image depends on the seed only, not on the number of threads.
 //   envmis_example_render --compare REF A [B] [--expect-ratio R]
@@ -38,6 +45,7 @@
 #include "envmis/io/image_io.h"
 #include "envmis/math/random.h"
 #include "envmis/pictures/picture.h"
+#include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"
 #include "envmis/study/shading/bsdf.h"
 #include "envmis/study/shading/frame.h"
@@ -64,17 +72,25 @@ struct Ray {
 struct Hit {
     Vec3 point, normal;
     const envmis::Bsdf* bsdf = nullptr;
+    uint32_t lobe = 0;  // the BSDF's lobe class in a binned map
 };
 
 struct Sphere {
     Vec3 centre;
     float radius;
     envmis::Bsdf bsdf;
+    uint32_t lobe = 0;
 };
 
 struct Scene {
     std::vector<Sphere> spheres;
     envmis::Bsdf ground;  // the plane z = 0, infinite
+    uint32_t ground_lobe = 0;
+
+    void set_lobe_classes(const envmis::BinnedEnvMap& binned) {
+        for (Sphere& s : spheres) s.lobe = binned.lobe_class(s.bsdf.phong_exponent());
+        ground_lobe = binned.lobe_class(ground.phong_exponent());
+    }
 
     // The nearest surface along the ray, if any.
     std::optional<Hit> intersect(const Ray& ray) const {
@@ -90,11 +106,11 @@ struct Scene {
             if (t <= 0 || t >= nearest) continue;
             nearest = t;
             const Vec3 p = ray.origin + ray.direction * t;
-            hit = Hit{p, (p - s.centre) * (1 / s.radius), &s.bsdf};
+            hit = Hit{p, (p - s.centre) * (1 / s.radius), &s.bsdf, s.lobe};
         }
         if (ray.direction.z < 0 && ray.origin.z > 0) {
             const float t = -ray.origin.z / ray.direction.z;
-            if (t < nearest) hit = Hit{ray.origin + ray.direction * t, {0, 0, 1}, &ground};
+            if (t < nearest) hit = Hit{ray.origin + ray.direction * t, {0, 0, 1}, &ground, ground_lobe};
         }
         return hit;
     }
@@ -110,6 +126,14 @@ Scene make_scene() {
              {{1.6f, 0, 0.7f}, 0.7f, envmis::Bsdf::ggx(0.1f)}},
             envmis::Bsdf::lambert({0.5f, 0.5f, 0.5f})};
 }
+
+// The environment as the renderer samples it: one global density, or with `binned` the
+// bin of each shading point's normal and lobe class (whose texels and radiance are
+// `global`'s, the binned map's plain map).
+struct Environment {
+    envmis::EnvMapView global;
+    const envmis::BinnedEnvMapView* binned = nullptr;
+};
 
 // A pinhole camera; (x, y) in [0,1)^2 across the image, y down.
 struct Camera {
@@ -132,9 +156,12 @@ struct Camera {
 enum class Technique { mis, env, bsdf };
 
 // Radiance leaving `hit` towards the viewer (world direction `to_viewer`): light from
-// the map, reflected once. MIS spends one environment and one BSDF sample.
-Rgb direct_lighting(const envmis::EnvMapView& env, const Scene& scene, const Hit& hit, Vec3 to_viewer,
-                    Technique technique, envmis::Pcg32& rng) {
+// the map, reflected once. MIS spends one environment and one BSDF sample. `env` is
+// the density sampled at this point, an EnvMapView or a binned map's BinView (the same
+// interface).
+template <class Density>
+Rgb direct_lighting(const Density& env, const Scene& scene, const Hit& hit, Vec3 to_viewer, Technique technique,
+                    envmis::Pcg32& rng) {
     // BSDFs work in the local shading frame (z = normal); the map in world directions.
     const envmis::Frame frame = envmis::Frame::from_normal(hit.normal);
     const Vec3 wo = frame.to_local(to_viewer);
@@ -166,10 +193,13 @@ Rgb direct_lighting(const envmis::EnvMapView& env, const Scene& scene, const Hit
 }
 
 // Radiance along a camera ray: the map where it escapes, else the lit surface.
-Rgb trace(const envmis::EnvMapView& env, const Scene& scene, const Ray& ray, Technique technique, envmis::Pcg32& rng) {
+Rgb trace(const Environment& env, const Scene& scene, const Ray& ray, Technique technique, envmis::Pcg32& rng) {
     const std::optional<Hit> hit = scene.intersect(ray);
-    if (!hit) return env.eval(ray.direction);
-    return direct_lighting(env, scene, *hit, ray.direction * -1.0f, technique, rng);
+    if (!hit) return env.global.eval(ray.direction);
+    if (env.binned)
+        return direct_lighting(env.binned->bin(hit->normal, hit->lobe), scene, *hit, ray.direction * -1.0f, technique,
+                               rng);
+    return direct_lighting(env.global, scene, *hit, ray.direction * -1.0f, technique, rng);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -181,10 +211,10 @@ struct Options {
     uint32_t width = 480, height = 320, spp = 16, threads = std::max(1u, std::thread::hardware_concurrency());
     uint64_t seed = 1;
     Technique technique = Technique::mis;
+    bool bins = false;
 };
 
-envmis::RgbImage render(const envmis::EnvMapView& env, const Options& o) {
-    const Scene scene = make_scene();
+envmis::RgbImage render(const Environment& env, const Scene& scene, const Options& o) {
     const Camera camera({0, -7.5f, 2.2f}, {0, 0, 0.55f}, 30,
                         static_cast<float>(o.width) / static_cast<float>(o.height));
     envmis::RgbImage image{o.width, o.height, std::vector<Rgb>(size_t{o.width} * o.height)};
@@ -212,14 +242,38 @@ envmis::RgbImage render(const envmis::EnvMapView& env, const Options& o) {
     return image;
 }
 
-int run_render(const Options& o) {
-    const envmis::Table table = envmis::read_table(o.table);  // checks sizes, checksums, version
-    const envmis::EnvMap& map = table.map;
-    if (map.options().axes != envmis::Axes{})
-        std::fprintf(stderr, "note: %s was built for axes %s; this scene is z up, so the map appears turned\n",
-                     o.table.string().c_str(), map.options().axes.to_string().c_str());
-    // A compensated density is 0 wherever the map is dimmer than alpha times its mean:
-    // sampled alone it would miss that light. Only MIS with BSDF sampling is unbiased.
+// The table's map, and with --bins the BinnedEnvMap its bins describe (which then holds
+// the map).
+struct Loaded {
+    std::optional<envmis::Table> table;
+    std::optional<envmis::BinnedEnvMap> binned;
+    const envmis::EnvMap& map() const { return binned ? binned->plain() : table->map; }
+};
+
+Loaded load(const Options& o) {
+    Loaded l;
+    l.table = envmis::read_table(o.table);  // checks sizes, checksums, version
+    if (!o.bins) return l;
+    if (!l.table->bins)
+        throw std::runtime_error(o.table.string() +
+                                 ": the table has no bins; --bins needs one built with `envmis precompute MAP -o " +
+                                 "T.envmis --bins K`");
+    l.binned = envmis::binned_map(std::move(*l.table));
+    l.table.reset();
+    return l;
+}
+
+// A compensated density is 0 wherever the map is dimmer than its threshold: sampled
+// alone it would miss that light. Only MIS with BSDF sampling is unbiased.
+void check_complete(const Loaded& l, const Options& o) {
+    if (l.binned) {
+        for (uint32_t c = 0; c < l.binned->classes(); ++c)
+            if (!l.binned->complete(c) && o.technique == Technique::env)
+                throw std::runtime_error(o.table.string() + ": compensated bins (lobe class " + std::to_string(c) +
+                                         "): they cannot be sampled alone; use --technique mis");
+        return;
+    }
+    const envmis::EnvMap& map = l.map();
     if (!map.complete()) {
         if (o.technique == Technique::env)
             throw std::runtime_error(o.table.string() + ": compensated table (its density is 0 over " +
@@ -228,8 +282,24 @@ int run_render(const Options& o) {
         std::fprintf(stderr, "note: compensated table: %llu lit texels are left to BSDF sampling through MIS\n",
                      static_cast<unsigned long long>(map.stats().zeroed_texels));
     }
+}
+
+int run_render(const Options& o) {
+    const Loaded loaded = load(o);
+    const envmis::EnvMap& map = loaded.map();
+    if (map.options().axes != envmis::Axes{})
+        std::fprintf(stderr, "note: %s was built for axes %s; this scene is z up, so the map appears turned\n",
+                     o.table.string().c_str(), map.options().axes.to_string().c_str());
+    check_complete(loaded, o);
+    Scene scene = make_scene();
+    std::optional<envmis::BinnedEnvMapView> binned_view;
+    if (loaded.binned) {
+        scene.set_lobe_classes(*loaded.binned);
+        binned_view = loaded.binned->view();
+    }
+    const Environment env{map.view(), binned_view ? &*binned_view : nullptr};
     const auto start = std::chrono::steady_clock::now();
-    const envmis::RgbImage image = render(map.view(), o);
+    const envmis::RgbImage image = render(env, scene, o);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     std::filesystem::path png = o.output;
@@ -237,9 +307,12 @@ int run_render(const Options& o) {
     envmis::io::write_exr(o.output, image);
     envmis::io::write_png(png, envmis::pictures::tonemap(image, 0, map.options().luma));
     const char* names[] = {"1 environment + 1 BSDF sample, balance heuristic", "1 environment sample", "1 BSDF sample"};
+    const std::string density = loaded.binned       ? std::to_string(loaded.binned->bins()) + " bins"
+                                : map.compensated() ? "compensated"
+                                                    : "plain";
     std::printf("%s: %ux%u, %u spp (%s), %s density, %.2f s -> %s, %s\n", o.table.string().c_str(), o.width, o.height,
-                o.spp, names[static_cast<int>(o.technique)], map.compensated() ? "compensated" : "plain", seconds,
-                o.output.string().c_str(), png.string().c_str());
+                o.spp, names[static_cast<int>(o.technique)], density.c_str(), seconds, o.output.string().c_str(),
+                png.string().c_str());
     return 0;
 }
 
@@ -293,7 +366,7 @@ struct UsageError : std::runtime_error {
 
 const char* const kUsage =
     "usage: envmis_example_render TABLE -o OUT.exr [--size WxH] [--spp N] [--seed S] [--threads T]\n"
-    "                             [--technique mis|env|bsdf]\n"
+    "                             [--technique mis|env|bsdf] [--bins]\n"
     "       envmis_example_render --compare REF A [B] [--expect-ratio R]\n";
 
 uint64_t parse_number(std::string_view flag, const std::string& text, uint64_t lo, uint64_t hi) {
@@ -351,6 +424,8 @@ int main(int argc, char** argv) {
                     o.technique = Technique::bsdf;
                 else
                     throw UsageError("--technique '" + t + "': expected mis, env or bsdf");
+            } else if (arg == "--bins") {
+                o.bins = true;
             } else if (arg == "--compare") {
                 compare = true;
             } else if (arg == "--expect-ratio") {

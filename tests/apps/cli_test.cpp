@@ -176,8 +176,10 @@ INSTANTIATE_TEST_SUITE_P(
     testing::Values(HelpCase{"precompute", with_map_flags({"input", "-o,--output", "--bins", "--cell-columns"})},
                     HelpCase{"info", with_map_flags({"input"})},
                     HelpCase{"sample", with_map_flags({"input", "-n,--count", "--seed", "-o,--output"})},
-                    HelpCase{"visualize", with_map_flags({"input", "-o,--output", "--panel-width"})},
-                    HelpCase{"bench", {"input", "--size", "--repeats", "--samples", "--no-compensate", "--json"}}),
+                    HelpCase{"visualize",
+                             with_map_flags({"input", "-o,--output", "--panel-width", "--normal", "--bins", "--lobe"})},
+                    HelpCase{"bench",
+                             {"input", "--size", "--repeats", "--samples", "--no-compensate", "--bins", "--json"}}),
     [](const testing::TestParamInfo<HelpCase>& info) { return info.param.subcommand; });
 
 TEST_F(Cli, TopLevelHelpListsEverySubcommand) {
@@ -305,6 +307,45 @@ TEST_F(Cli, BenchPrintsOneLinePerSamplerWithTheDocumentedFields) {
     EXPECT_TRUE(contains(r.out, "\\nspeedup_vs_textbook build=" + number + "x sample=" + number + "x pdf=" + number +
                                     "x batch_sample=" + number + "x batch_pdf=" + number + "x "))
         << r;
+}
+
+TEST_F(Cli, VisualizeWithANormalAddsTheBinnedPanelToTheSamePicture) {
+    const std::string map = (kBundled / "studio.exr").string();
+    const auto width = [&](const std::string& png) {
+        auto in = OIIO::ImageInput::open(file(png).string());
+        return in ? in->spec().width : 0;
+    };
+    const Result plain = envmis({"visualize", map, "-o", "plain.png", "--panel-width", "512"});
+    ASSERT_EQ(plain.exit_code, 0) << plain;
+    const Result r = envmis({"visualize", map, "-o", "binned.png", "--panel-width", "512", "--normal", "0,0,2",
+                             "--bins", "16", "--lobe", "ggx:0.2"});
+    ASSERT_EQ(r.exit_code, 0) << r;
+    EXPECT_TRUE(contains(r.out, "binned.png")) << r;
+    EXPECT_GE(width("binned.png"), width("plain.png") + 512) << r;  // one more panel
+}
+
+TEST_F(Cli, BenchWithBinsAddsTheBinnedSamplerAgainstTodaysMaps) {
+    const Result r = envmis({"bench", "--size", "256x128", "--repeats", "1", "--samples", "10000", "--bins", "16"});
+    ASSERT_EQ(r.exit_code, 0) << r;
+    const std::string number = "[0-9]+(\\.[0-9]+)?";
+    EXPECT_TRUE(contains(r.out, "\\nbinned bins=16 cells=8x4 lobe_class=0 ")) << r;
+    for (const char* sampler : {"plain", "compensated", "binned"})
+        EXPECT_TRUE(contains(r.out, std::string("\\nsampler=") + sampler + " build_ms=" + number + " ns_per_sample=" +
+                                        number + " ns_per_pdf=" + number + " ns_per_batch_sample=" + number +
+                                        " ns_per_batch_lookup=" + number + " bytes=[0-9]+\\n"))
+            << sampler << r;
+    EXPECT_TRUE(contains(r.out, "\\nbinned_over_compensated sample=" + number + "x pdf=" + number +
+                                    "x batch_sample=" + number + "x batch_lookup=" + number + "x build=" + number +
+                                    "x memory=" + number + "%\\n"))
+        << r;
+    const Result j =
+        envmis({"bench", "--size", "256x128", "--repeats", "1", "--samples", "1000", "--bins", "4", "--json"});
+    ASSERT_EQ(j.exit_code, 0) << j;
+    const nlohmann::json binned = nlohmann::json::parse(j.out).at("binned");
+    EXPECT_EQ(binned.at("bins"), 4);
+    ASSERT_EQ(binned.at("samplers").size(), 3u);
+    for (const char* field : {"sample", "pdf", "batch_sample", "batch_lookup", "build", "memory"})
+        EXPECT_GT(binned.at("binned_over_compensated").at(field).get<double>(), 0) << field << j;
 }
 
 TEST_F(Cli, BenchJsonIsOneObjectWithTheSameFields) {

@@ -99,6 +99,18 @@ INSTANTIATE_TEST_SUITE_P(
         BadFlag{"ConvertSupersamplingAbove64", convert({"--supersampling", "65"}), "--supersampling"},
         // bench: --repeats 1 to 1000, --samples 1 to 2^26, --size WxH each 1 to 65536.
         BadFlag{"BenchNegativeRepeats", bench({"--repeats", "-1"}), "--repeats"},
+        // --bins: a square number of bins, 1 to 4096 (64 x 64).
+        BadFlag{"BenchBinsNotSquare", bench({"--bins", "10"}), "--bins"},
+        BadFlag{"BenchZeroBins", bench({"--bins", "0"}), "--bins"},
+        BadFlag{"BenchBinsAbove4096", bench({"--bins", "4225"}), "--bins"},
+        BadFlag{"VisualizeBinsNotSquare", visualize({"--normal", "0,0,1", "--bins", "-4"}), "--bins"},
+        // visualize --normal X,Y,Z: three finite numbers, not all zero; --lobe a BSDF.
+        BadFlag{"VisualizeZeroNormal", visualize({"--normal", "0,0,0"}), "--normal"},
+        BadFlag{"VisualizeNanNormal", visualize({"--normal", "0,nan,1"}), "--normal"},
+        BadFlag{"VisualizeInfiniteNormal", visualize({"--normal", "inf,0,1"}), "--normal"},
+        BadFlag{"VisualizeNormalWithTwoComponents", visualize({"--normal", "0,1"}), "--normal"},
+        BadFlag{"VisualizeNormalWithFourComponents", visualize({"--normal", "0,1,0,1"}), "--normal"},
+        BadFlag{"VisualizeUnknownLobe", visualize({"--normal", "0,0,1", "--lobe", "velvet"}), "--lobe"},
         BadFlag{"BenchZeroRepeats", bench({"--repeats", "0"}), "--repeats"},
         BadFlag{"BenchRepeatsAbove1000", bench({"--repeats", "1001"}), "--repeats"},
         BadFlag{"BenchNegativeSamples", bench({"--samples", "-1"}), "--samples"},
