@@ -1,6 +1,6 @@
 // Google Benchmark: the guided-CDF sampler (EnvMap) against the textbook float-CDF
 // sampler (reference::TextbookEnvMap), building and sampling the same synthetic sky; and
-// the binned sampler (BinnedEnvMap, 100 bins, lobe class 0) against today's EnvMap,
+// the binned sampler (BinnedEnvMap, the default 121 bins, lobe class 0) against today's EnvMap,
 // plain and compensated, with a random shading normal per call.
 // Run with --benchmark_repetitions=5 --benchmark_report_aggregates_only=true for medians.
 #include <benchmark/benchmark.h>

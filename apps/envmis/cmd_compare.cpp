@@ -38,7 +38,7 @@ struct CompareArgs {
     const CLI::Option* alpha_flag = nullptr;  // --alpha: given, it fixes the bins' alpha too
 };
 
-constexpr uint32_t kDefaultBins = 100;
+constexpr uint32_t kDefaultBins = 121;  // BinnedOptions{}.bins_per_side squared
 
 // The limits of the count flags, checked by in_range (cli.h), which refuses a negative value
 // instead of wrapping it.

@@ -53,7 +53,7 @@ struct VisualizeArgs {
     uint32_t panel_width = 512;
     MapFlags map;
     std::string normal, lobe = "lambert";  // normal empty: no binned panel
-    uint32_t bins = 100;
+    uint32_t bins = 121;
 };
 
 void add_visualize_flags(CLI::App& sub, VisualizeArgs& args) {

@@ -45,7 +45,7 @@ add_test(NAME examples.table.compensated
 add_test(NAME examples.table.plain
   COMMAND envmis precompute ${envmis_examples_map} -o ${envmis_examples_work}/plain.envmis --no-compensate)
 add_test(NAME examples.table.binned
-  COMMAND envmis precompute ${envmis_examples_map} -o ${envmis_examples_work}/binned.envmis --bins 100)
+  COMMAND envmis precompute ${envmis_examples_map} -o ${envmis_examples_work}/binned.envmis --bins 121)
 set_tests_properties(examples.table.compensated examples.table.plain examples.table.binned PROPERTIES
   FIXTURES_REQUIRED envmis_examples_work FIXTURES_SETUP envmis_examples_tables TIMEOUT 120)
 
