@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Makes docs/results.md and its plots (docs/images/results/MAP/): every technique on
-# every bundled map for the default BSDFs (compensated at the automatic alpha), the
+# every bundled map for the default BSDFs (compensated at the automatic alpha; the normal-
+# aware bins at their per-bin choice), the
 # compensation-strength sweep (exact variances) against `--alpha auto`, and the
 # sample-allocation sweep. About 3 minutes on 2 cores after the build.
 set -euo pipefail
@@ -14,6 +15,7 @@ envmis="$build_dir/apps/envmis"
 
 techniques=env,bsdf,mis-balance,mis-power,mis-optimal,mis-var,one-sample,mis-balance-comp,mis-power-comp
 techniques+=,mis-optimal-comp,mis-var-comp,one-sample-comp,mis-balance-all,mis-optimal-all
+techniques+=,mis-balance-bins,mis-power-bins,mis-optimal-bins
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -27,7 +29,7 @@ for map in rooitou_park_1k.hdr city.exr studio.exr; do
   "$envmis" compare "data/envmaps/$map" "${common[@]}" --alpha-sweep 0:3:0.25 --exact --spp 1024 \
     --json "$work/$name-alpha.json" > /dev/null
   "$envmis" compare "data/envmaps/$map" "${common[@]}" --allocation-sweep 4 \
-    --techniques mis-balance,mis-balance-comp,mis-optimal-comp --spp 2048 --json "$work/$name-allocation.json" > /dev/null
+    --techniques mis-balance,mis-balance-comp,mis-optimal-comp,mis-balance-bins --spp 2048 --json "$work/$name-allocation.json" > /dev/null
   results+=("$work/$name.json" "$work/$name-alpha.json" "$work/$name-allocation.json")
 done
 "$envmis" report "${results[@]}" -o docs/results.md --title "envmis results: every technique on the bundled maps" \

@@ -119,7 +119,8 @@ struct BenchArgs {
     std::string input, size = "8192x4096";
     int repeats = 5;
     uint32_t samples = 1u << 20;
-    uint32_t bins = 0;  // 0: no binned measurement
+    uint32_t bins = 0;                // 0: no binned measurement
+    uint32_t samples_per_normal = 1;  // consecutive calls that share a normal (a shading point's samples)
     bool json = false, no_compensate = false;
 };
 
@@ -146,6 +147,11 @@ void add_bench_flags(CLI::App& sub, BenchArgs& args) {
                    "compensated: build, memory, sample and pdf with a random normal per call (lobe class 0)")
         ->type_name("K")
         ->check(bins_validator());
+    sub.add_option("--samples-per-normal", args.samples_per_normal,
+                   "With --bins: consecutive calls that share one random normal, as a shading point's samples do "
+                   "(1: a new normal every call, the worst case for the bins' caches)")
+        ->capture_default_str()
+        ->check(in_range(uint32_t{1}, uint32_t{65536}));
     sub.add_flag("--json", args.json, "Print one JSON object instead of text lines");
 }
 
@@ -173,7 +179,7 @@ struct BenchPoints {
     std::vector<Vec3> directions, normals;
 };
 
-BenchPoints bench_points(uint32_t n, bool normals) {
+BenchPoints bench_points(uint32_t n, bool normals, uint32_t samples_per_normal) {
     std::mt19937_64 rng(7);
     auto uniform = [&rng] { return static_cast<float>(rng() >> 40) * 0x1p-24f; };
     auto sphere = [&](std::vector<Vec3>& v) {
@@ -186,6 +192,8 @@ BenchPoints bench_points(uint32_t n, bool normals) {
     for (Vec2& u : points.us) u = {uniform(), uniform()};
     sphere(points.directions);
     sphere(points.normals);
+    // Group g takes normal g; downwards, so that every source is read before it is overwritten.
+    for (size_t i = points.normals.size(); i-- > 0;) points.normals[i] = points.normals[i / samples_per_normal];
     return points;
 }
 
@@ -264,7 +272,7 @@ BenchResult measure(const RgbImage& image, const EnvMapOptions& options, const B
 enum Today { kPlain, kCompensated };
 constexpr const char* kCallNames[4] = {"sample", "pdf", "batch_sample", "batch_lookup"};
 struct BinnedResult {
-    uint32_t bins = 0, cells_w = 0, cells_h = 0;
+    uint32_t bins = 0, cells_w = 0, cells_h = 0, samples_per_normal = 1;
     double build_ms[3] = {}, bytes[3] = {};  // plain, compensated, bins (bins alone)
     double ns[3][4] = {};                    // per sampler and kind of call
     double ratio[2][4] = {};                 // binned over plain, over compensated
@@ -341,7 +349,10 @@ double binned_memory_ratio(const BinnedResult& b) { return b.bytes[2] / b.bytes[
 constexpr const char* kBinnedSamplers[3] = {"plain", "compensated", "binned"};
 
 nlohmann::json binned_json(const BinnedResult& b) {
-    nlohmann::json j = {{"bins", b.bins}, {"cells", {b.cells_w, b.cells_h}}, {"lobe_class", 0}};
+    nlohmann::json j = {{"bins", b.bins},
+                        {"cells", {b.cells_w, b.cells_h}},
+                        {"lobe_class", 0},
+                        {"samples_per_normal", b.samples_per_normal}};
     for (int k = 0; k < 3; ++k) {
         nlohmann::json s = {{"sampler", kBinnedSamplers[k]}, {"build_ms", b.build_ms[k]}, {"bytes", b.bytes[k]}};
         for (int c = 0; c < 4; ++c) s[std::string("ns_per_") + kCallNames[c]] = b.ns[k][c];
@@ -356,9 +367,9 @@ nlohmann::json binned_json(const BinnedResult& b) {
 
 void print_binned_text(const BinnedResult& b) {
     std::printf(
-        "binned bins=%u cells=%ux%u lobe_class=0 (a random normal per call; bins' build_ms and bytes "
-        "exclude their plain map)\n",
-        b.bins, b.cells_w, b.cells_h);
+        "binned bins=%u cells=%ux%u lobe_class=0 samples_per_normal=%u (bins' build_ms and bytes exclude their "
+        "plain map)\n",
+        b.bins, b.cells_w, b.cells_h, b.samples_per_normal);
     for (int k = 0; k < 3; ++k)
         std::printf(
             "sampler=%s build_ms=%.1f ns_per_sample=%.1f ns_per_pdf=%.1f ns_per_batch_sample=%.1f "
@@ -417,10 +428,13 @@ void run_bench(const BenchArgs& args) {
     const BenchMap map = bench_map(args);
     EnvMapOptions options;
     options.compensation.enabled = !args.no_compensate;
-    const BenchPoints points = bench_points(args.samples, args.bins > 0);
+    const BenchPoints points = bench_points(args.samples, args.bins > 0, args.samples_per_normal);
     const BenchResult result = measure(map.image, options, points, args.repeats);
     std::optional<BinnedResult> binned;
-    if (args.bins > 0) binned = measure_binned(map.image, args.bins, points, args.repeats);
+    if (args.bins > 0) {
+        binned = measure_binned(map.image, args.bins, points, args.repeats);
+        binned->samples_per_normal = args.samples_per_normal;
+    }
     if (args.json)
         print_bench_json(args, map, result, binned);
     else

@@ -109,7 +109,7 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
         "mis-{balance,power,optimal,var}[-comp],mis-{balance,optimal}-all,mis-{balance,power,optimal}-bins,"
         "one-sample[-comp])");
     sub.add_option("--bins", args.bins,
-                   "Normal bins K = g*g (1 to 4096; default 100) of the -bins techniques, which sample the bin of "
+                   "Normal bins K = g*g (1 to 4096; default 121) of the -bins techniques, which sample the bin of "
                    "each point's normal; alpha per bin by exact variance unless --alpha X fixes it");
     sub.add_option("--spp", args.spp, "Estimates per shading point, BSDF and technique (1 to 2^32-1)")
         ->capture_default_str()
