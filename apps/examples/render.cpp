@@ -13,8 +13,9 @@
 //
 // --bins samples normal-aware densities (envmis/sampling/binned.h) instead of one global
 // one: the table must hold bins (`envmis precompute MAP -o T.envmis --bins K`). At each
-// shading point the environment technique samples the bin that the surface normal and
-// the BSDF's lobe class pick, and the MIS weight of the BSDF sample uses that same bin's
+// shading point the environment technique samples the bin that the BSDF's lobe class and
+// its axis pick (the normal for a diffuse lobe, the mirror direction of the view for a
+// glossy one: envmis::lobe_axis), and the MIS weight of the BSDF sample uses that same bin's
 // pdf, so both weights describe the densities that were actually sampled. The lobe class
 // of each material is found once (Scene::set_lobe_classes), not per shading point.
 //
@@ -197,8 +198,9 @@ Rgb trace(const Environment& env, const Scene& scene, const Ray& ray, Technique 
     const std::optional<Hit> hit = scene.intersect(ray);
     if (!hit) return env.global.eval(ray.direction);
     if (env.binned)
-        return direct_lighting(env.binned->bin(hit->normal, hit->lobe), scene, *hit, ray.direction * -1.0f, technique,
-                               rng);
+        return direct_lighting(
+            env.binned->bin(envmis::lobe_axis(hit->lobe, hit->normal, ray.direction * -1.0f), hit->lobe), scene, *hit,
+            ray.direction * -1.0f, technique, rng);
     return direct_lighting(env.global, scene, *hit, ray.direction * -1.0f, technique, rng);
 }
 

@@ -186,7 +186,8 @@ double exact_variance(const BinnedEnvMap& binned, Technique technique, Allocatio
     if (!technique.bins)
         throw std::invalid_argument("exact_variance: " + technique.name() + " does not sample a binned map");
     const BinnedEnvMapView view = binned.view();
-    const BinView bin = view.bin(point.normal, binned.lobe_class(bsdf.phong_exponent()));
+    const uint32_t lobe = binned.lobe_class(bsdf.phong_exponent());
+    const BinView bin = view.bin(lobe_axis(lobe, point.normal, point.wo), lobe);
     return exact_variance_with(
         binned.plain(), [&](Vec2 uv) { return bin.pdf_uv(uv); }, technique, allocation, bsdf, point, subdivisions);
 }

@@ -328,7 +328,8 @@ DirectLightingEstimator::DirectLightingEstimator(const BinnedEnvMap& binned, Tec
 }
 
 BinView DirectLightingEstimator::bin_of(const ShadingPoint& point, const Bsdf& bsdf) const noexcept {
-    return binned_view_.bin(point.normal, binned_->lobe_class(bsdf.phong_exponent()));
+    const uint32_t lobe = binned_->lobe_class(bsdf.phong_exponent());
+    return binned_view_.bin(lobe_axis(lobe, point.normal, point.wo), lobe);
 }
 
 Rgb DirectLightingEstimator::estimate(const ShadingPoint& point, const Bsdf& bsdf, Pcg32& rng,

@@ -102,6 +102,16 @@ uint32_t lobe_class(std::span<const float> exponents, float phong_exponent) noex
 // at 0.85x of plain balance MIS on rooitou_park, against 0.67x in the Phong-200 class.
 inline float ggx_lobe_exponent(float a) noexcept { return a > 0 ? (2 / (a * a) - 2) / 4 : 1e5f; }
 
+// The direction that picks a shading point's bin: the normal for the diffuse class (0),
+// whose lobe is the cosine about it; for glossy classes the mirror direction of the
+// view (wo, towards the viewer) about the normal, which their lobes follow. A glossy
+// bin is a lobe about its centre, as its alpha was chosen: indexed by the normal, a
+// Phong-200 surface seen at grazing view on rooitou_park keeps 1.03x the variance of
+// plain balance MIS (its lobe near the bin's horizon), 0.29x by the mirror direction.
+ENVMIS_HD inline Vec3 lobe_axis(uint32_t lobe, Vec3 normal, Vec3 wo) noexcept {
+    return lobe == 0 ? normal : normal * (2 * dot(normal, wo)) - wo;
+}
+
 struct BinnedOptions {
     uint32_t bins_per_side = 11;  // g: K = g^2 bins; 1 to 64; odd keeps the axes at bin centres
     // Cell grid: columns (rows: half of them for equirect, as many for equal-area).
