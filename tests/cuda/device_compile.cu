@@ -1,9 +1,10 @@
 // Compile-only check that the runtime sampling path builds as CUDA device code: the
-// table-backed env-map view (sample, pdf, eval, lookup), the 1D/2D distribution views,
-// the BSDFs, the shading frame and the random number generator, all from the same
-// headers the CPU tests use. Built by tests/cuda/cuda.cmake when nvcc is present; it
+// table-backed env-map view (sample, pdf, eval, lookup), the binned view (binned.h), the
+// 1D/2D distribution views, the BSDFs, the shading frame and the random number
+// generator, all from the same headers the CPU tests use. Built by tests/cuda/cuda.cmake when nvcc is present; it
 // need not run.
 #include "envmis/math/random.h"
+#include "envmis/sampling/binned.h"
 #include "envmis/sampling/distribution.h"
 #include "envmis/sampling/envmap.h"
 #include "envmis/study/shading/bsdf.h"
@@ -52,6 +53,17 @@ __global__ void distributions(envmis::Distribution2DView d2, envmis::Distributio
     out[i] = s.pdf + d2.pdf(s.p) + d2.invert(s.p).x + t.pdf + d1.pdf(t.x) + d1.invert(t.x);
 }
 
+// The normal-aware bins: a bin per thread's normal and lobe class, sampled and looked up.
+__global__ void binned(envmis::BinnedEnvMapView env, const envmis::Vec3* normals, float* out, unsigned n) {
+    const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i >= n) return;
+    const envmis::Vec3 axis = envmis::lobe_axis(i % env.classes, normals[i], normals[i]);
+    const envmis::BinView bin = env.bin(axis, i % env.classes);
+    const envmis::EnvSample s = bin.sample({0.5f, 0.25f});
+    const envmis::EnvMapView::Lookup l = bin.lookup(s.direction);
+    out[i] = s.pdf + l.pdf + l.radiance.r + bin.pdf(normals[i]) + bin.eval(normals[i]).g;
+}
+
 }  // namespace
 
 // Host entry points so the kernels are instantiated and launched from host code.
@@ -62,4 +74,8 @@ void launch_direct_lighting(const envmis::EnvMapView& env, const envmis::Bsdf& b
 
 void launch_distributions(const envmis::Distribution2DView& d2, const envmis::Distribution1DView& d1, float* out) {
     distributions<<<1, 32>>>(d2, d1, out);
+}
+
+void launch_binned(const envmis::BinnedEnvMapView& env, const envmis::Vec3* normals, float* out, unsigned n) {
+    binned<<<(n + 127) / 128, 128>>>(env, normals, out, n);
 }
