@@ -20,9 +20,11 @@
 // Representation (what keeps it small): the map is cut into a coarse grid of cells
 // (BinLayout; 32 x 16 for a 1k map, at most 128 x 64); each bin holds only
 // the masses of its cells (sum over the cell's texels of q_b times their solid angle), in
-// a Distribution2D over the grid. Inside a cell, a texel is picked by the plain map's
-// own density (luminance times solid angle), through the plain EnvMap's row CDFs and one
-// small CDF over each cell's rows: pdf_b(x) = P_b(cell) P(row | cell) P(x | row, cell),
+// one 1D CDF over all cells, row-major (two dependent loads to find a cell, where a
+// marginal and a conditional CDF took four). Inside a cell, a texel is picked by the
+// plain map's own density (luminance times solid angle), through the plain EnvMap's row
+// CDFs and one small CDF over each cell's rows: u.x picks the cell and, by its offset in
+// the cell, the texel in the row; u.y the row. pdf_b(x) = P_b(cell) P(row | cell) P(x | row, cell),
 // exact in 31-bit fixed point as in distribution.h, so sample and pdf agree exactly.
 // The plain map is therefore what a binned table stores at the texel level; the
 // compensation lives in the bins.
@@ -50,9 +52,10 @@
 // sample(n, u) would have drawn. A compensated bin is incomplete (pdf 0 where L <= its
 // threshold): combine it with BSDF sampling.
 //
-// Cost: sample O(1) (four fixed-point CDF inversions, two in small tables), pdf O(1);
-// noexcept, allocation-free, ENVMIS_HD. Memory on top of the plain map: 6 bytes per cell
-// per bin per class, 6 bytes per (cell column, texel row); figures in docs/performance.md.
+// Cost: sample O(1) (three fixed-point CDF inversions: the bin's cells, the cell's rows,
+// the texel in the plain row's segment), pdf O(1); noexcept, allocation-free, ENVMIS_HD.
+// Memory on top of the plain map: 6 bytes per cell per bin per class, 6 bytes per (cell
+// column, texel row); figures in docs/performance.md. At most 65536 cells (uint16 guide).
 // Build: three passes over the texels (choice nodes, candidate and final cell
 // histograms), then O(K classes cells) work and the choice (0.15 s for a 1k map).
 #pragma once
@@ -135,7 +138,9 @@ struct BinLayout {
 struct BinnedEnvMapView;
 struct BinView {
     const BinnedEnvMapView* map = nullptr;
-    Distribution2DView cells;  // over the cell grid
+    // Over all cells of the grid, row-major (cell cy cells_w + cx): one CDF rather than a
+    // marginal and a conditional, so that a sample waits on two dependent loads, not four.
+    CdfView cells;
 
     ENVMIS_HD EnvSample sample(Vec2 u) const noexcept;
     ENVMIS_HD float pdf(Vec3 direction) const noexcept;
@@ -149,8 +154,6 @@ struct BinnedEnvMapView {
     EnvMapView plain;                      // texel level: the plain density and the radiance
     const uint32_t* cell_start = nullptr;  // per (class, bin): cells_w cells_h, row-major
     const uint16_t* cell_guide = nullptr;
-    const uint32_t* cell_marginal_start = nullptr;  // per (class, bin): cells_h
-    const uint16_t* cell_marginal_guide = nullptr;
     // Per cell column cx and texel row y: CDF over the texel rows of cell (cx, row of y),
     // at [cx h + y]: the cell's rows weighted by their plain mass inside the column.
     const uint32_t* rows_start = nullptr;
@@ -165,15 +168,9 @@ struct BinnedEnvMapView {
         return bin_at(min(lobe, classes - 1) * bins + b);
     }
     ENVMIS_HD BinView bin_at(uint32_t class_bin) const noexcept {
-        const size_t cells = size_t{cells_w} * cells_h;
-        return {this,
-                {cell_start + class_bin * cells,
-                 cell_guide + class_bin * cells,
-                 {cell_marginal_start + size_t{class_bin} * cells_h, cell_marginal_guide + size_t{class_bin} * cells_h,
-                  cells_h},
-                 cells_w,
-                 cells_h,
-                 static_cast<float>(cells) * 0x1p-62f}};
+        const uint32_t cells = cells_w * cells_h;
+        const size_t at = size_t{class_bin} * cells;
+        return {this, {cell_start + at, cell_guide + at, cells}};
     }
     ENVMIS_HD EnvSample sample(Vec3 normal, uint32_t lobe, Vec2 u) const noexcept {
         return bin(normal, lobe).sample(u);
@@ -198,18 +195,16 @@ struct BinnedEnvMapView {
         const size_t at = size_t{cx} * plain.distribution.h + row_edges[cy];
         return {rows_start + at, rows_guide + at, row_edges[cy + 1] - row_edges[cy]};
     }
-    // Image-space density of texel (x, y) under a bin, from the fixed-point widths of its
-    // cell (row and column of the bin's grid), of its row in the cell, and of the texel
-    // and its row segment in the plain row CDF; one expression for sample and pdf.
-    ENVMIS_HD float texel_pdf(const BinView& b, uint32_t cx, uint32_t cy, uint32_t row_width, uint32_t x,
+    // Image-space density of texel (x, y) of cell column cx under a bin, from the
+    // fixed-point widths of its cell in the bin's CDF, of its row in the cell, and of the
+    // texel and its row segment in the plain row CDF; one expression for sample and pdf.
+    ENVMIS_HD float texel_pdf(uint32_t cell_width, uint32_t cx, uint32_t row_width, uint32_t x,
                               uint32_t y) const noexcept {
         const CdfView row = plain.distribution.row(y);
         const uint32_t x1 = column_edges[cx + 1];
         const uint32_t segment = (x1 < row.n ? row.start[x1] : kCdfUnits) - row.start[column_edges[cx]];
-        const float cell =
-            static_cast<float>(b.cells.marginal.width(cy)) * static_cast<float>(b.cells.row(cy).width(cx)) * 0x1p-62f;
         const float texels = static_cast<float>(uint64_t{plain.distribution.w} * plain.distribution.h);
-        return cell * (static_cast<float>(row_width) * 0x1p-31f) *
+        return static_cast<float>(cell_width) * static_cast<float>(row_width) * 0x1p-62f *
                (static_cast<float>(row.width(x)) / static_cast<float>(segment)) * texels;
     }
 };
@@ -254,8 +249,8 @@ private:
 
     EnvMap plain_;
     BinLayout layout_;
-    LargeVector<uint32_t> cell_start_, cell_marginal_start_, rows_start_;
-    LargeVector<uint16_t> cell_guide_, cell_marginal_guide_, rows_guide_;
+    LargeVector<uint32_t> cell_start_, rows_start_;
+    LargeVector<uint16_t> cell_guide_, rows_guide_;
     std::vector<uint32_t> column_edges_, row_edges_;
     double choice_seconds_ = 0;
 };
@@ -264,14 +259,15 @@ private:
 
 ENVMIS_HD inline EnvSample BinView::sample(Vec2 u) const noexcept {
     const BinnedEnvMapView& m = *map;
-    const CellHit r = cells.marginal.invert(u.y);
-    const CellHit c = cells.row(r.index).invert(u.x);
-    const CdfView rows = m.cell_rows(c.index, r.index);
-    const CellHit ry = rows.invert(r.offset);
-    const uint32_t y = m.row_edges[r.index] + ry.index;
+    // u.x picks the cell, its offset in the cell the texel inside the row; u.y the row.
+    const CellHit c = cells.invert(u.x);
+    const uint32_t cy = c.index / m.cells_w, cx = c.index - cy * m.cells_w;
+    const CdfView rows = m.cell_rows(cx, cy);
+    const CellHit ry = rows.invert(u.y);
+    const uint32_t y = m.row_edges[cy] + ry.index;
     // The texel: the plain row CDF inverted inside the cell's segment of the row.
     const CdfView row = m.plain.distribution.row(y);
-    const uint32_t x0 = m.column_edges[c.index], x1 = m.column_edges[c.index + 1];
+    const uint32_t x0 = m.column_edges[cx], x1 = m.column_edges[cx + 1];
     const uint32_t a = row.start[x0], b = x1 < row.n ? row.start[x1] : kCdfUnits;
     const double units = a + static_cast<double>(c.offset) * (b - a);
     const auto t = min(static_cast<uint32_t>(units), b - 1);
@@ -286,7 +282,7 @@ ENVMIS_HD inline EnvSample BinView::sample(Vec2 u) const noexcept {
     const float ox = min(static_cast<float>((units - row.start[lo]) / row.width(lo)), kOneMinusEpsilon);
     const Vec2 p{detail::point_in_cell(lo, max(ox, 0.0f), row.n),
                  detail::point_in_cell(y, ry.offset, m.plain.distribution.h)};
-    const float image_pdf = m.texel_pdf(*this, c.index, r.index, rows.width(ry.index), lo, y);
+    const float image_pdf = m.texel_pdf(cells.width(c.index), cx, rows.width(ry.index), lo, y);
     return m.plain.at(p, image_pdf, static_cast<size_t>(y) * row.n + lo);
 }
 
@@ -295,7 +291,7 @@ ENVMIS_HD inline float BinView::pdf_uv(Vec2 uv) const noexcept {
     const uint32_t x = detail::cell_of(uv.x, m.plain.distribution.w), y = detail::cell_of(uv.y, m.plain.distribution.h);
     const uint32_t cx = m.cell_column(x), cy = m.cell_row(y);
     const uint32_t row_width = m.cell_rows(cx, cy).width(y - m.row_edges[cy]);
-    const float image_pdf = m.texel_pdf(*this, cx, cy, row_width, x, y);
+    const float image_pdf = m.texel_pdf(cells.width(cy * m.cells_w + cx), cx, row_width, x, y);
     return m.plain.image_to_solid_angle(image_pdf, uv);
 }
 
