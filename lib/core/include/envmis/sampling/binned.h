@@ -142,6 +142,20 @@ struct BinView {
     // marginal and a conditional, so that a sample waits on two dependent loads, not four.
     CdfView cells;
 
+    // sample(u) in stages, each ending on prefetches of what the next one loads, so that
+    // sample_many can interleave the stages of several samples (bit-identical to sample).
+    struct Cell {
+        CellHit hit;  // in the bin's CDF: the cell and u.x's offset in it
+        uint32_t cx = 0, cy = 0;
+    };
+    struct Row {
+        uint32_t y = 0, width = 0;  // texel row, its width in the cell's row CDF
+        float offset = 0;           // u.y's offset in the row
+    };
+    ENVMIS_HD Cell find_cell(float ux) const noexcept;
+    ENVMIS_HD Row find_row(const Cell& c, float uy) const noexcept;
+    ENVMIS_HD EnvSample sample_in_row(const Cell& c, const Row& r) const noexcept;
+
     ENVMIS_HD EnvSample sample(Vec2 u) const noexcept;
     ENVMIS_HD float pdf(Vec3 direction) const noexcept;
     ENVMIS_HD float pdf_uv(Vec2 uv) const noexcept;
@@ -257,19 +271,47 @@ private:
 
 // ---- inline definitions ----
 
-ENVMIS_HD inline EnvSample BinView::sample(Vec2 u) const noexcept {
+// The cell of u.x in the bin's CDF.
+ENVMIS_HD inline BinView::Cell BinView::find_cell(float ux) const noexcept {
     const BinnedEnvMapView& m = *map;
-    // u.x picks the cell, its offset in the cell the texel inside the row; u.y the row.
-    const CellHit c = cells.invert(u.x);
-    const uint32_t cy = c.index / m.cells_w, cx = c.index - cy * m.cells_w;
-    const CdfView rows = m.cell_rows(cx, cy);
-    const CellHit ry = rows.invert(u.y);
-    const uint32_t y = m.row_edges[cy] + ry.index;
-    // The texel: the plain row CDF inverted inside the cell's segment of the row.
+    const CellHit hit = cells.invert(ux);
+    const uint32_t cy = hit.index / m.cells_w;
+    return {hit, hit.index - cy * m.cells_w, cy};
+}
+
+// Prefetches, once the cell is known, of its row CDF where u.y's guide bucket points and
+// of the plain row start of the row that bucket guesses (exact when the rows weigh
+// alike): they overlap the row CDF's misses with the plain row's.
+ENVMIS_HD inline void prefetch_row(const BinnedEnvMapView& m, const BinView::Cell& c, float uy) noexcept {
+    const CdfView rows = m.cell_rows(c.cx, c.cy);
+    const auto k = static_cast<uint32_t>((static_cast<uint64_t>(uy * static_cast<float>(kCdfUnits)) * rows.n) >> 31);
+    ENVMIS_PREFETCH(rows.guide + k);
+    ENVMIS_PREFETCH(rows.start + k);
+    const uint32_t* start = m.plain.distribution.row(m.row_edges[c.cy] + k).start;
+    ENVMIS_PREFETCH(start + m.column_edges[c.cx]);
+}
+
+// The texel row, by the cell's CDF over its rows; then a prefetch of the row's segment.
+ENVMIS_HD inline BinView::Row BinView::find_row(const Cell& c, float uy) const noexcept {
+    const BinnedEnvMapView& m = *map;
+    const CdfView rows = m.cell_rows(c.cx, c.cy);
+    const CellHit ry = rows.invert(uy);
+    const uint32_t y = m.row_edges[c.cy] + ry.index;
+    const uint32_t* start = m.plain.distribution.row(y).start;
+    ENVMIS_PREFETCH(start + m.column_edges[c.cx]);
+    ENVMIS_PREFETCH(start + m.column_edges[c.cx + 1] - 1);
+    return {y, rows.width(ry.index), ry.offset};
+}
+
+// The texel: the plain row CDF inverted inside the cell's segment of the row, at u.x's
+// offset in the cell.
+ENVMIS_HD inline EnvSample BinView::sample_in_row(const Cell& c, const Row& r) const noexcept {
+    const BinnedEnvMapView& m = *map;
+    const uint32_t y = r.y;
     const CdfView row = m.plain.distribution.row(y);
-    const uint32_t x0 = m.column_edges[cx], x1 = m.column_edges[cx + 1];
+    const uint32_t x0 = m.column_edges[c.cx], x1 = m.column_edges[c.cx + 1];
     const uint32_t a = row.start[x0], b = x1 < row.n ? row.start[x1] : kCdfUnits;
-    const double units = a + static_cast<double>(c.offset) * (b - a);
+    const double units = a + static_cast<double>(c.hit.offset) * (b - a);
     const auto t = min(static_cast<uint32_t>(units), b - 1);
     uint32_t lo = x0, hi = x1 - 1;
     while (lo < hi) {  // last texel of the segment whose start is <= t
@@ -281,9 +323,16 @@ ENVMIS_HD inline EnvSample BinView::sample(Vec2 u) const noexcept {
     }
     const float ox = min(static_cast<float>((units - row.start[lo]) / row.width(lo)), kOneMinusEpsilon);
     const Vec2 p{detail::point_in_cell(lo, max(ox, 0.0f), row.n),
-                 detail::point_in_cell(y, ry.offset, m.plain.distribution.h)};
-    const float image_pdf = m.texel_pdf(cells.width(c.index), cx, rows.width(ry.index), lo, y);
+                 detail::point_in_cell(y, r.offset, m.plain.distribution.h)};
+    const float image_pdf = m.texel_pdf(cells.width(c.hit.index), c.cx, r.width, lo, y);
     return m.plain.at(p, image_pdf, static_cast<size_t>(y) * row.n + lo);
+}
+
+// u.x picks the cell and, by its offset there, the texel inside the row; u.y the row.
+ENVMIS_HD inline EnvSample BinView::sample(Vec2 u) const noexcept {
+    const Cell c = find_cell(u.x);
+    prefetch_row(*map, c, u.y);
+    return sample_in_row(c, find_row(c, u.y));
 }
 
 ENVMIS_HD inline float BinView::pdf_uv(Vec2 uv) const noexcept {
