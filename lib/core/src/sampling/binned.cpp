@@ -274,7 +274,7 @@ void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays nor
 }
 
 // Software-pipelined: a block of samples goes through each stage of BinView::sample in
-// turn (bin and a prefetch of its CDF at u.x's guide bucket; cell; row; texel), each
+// turn (bin and a prefetch of its CDF at u.x's guide bucket; cell; row; texel; radiance), each
 // stage prefetching what the next loads, so that the misses of a block's samples overlap
 // instead of each sample waiting on its chain of dependent loads. The stages are the
 // single call's own functions, so the results are bit-identical to it.
@@ -284,6 +284,7 @@ void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays nor
     BinView bins[kBlock];
     BinView::Cell cells[kBlock];
     BinView::Row rows[kBlock];
+    BinView::Texel texels[kBlock];
     for (uint32_t first = 0; first < n; first += kBlock) {
         const uint32_t m = std::min(kBlock, n - first);
         for (uint32_t j = 0; j < m; ++j) {
@@ -300,9 +301,10 @@ void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays nor
             prefetch_row(env, cells[j], in.y[first + j]);
         }
         for (uint32_t j = 0; j < m; ++j) rows[j] = bins[j].find_row(cells[j], in.y[first + j]);
+        for (uint32_t j = 0; j < m; ++j) texels[j] = bins[j].find_texel(cells[j], rows[j]);
         for (uint32_t j = 0; j < m; ++j) {
             const uint32_t i = first + j;
-            const EnvSample s = bins[j].sample_in_row(cells[j], rows[j]);
+            const EnvSample s = bins[j].sample_at(cells[j], rows[j], texels[j]);
             out.x[i] = s.direction.x, out.y[i] = s.direction.y, out.z[i] = s.direction.z, out.pdf[i] = s.pdf;
             out.r[i] = s.radiance.r, out.g[i] = s.radiance.g, out.b[i] = s.radiance.b;
         }

@@ -154,7 +154,12 @@ struct BinView {
     };
     ENVMIS_HD Cell find_cell(float ux) const noexcept;
     ENVMIS_HD Row find_row(const Cell& c, float uy) const noexcept;
-    ENVMIS_HD EnvSample sample_in_row(const Cell& c, const Row& r) const noexcept;
+    struct Texel {
+        uint32_t x = 0;
+        float offset = 0;  // u.x's position inside the texel
+    };
+    ENVMIS_HD Texel find_texel(const Cell& c, const Row& r) const noexcept;
+    ENVMIS_HD EnvSample sample_at(const Cell& c, const Row& r, const Texel& t) const noexcept;
 
     ENVMIS_HD EnvSample sample(Vec2 u) const noexcept;
     ENVMIS_HD float pdf(Vec3 direction) const noexcept;
@@ -304,11 +309,10 @@ ENVMIS_HD inline BinView::Row BinView::find_row(const Cell& c, float uy) const n
 }
 
 // The texel: the plain row CDF inverted inside the cell's segment of the row, at u.x's
-// offset in the cell.
-ENVMIS_HD inline EnvSample BinView::sample_in_row(const Cell& c, const Row& r) const noexcept {
+// offset in the cell; then a prefetch of its radiance.
+ENVMIS_HD inline BinView::Texel BinView::find_texel(const Cell& c, const Row& r) const noexcept {
     const BinnedEnvMapView& m = *map;
-    const uint32_t y = r.y;
-    const CdfView row = m.plain.distribution.row(y);
+    const CdfView row = m.plain.distribution.row(r.y);
     const uint32_t x0 = m.column_edges[c.cx], x1 = m.column_edges[c.cx + 1];
     const uint32_t a = row.start[x0], b = x1 < row.n ? row.start[x1] : kCdfUnits;
     const double units = a + static_cast<double>(c.hit.offset) * (b - a);
@@ -322,17 +326,24 @@ ENVMIS_HD inline EnvSample BinView::sample_in_row(const Cell& c, const Row& r) c
             hi = mid - 1;
     }
     const float ox = min(static_cast<float>((units - row.start[lo]) / row.width(lo)), kOneMinusEpsilon);
-    const Vec2 p{detail::point_in_cell(lo, max(ox, 0.0f), row.n),
-                 detail::point_in_cell(y, r.offset, m.plain.distribution.h)};
-    const float image_pdf = m.texel_pdf(cells.width(c.hit.index), c.cx, r.width, lo, y);
-    return m.plain.at(p, image_pdf, static_cast<size_t>(y) * row.n + lo);
+    ENVMIS_PREFETCH(m.plain.radiance + static_cast<size_t>(r.y) * row.n + lo);
+    return {lo, max(ox, 0.0f)};
+}
+
+ENVMIS_HD inline EnvSample BinView::sample_at(const Cell& c, const Row& r, const Texel& t) const noexcept {
+    const BinnedEnvMapView& m = *map;
+    const uint32_t w = m.plain.distribution.w;
+    const Vec2 p{detail::point_in_cell(t.x, t.offset, w), detail::point_in_cell(r.y, r.offset, m.plain.distribution.h)};
+    const float image_pdf = m.texel_pdf(cells.width(c.hit.index), c.cx, r.width, t.x, r.y);
+    return m.plain.at(p, image_pdf, static_cast<size_t>(r.y) * w + t.x);
 }
 
 // u.x picks the cell and, by its offset there, the texel inside the row; u.y the row.
 ENVMIS_HD inline EnvSample BinView::sample(Vec2 u) const noexcept {
     const Cell c = find_cell(u.x);
     prefetch_row(*map, c, u.y);
-    return sample_in_row(c, find_row(c, u.y));
+    const Row r = find_row(c, u.y);
+    return sample_at(c, r, find_texel(c, r));
 }
 
 ENVMIS_HD inline float BinView::pdf_uv(Vec2 uv) const noexcept {
