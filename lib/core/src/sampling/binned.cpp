@@ -136,6 +136,13 @@ void check_options(const BinnedOptions& o) {
         throw std::invalid_argument("bin alphas must be finite, 0 to 1000");
 }
 
+// A bin's cells form one CDF, whose uint16 guide entries name at most 65536 cells.
+void check_cells(uint32_t columns, uint32_t rows) {
+    if (uint64_t{columns} * rows > kMaxCells1D)
+        throw std::invalid_argument("a cell grid has at most 65536 cells, got " + std::to_string(columns) + "x" +
+                                    std::to_string(rows));
+}
+
 CellGrid grid_for(const EnvMap& plain, uint32_t columns) {
     const uint32_t w = plain.width(), h = plain.height();
     if (columns == 0) columns = std::clamp(w / 32, 1u, 128u);
@@ -144,6 +151,7 @@ CellGrid grid_for(const EnvMap& plain, uint32_t columns) {
     const bool square = plain.options().mapping == Mapping::equal_area;
     columns = std::min(columns, w);
     const uint32_t rows = std::min(square ? columns : std::max(1u, columns / 2), h);
+    check_cells(columns, rows);
     return CellGrid(w, h, columns, rows, plain.options().mapping);
 }
 
@@ -169,6 +177,7 @@ BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinLayout& layout) : plain_(std::
         throw std::invalid_argument("bin layout " + std::to_string(g) + " bins per side, " +
                                     std::to_string(layout.cell_columns) + "x" + std::to_string(layout.cell_rows) +
                                     " cells does not fit a " + std::to_string(w) + "x" + std::to_string(h) + " map");
+    check_cells(layout.cell_columns, layout.cell_rows);
     BinnedOptions check;
     check.lobe_exponents = layout.lobe_exponents;
     check_options(check);
@@ -191,15 +200,12 @@ void BinnedEnvMap::build(const std::vector<std::vector<float>>& masses) {
     const size_t cells = size_t{grid.cw} * grid.ch;
     cell_start_.resize(cells * masses.size());
     cell_guide_.resize(cells * masses.size());
-    cell_marginal_start_.resize(size_t{grid.ch} * masses.size());
-    cell_marginal_guide_.resize(size_t{grid.ch} * masses.size());
+    detail::CdfScratch cell_scratch(static_cast<uint32_t>(cells));
     for (size_t cb = 0; cb < masses.size(); ++cb) {
-        const Distribution2D bin(masses[cb], grid.cw, grid.ch);
-        const Distribution2DView d = bin.view();
-        std::copy_n(d.start, cells, cell_start_.data() + cb * cells);
-        std::copy_n(d.guide, cells, cell_guide_.data() + cb * cells);
-        std::copy_n(d.marginal.start, grid.ch, cell_marginal_start_.data() + cb * grid.ch);
-        std::copy_n(d.marginal.guide, grid.ch, cell_marginal_guide_.data() + cb * grid.ch);
+        uint32_t invalid = 0;
+        detail::build_cdf(masses[cb].data(), static_cast<uint32_t>(cells), cell_start_.data() + cb * cells,
+                          cell_guide_.data() + cb * cells, invalid, cell_scratch);
+        if (invalid) throw std::invalid_argument("bin masses: negative or non-finite value");
     }
     // Each cell's rows, weighted by the plain mass of their segment in the cell.
     const Distribution2DView plain = plain_.distribution().view();
@@ -231,8 +237,6 @@ BinnedEnvMapView BinnedEnvMap::view() const noexcept {
     return {plain_.view(),
             cell_start_.data(),
             cell_guide_.data(),
-            cell_marginal_start_.data(),
-            cell_marginal_guide_.data(),
             rows_start_.data(),
             rows_guide_.data(),
             column_edges_.data(),
@@ -255,8 +259,8 @@ bool BinnedEnvMap::complete(uint32_t lobe) const noexcept {
 }
 
 size_t BinnedEnvMap::bytes() const noexcept {
-    return (cell_start_.size() + cell_marginal_start_.size() + rows_start_.size()) * sizeof(uint32_t) +
-           (cell_guide_.size() + cell_marginal_guide_.size() + rows_guide_.size()) * sizeof(uint16_t) +
+    return (cell_start_.size() + rows_start_.size()) * sizeof(uint32_t) +
+           (cell_guide_.size() + rows_guide_.size()) * sizeof(uint16_t) +
            (column_edges_.size() + row_edges_.size()) * sizeof(uint32_t);
 }
 
@@ -269,12 +273,41 @@ void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays nor
     }
 }
 
+// Software-pipelined: a block of samples goes through each stage of BinView::sample in
+// turn (bin and a prefetch of its CDF at u.x's guide bucket; cell; row; texel; radiance), each
+// stage prefetching what the next loads, so that the misses of a block's samples overlap
+// instead of each sample waiting on its chain of dependent loads. The stages are the
+// single call's own functions, so the results are bit-identical to it.
 void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays normals, PointArrays in, SampleArrays out,
                  uint32_t n) noexcept {
-    for (uint32_t i = 0; i < n; ++i) {
-        const EnvSample s = env.sample({normals.x[i], normals.y[i], normals.z[i]}, lobe, {in.x[i], in.y[i]});
-        out.x[i] = s.direction.x, out.y[i] = s.direction.y, out.z[i] = s.direction.z, out.pdf[i] = s.pdf;
-        out.r[i] = s.radiance.r, out.g[i] = s.radiance.g, out.b[i] = s.radiance.b;
+    constexpr uint32_t kBlock = 16;
+    BinView bins[kBlock];
+    BinView::Cell cells[kBlock];
+    BinView::Row rows[kBlock];
+    BinView::Texel texels[kBlock];
+    for (uint32_t first = 0; first < n; first += kBlock) {
+        const uint32_t m = std::min(kBlock, n - first);
+        for (uint32_t j = 0; j < m; ++j) {
+            const uint32_t i = first + j;
+            bins[j] = env.bin({normals.x[i], normals.y[i], normals.z[i]}, lobe);
+            const CdfView& c = bins[j].cells;
+            const auto k =
+                static_cast<uint32_t>((static_cast<uint64_t>(in.x[i] * static_cast<float>(kCdfUnits)) * c.n) >> 31);
+            ENVMIS_PREFETCH(c.guide + k);
+            ENVMIS_PREFETCH(c.start + k);
+        }
+        for (uint32_t j = 0; j < m; ++j) {
+            cells[j] = bins[j].find_cell(in.x[first + j]);
+            prefetch_row(env, cells[j], in.y[first + j]);
+        }
+        for (uint32_t j = 0; j < m; ++j) rows[j] = bins[j].find_row(cells[j], in.y[first + j]);
+        for (uint32_t j = 0; j < m; ++j) texels[j] = bins[j].find_texel(cells[j], rows[j]);
+        for (uint32_t j = 0; j < m; ++j) {
+            const uint32_t i = first + j;
+            const EnvSample s = bins[j].sample_at(cells[j], rows[j], texels[j]);
+            out.x[i] = s.direction.x, out.y[i] = s.direction.y, out.z[i] = s.direction.z, out.pdf[i] = s.pdf;
+            out.r[i] = s.radiance.r, out.g[i] = s.radiance.g, out.b[i] = s.radiance.b;
+        }
     }
 }
 

@@ -20,9 +20,11 @@
 // Representation (what keeps it small): the map is cut into a coarse grid of cells
 // (BinLayout; 32 x 16 for a 1k map, at most 128 x 64); each bin holds only
 // the masses of its cells (sum over the cell's texels of q_b times their solid angle), in
-// a Distribution2D over the grid. Inside a cell, a texel is picked by the plain map's
-// own density (luminance times solid angle), through the plain EnvMap's row CDFs and one
-// small CDF over each cell's rows: pdf_b(x) = P_b(cell) P(row | cell) P(x | row, cell),
+// one 1D CDF over all cells, row-major (two dependent loads to find a cell, where a
+// marginal and a conditional CDF took four). Inside a cell, a texel is picked by the
+// plain map's own density (luminance times solid angle), through the plain EnvMap's row
+// CDFs and one small CDF over each cell's rows: u.x picks the cell and, by its offset in
+// the cell, the texel in the row; u.y the row. pdf_b(x) = P_b(cell) P(row | cell) P(x | row, cell),
 // exact in 31-bit fixed point as in distribution.h, so sample and pdf agree exactly.
 // The plain map is therefore what a binned table stores at the texel level; the
 // compensation lives in the bins.
@@ -50,9 +52,10 @@
 // sample(n, u) would have drawn. A compensated bin is incomplete (pdf 0 where L <= its
 // threshold): combine it with BSDF sampling.
 //
-// Cost: sample O(1) (four fixed-point CDF inversions, two in small tables), pdf O(1);
-// noexcept, allocation-free, ENVMIS_HD. Memory on top of the plain map: 6 bytes per cell
-// per bin per class, 6 bytes per (cell column, texel row); figures in docs/performance.md.
+// Cost: sample O(1) (three fixed-point CDF inversions: the bin's cells, the cell's rows,
+// the texel in the plain row's segment), pdf O(1); noexcept, allocation-free, ENVMIS_HD.
+// Memory on top of the plain map: 6 bytes per cell per bin per class, 6 bytes per (cell
+// column, texel row); figures in docs/performance.md. At most 65536 cells (uint16 guide).
 // Build: three passes over the texels (choice nodes, candidate and final cell
 // histograms), then O(K classes cells) work and the choice (0.15 s for a 1k map).
 #pragma once
@@ -145,7 +148,28 @@ struct BinLayout {
 struct BinnedEnvMapView;
 struct BinView {
     const BinnedEnvMapView* map = nullptr;
-    Distribution2DView cells;  // over the cell grid
+    // Over all cells of the grid, row-major (cell cy cells_w + cx): one CDF rather than a
+    // marginal and a conditional, so that a sample waits on two dependent loads, not four.
+    CdfView cells;
+
+    // sample(u) in stages, each ending on prefetches of what the next one loads, so that
+    // sample_many can interleave the stages of several samples (bit-identical to sample).
+    struct Cell {
+        CellHit hit;  // in the bin's CDF: the cell and u.x's offset in it
+        uint32_t cx = 0, cy = 0;
+    };
+    struct Row {
+        uint32_t y = 0, width = 0;  // texel row, its width in the cell's row CDF
+        float offset = 0;           // u.y's offset in the row
+    };
+    ENVMIS_HD Cell find_cell(float ux) const noexcept;
+    ENVMIS_HD Row find_row(const Cell& c, float uy) const noexcept;
+    struct Texel {
+        uint32_t x = 0;
+        float offset = 0;  // u.x's position inside the texel
+    };
+    ENVMIS_HD Texel find_texel(const Cell& c, const Row& r) const noexcept;
+    ENVMIS_HD EnvSample sample_at(const Cell& c, const Row& r, const Texel& t) const noexcept;
 
     ENVMIS_HD EnvSample sample(Vec2 u) const noexcept;
     ENVMIS_HD float pdf(Vec3 direction) const noexcept;
@@ -159,8 +183,6 @@ struct BinnedEnvMapView {
     EnvMapView plain;                      // texel level: the plain density and the radiance
     const uint32_t* cell_start = nullptr;  // per (class, bin): cells_w cells_h, row-major
     const uint16_t* cell_guide = nullptr;
-    const uint32_t* cell_marginal_start = nullptr;  // per (class, bin): cells_h
-    const uint16_t* cell_marginal_guide = nullptr;
     // Per cell column cx and texel row y: CDF over the texel rows of cell (cx, row of y),
     // at [cx h + y]: the cell's rows weighted by their plain mass inside the column.
     const uint32_t* rows_start = nullptr;
@@ -175,15 +197,9 @@ struct BinnedEnvMapView {
         return bin_at(min(lobe, classes - 1) * bins + b);
     }
     ENVMIS_HD BinView bin_at(uint32_t class_bin) const noexcept {
-        const size_t cells = size_t{cells_w} * cells_h;
-        return {this,
-                {cell_start + class_bin * cells,
-                 cell_guide + class_bin * cells,
-                 {cell_marginal_start + size_t{class_bin} * cells_h, cell_marginal_guide + size_t{class_bin} * cells_h,
-                  cells_h},
-                 cells_w,
-                 cells_h,
-                 static_cast<float>(cells) * 0x1p-62f}};
+        const uint32_t cells = cells_w * cells_h;
+        const size_t at = size_t{class_bin} * cells;
+        return {this, {cell_start + at, cell_guide + at, cells}};
     }
     ENVMIS_HD EnvSample sample(Vec3 normal, uint32_t lobe, Vec2 u) const noexcept {
         return bin(normal, lobe).sample(u);
@@ -208,18 +224,16 @@ struct BinnedEnvMapView {
         const size_t at = size_t{cx} * plain.distribution.h + row_edges[cy];
         return {rows_start + at, rows_guide + at, row_edges[cy + 1] - row_edges[cy]};
     }
-    // Image-space density of texel (x, y) under a bin, from the fixed-point widths of its
-    // cell (row and column of the bin's grid), of its row in the cell, and of the texel
-    // and its row segment in the plain row CDF; one expression for sample and pdf.
-    ENVMIS_HD float texel_pdf(const BinView& b, uint32_t cx, uint32_t cy, uint32_t row_width, uint32_t x,
+    // Image-space density of texel (x, y) of cell column cx under a bin, from the
+    // fixed-point widths of its cell in the bin's CDF, of its row in the cell, and of the
+    // texel and its row segment in the plain row CDF; one expression for sample and pdf.
+    ENVMIS_HD float texel_pdf(uint32_t cell_width, uint32_t cx, uint32_t row_width, uint32_t x,
                               uint32_t y) const noexcept {
         const CdfView row = plain.distribution.row(y);
         const uint32_t x1 = column_edges[cx + 1];
         const uint32_t segment = (x1 < row.n ? row.start[x1] : kCdfUnits) - row.start[column_edges[cx]];
-        const float cell =
-            static_cast<float>(b.cells.marginal.width(cy)) * static_cast<float>(b.cells.row(cy).width(cx)) * 0x1p-62f;
         const float texels = static_cast<float>(uint64_t{plain.distribution.w} * plain.distribution.h);
-        return cell * (static_cast<float>(row_width) * 0x1p-31f) *
+        return static_cast<float>(cell_width) * static_cast<float>(row_width) * 0x1p-62f *
                (static_cast<float>(row.width(x)) / static_cast<float>(segment)) * texels;
     }
 };
@@ -264,26 +278,54 @@ private:
 
     EnvMap plain_;
     BinLayout layout_;
-    LargeVector<uint32_t> cell_start_, cell_marginal_start_, rows_start_;
-    LargeVector<uint16_t> cell_guide_, cell_marginal_guide_, rows_guide_;
+    LargeVector<uint32_t> cell_start_, rows_start_;
+    LargeVector<uint16_t> cell_guide_, rows_guide_;
     std::vector<uint32_t> column_edges_, row_edges_;
     double choice_seconds_ = 0;
 };
 
 // ---- inline definitions ----
 
-ENVMIS_HD inline EnvSample BinView::sample(Vec2 u) const noexcept {
+// The cell of u.x in the bin's CDF.
+ENVMIS_HD inline BinView::Cell BinView::find_cell(float ux) const noexcept {
     const BinnedEnvMapView& m = *map;
-    const CellHit r = cells.marginal.invert(u.y);
-    const CellHit c = cells.row(r.index).invert(u.x);
-    const CdfView rows = m.cell_rows(c.index, r.index);
-    const CellHit ry = rows.invert(r.offset);
-    const uint32_t y = m.row_edges[r.index] + ry.index;
-    // The texel: the plain row CDF inverted inside the cell's segment of the row.
-    const CdfView row = m.plain.distribution.row(y);
-    const uint32_t x0 = m.column_edges[c.index], x1 = m.column_edges[c.index + 1];
+    const CellHit hit = cells.invert(ux);
+    const uint32_t cy = hit.index / m.cells_w;
+    return {hit, hit.index - cy * m.cells_w, cy};
+}
+
+// Prefetches, once the cell is known, of its row CDF where u.y's guide bucket points and
+// of the plain row start of the row that bucket guesses (exact when the rows weigh
+// alike): they overlap the row CDF's misses with the plain row's.
+ENVMIS_HD inline void prefetch_row(const BinnedEnvMapView& m, const BinView::Cell& c, float uy) noexcept {
+    const CdfView rows = m.cell_rows(c.cx, c.cy);
+    const auto k = static_cast<uint32_t>((static_cast<uint64_t>(uy * static_cast<float>(kCdfUnits)) * rows.n) >> 31);
+    ENVMIS_PREFETCH(rows.guide + k);
+    ENVMIS_PREFETCH(rows.start + k);
+    const uint32_t* start = m.plain.distribution.row(m.row_edges[c.cy] + k).start;
+    ENVMIS_PREFETCH(start + m.column_edges[c.cx]);
+}
+
+// The texel row, by the cell's CDF over its rows; then a prefetch of the row's segment.
+ENVMIS_HD inline BinView::Row BinView::find_row(const Cell& c, float uy) const noexcept {
+    const BinnedEnvMapView& m = *map;
+    const CdfView rows = m.cell_rows(c.cx, c.cy);
+    const CellHit ry = rows.invert(uy);
+    const uint32_t y = m.row_edges[c.cy] + ry.index;
+    const uint32_t* start = m.plain.distribution.row(y).start;
+    ENVMIS_PREFETCH(start + m.column_edges[c.cx]);
+    ENVMIS_PREFETCH(start + m.column_edges[c.cx + 1] - 1);
+    return {y, rows.width(ry.index), ry.offset};
+}
+
+// The texel: the plain row CDF inverted inside the cell's segment of the row, at u.x's
+// offset in the cell; then a prefetch of its radiance.
+ENVMIS_HD inline BinView::Texel BinView::find_texel(const Cell& c, const Row& r) const noexcept {
+    const BinnedEnvMapView& m = *map;
+    const CdfView row = m.plain.distribution.row(r.y);
+    const uint32_t x0 = m.column_edges[c.cx], x1 = m.column_edges[c.cx + 1];
     const uint32_t a = row.start[x0], b = x1 < row.n ? row.start[x1] : kCdfUnits;
-    const double units = a + static_cast<double>(c.offset) * (b - a);
+    const double units = a + static_cast<double>(c.hit.offset) * (b - a);
     const auto t = min(static_cast<uint32_t>(units), b - 1);
     uint32_t lo = x0, hi = x1 - 1;
     while (lo < hi) {  // last texel of the segment whose start is <= t
@@ -294,10 +336,24 @@ ENVMIS_HD inline EnvSample BinView::sample(Vec2 u) const noexcept {
             hi = mid - 1;
     }
     const float ox = min(static_cast<float>((units - row.start[lo]) / row.width(lo)), kOneMinusEpsilon);
-    const Vec2 p{detail::point_in_cell(lo, max(ox, 0.0f), row.n),
-                 detail::point_in_cell(y, ry.offset, m.plain.distribution.h)};
-    const float image_pdf = m.texel_pdf(*this, c.index, r.index, rows.width(ry.index), lo, y);
-    return m.plain.at(p, image_pdf, static_cast<size_t>(y) * row.n + lo);
+    ENVMIS_PREFETCH(m.plain.radiance + static_cast<size_t>(r.y) * row.n + lo);
+    return {lo, max(ox, 0.0f)};
+}
+
+ENVMIS_HD inline EnvSample BinView::sample_at(const Cell& c, const Row& r, const Texel& t) const noexcept {
+    const BinnedEnvMapView& m = *map;
+    const uint32_t w = m.plain.distribution.w;
+    const Vec2 p{detail::point_in_cell(t.x, t.offset, w), detail::point_in_cell(r.y, r.offset, m.plain.distribution.h)};
+    const float image_pdf = m.texel_pdf(cells.width(c.hit.index), c.cx, r.width, t.x, r.y);
+    return m.plain.at(p, image_pdf, static_cast<size_t>(r.y) * w + t.x);
+}
+
+// u.x picks the cell and, by its offset there, the texel inside the row; u.y the row.
+ENVMIS_HD inline EnvSample BinView::sample(Vec2 u) const noexcept {
+    const Cell c = find_cell(u.x);
+    prefetch_row(*map, c, u.y);
+    const Row r = find_row(c, u.y);
+    return sample_at(c, r, find_texel(c, r));
 }
 
 ENVMIS_HD inline float BinView::pdf_uv(Vec2 uv) const noexcept {
@@ -305,7 +361,7 @@ ENVMIS_HD inline float BinView::pdf_uv(Vec2 uv) const noexcept {
     const uint32_t x = detail::cell_of(uv.x, m.plain.distribution.w), y = detail::cell_of(uv.y, m.plain.distribution.h);
     const uint32_t cx = m.cell_column(x), cy = m.cell_row(y);
     const uint32_t row_width = m.cell_rows(cx, cy).width(y - m.row_edges[cy]);
-    const float image_pdf = m.texel_pdf(*this, cx, cy, row_width, x, y);
+    const float image_pdf = m.texel_pdf(cells.width(cy * m.cells_w + cx), cx, row_width, x, y);
     return m.plain.image_to_solid_angle(image_pdf, uv);
 }
 
