@@ -306,15 +306,18 @@ ENVMIS_HD inline void prefetch_row(const BinnedEnvMapView& m, const BinView::Cel
     ENVMIS_PREFETCH(start + m.column_edges[c.cx]);
 }
 
-// The texel row, by the cell's CDF over its rows; then a prefetch of the row's segment.
+// The texel row, by the cell's CDF over its rows; then prefetches of the row's segment.
 ENVMIS_HD inline BinView::Row BinView::find_row(const Cell& c, float uy) const noexcept {
     const BinnedEnvMapView& m = *map;
     const CdfView rows = m.cell_rows(c.cx, c.cy);
     const CellHit ry = rows.invert(uy);
     const uint32_t y = m.row_edges[c.cy] + ry.index;
+    // Every cache line of the segment (its end too), so that the binary search over it
+    // waits for one miss, not one per halving.
     const uint32_t* start = m.plain.distribution.row(y).start;
-    ENVMIS_PREFETCH(start + m.column_edges[c.cx]);
-    ENVMIS_PREFETCH(start + m.column_edges[c.cx + 1] - 1);
+    const uint32_t x1 = min(m.column_edges[c.cx + 1], m.plain.distribution.w - 1);
+    for (uint32_t x = m.column_edges[c.cx]; x < x1; x += 16) ENVMIS_PREFETCH(start + x);
+    ENVMIS_PREFETCH(start + x1);
     return {y, rows.width(ry.index), ry.offset};
 }
 
