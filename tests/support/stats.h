@@ -98,4 +98,21 @@ inline ChiSquare chi_square(std::span<const double> expected, std::span<const do
     return r;
 }
 
+// Midpoint rule over the sphere on an nt x np grid in (theta, phi), z up: the integral
+// of f(direction) d(omega), for checking that a solid-angle pdf integrates to 1.
+template <class F>
+double sphere_integral(uint32_t nt, uint32_t np, F&& f) {
+    double integral = 0;
+    for (uint32_t i = 0; i < nt; ++i) {
+        const double theta = kPi * (i + 0.5) / nt;
+        for (uint32_t j = 0; j < np; ++j) {
+            const double phi = 2 * kPi * (j + 0.5) / np;
+            const Vec3 d{static_cast<float>(std::sin(theta) * std::cos(phi)),
+                         static_cast<float>(std::sin(theta) * std::sin(phi)), static_cast<float>(std::cos(theta))};
+            integral += f(d) * std::sin(theta);
+        }
+    }
+    return integral * (kPi / nt) * (2 * kPi / np);
+}
+
 }  // namespace envmis::test

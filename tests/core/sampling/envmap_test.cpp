@@ -173,19 +173,8 @@ TEST(EnvMap, SolidAnglePdfIntegratesToOne) {
         for (bool compensate : {false, true}) {
             const EnvMap map(image, options(compensate));
             // Midpoint rule in (theta, phi) on a grid aligned with, and 4x finer than, the texels.
-            const uint32_t nt = 4 * map.height(), np = 4 * map.width();
-            double integral = 0;
-            for (uint32_t i = 0; i < nt; ++i) {
-                const double theta = kPi * (i + 0.5) / nt;
-                for (uint32_t j = 0; j < np; ++j) {
-                    const double phi = 2 * kPi * (j + 0.5) / np;
-                    const Vec3 d{static_cast<float>(std::sin(theta) * std::cos(phi)),
-                                 static_cast<float>(std::sin(theta) * std::sin(phi)),
-                                 static_cast<float>(std::cos(theta))};
-                    integral += map.pdf(d) * std::sin(theta);
-                }
-            }
-            integral *= (kPi / nt) * (2 * kPi / np);
+            const double integral =
+                test::sphere_integral(4 * map.height(), 4 * map.width(), [&](Vec3 d) { return map.pdf(d); });
             EXPECT_NEAR(integral, 1.0, 1e-3) << image.width << "x" << image.height << " compensate=" << compensate;
         }
 }

@@ -13,6 +13,7 @@
 #include "envmis/study/reference/quadrature.h"
 #include "envmis/study/statistics/statistics.h"
 #include "envmis/study/techniques/estimator.h"
+#include "estimates.h"
 #include "maps.h"
 
 namespace envmis {
@@ -90,16 +91,9 @@ TEST(BinnedEstimator, ManyEstimatesAtOnceEqualTheSameEstimatesOneAtATime) {
             for (const Allocation a : {Allocation{1, 1}, Allocation{2, 3}, Allocation{5, 4}})
                 for (const Technique& t : bins_techniques()) {
                     const DirectLightingEstimator estimator(binned, t, a);
-                    Pcg32 rng(7), mine(7);
-                    PointState state, my_state;
-                    std::vector<Rgb> got(100);
-                    estimator.estimate(point, bsdf, rng, state, got);
-                    for (size_t i = 0; i < got.size(); ++i) {
-                        const Rgb expected = estimator.estimate(point, bsdf, mine, my_state);
-                        ASSERT_EQ(std::memcmp(&got[i], &expected, sizeof(Rgb)), 0)
-                            << t.name() << " " << bsdf.name() << " " << a.env << "+" << a.bsdf << " estimate " << i;
-                    }
-                    EXPECT_EQ(rng.uniform(), mine.uniform()) << t.name() << ": not the same random numbers";
+                    test::expect_batch_equals_single(
+                        estimator, point, bsdf,
+                        t.name() + " " + bsdf.name() + " " + std::to_string(a.env) + "+" + std::to_string(a.bsdf));
                 }
 }
 
