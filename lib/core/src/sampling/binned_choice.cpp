@@ -80,7 +80,7 @@ CellHistogram histogram(const EnvMap& plain, const CellGrid& grid, std::span<con
     return hist;
 }
 
-// Node grid for the choice: each cell cut into k x k nodes, at most 128 columns.
+// Node grid for the choice: each cell cut into k x k nodes, at most kNodeColumns wide.
 constexpr uint32_t kNodeColumns = 64;
 
 struct Nodes {
