@@ -4,14 +4,11 @@
 #include <cmath>
 #include <limits>
 
+#include "detail/luminance.h"
 #include "detail/parallel.h"
 
 namespace envmis::detail {
 namespace {
-
-float texel_luminance(const Rgb& p, const LumaCoefficients& k) noexcept {
-    return std::min(luminance(p, k), std::numeric_limits<float>::max());
-}
 
 // Per cell, over its texels: sums of L w (w: the texel's relative solid angle, as the
 // plain density has it) and of w by histogram bucket, as suffix sums (bucket k holds

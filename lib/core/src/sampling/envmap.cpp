@@ -11,6 +11,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "detail/luminance.h"
 #include "detail/parallel.h"
 
 namespace envmis {
@@ -58,11 +59,6 @@ void check_options(const EnvMapOptions& o) {
         throw std::invalid_argument("luma coefficients must be finite, >= 0 and not all 0");
 }
 
-// Luminance of a repaired pixel, kept finite when the channels are near float's maximum.
-float texel_luminance(const Rgb& p, const LumaCoefficients& k) noexcept {
-    return std::min(luminance(p, k), std::numeric_limits<float>::max());
-}
-
 // Per-row results, reduced in row order so that the result does not depend on the
 // number of threads.
 struct RowStats {
@@ -105,7 +101,7 @@ bool scan_row(const Rgb* pixels, uint32_t w, const LumaCoefficients& luma, uint3
             const auto b = std::bit_cast<uint32_t>(channel[c]);
             dirty |= b | (0x7f7fffffu - b);
         }
-        const float l = texel_luminance(pixels[x], luma);
+        const float l = detail::texel_luminance(pixels[x], luma);
         bits[x] = std::bit_cast<uint32_t>(l);
         high = std::max(high, l);
         low = std::min(low, l > 0 ? l : kInf);
