@@ -3,9 +3,11 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -15,6 +17,7 @@
 #include <string_view>
 
 #include "envmis/io/image_io.h"
+#include "envmis/table/atomic_file.h"
 
 namespace envmis::cli {
 
@@ -293,6 +296,22 @@ void Progress::update(uint64_t done) {
     shown_ = percent;
     std::fprintf(stderr, "\r%s %3d%%", label_.c_str(), percent);
     std::fflush(stderr);
+}
+
+void prepare_output(const std::filesystem::path& path) {
+    check_destination(path);
+    for (const std::filesystem::path& removed : remove_stale_temporaries(path))
+        std::cerr << "envmis: removed " << removed.string() << ", the temporary file of an interrupted earlier run\n";
+}
+
+void finish_standard_output() {
+    errno = 0;
+    std::cout.flush();  // std::cout writes through stdout (synchronised with stdio)
+    const bool flushed = std::fflush(stdout) == 0;
+    const int error = errno;
+    // A write that failed earlier leaves the stream's error flag (and maybe nothing left to flush).
+    if (flushed && !std::ferror(stdout) && std::cout) return;
+    throw std::runtime_error(std::string("standard output: ") + (error != 0 ? std::strerror(error) : "write failed"));
 }
 
 }  // namespace envmis::cli

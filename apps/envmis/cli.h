@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -128,6 +129,18 @@ private:
     int shown_ = -1;
     bool enabled_;
 };
+
+// An output file given on the command line, before any work: refuses one that exists and
+// is not a regular file (check_destination in atomic_file.h: a device, FIFO, folder or
+// symbolic link is never replaced) and removes its stale temporaries from killed runs,
+// one line on stderr for each ("envmis: removed ..."). The writer itself does both again
+// (silently), for the files that commands write into folders (--plots, --images).
+void prepare_output(const std::filesystem::path& path);
+
+// Flushes standard output (both the C++ and the C stream) and throws
+// std::runtime_error("standard output: REASON") if it or any earlier write failed (a full
+// disk, /dev/full): a report that did not arrive is an error.
+void finish_standard_output();
 
 // Each subcommand adds itself to the app, with the function that runs it once parsed.
 struct Subcommand {
