@@ -304,14 +304,49 @@ void prepare_output(const std::filesystem::path& path) {
         std::cerr << "envmis: removed " << removed.string() << ", the temporary file of an interrupted earlier run\n";
 }
 
-void finish_standard_output() {
-    errno = 0;
-    std::cout.flush();  // std::cout writes through stdout (synchronised with stdio)
-    const bool flushed = std::fflush(stdout) == 0;
-    const int error = errno;
-    // A write that failed earlier leaves the stream's error flag (and maybe nothing left to flush).
-    if (flushed && !std::ferror(stdout) && std::cout) return;
-    throw std::runtime_error(std::string("standard output: ") + (error != 0 ? std::strerror(error) : "write failed"));
+// Writes through C's stdout, as libstdc++'s own synchronised buffer does, but keeps the
+// errno of the first failed write: by the final flush it is long gone (the C stream
+// discards what it failed to write, and a failed std::cout writes nothing more).
+class StandardOutput::Buffer final : public std::streambuf {
+public:
+    int error() const noexcept { return error_; }
+    int sync() override { return std::fflush(stdout) == 0 ? 0 : failed(); }
+
+protected:
+    int_type overflow(int_type c) override {
+        if (traits_type::eq_int_type(c, traits_type::eof()))
+            return sync() == 0 ? traits_type::not_eof(c) : traits_type::eof();
+        if (std::fputc(traits_type::to_char_type(c), stdout) == EOF) {
+            failed();
+            return traits_type::eof();
+        }
+        return c;
+    }
+    std::streamsize xsputn(const char* s, std::streamsize n) override {
+        const size_t written = std::fwrite(s, 1, static_cast<size_t>(n), stdout);
+        if (written < static_cast<size_t>(n)) failed();
+        return static_cast<std::streamsize>(written);
+    }
+
+private:
+    int failed() noexcept {
+        if (error_ == 0) error_ = errno != 0 ? errno : EIO;
+        return -1;
+    }
+    int error_ = 0;
+};
+
+StandardOutput::StandardOutput() : buffer_(std::make_unique<Buffer>()), previous_(std::cout.rdbuf(buffer_.get())) {}
+
+StandardOutput::~StandardOutput() { std::cout.rdbuf(previous_); }
+
+void StandardOutput::finish() {
+    std::cout.flush();
+    buffer_->sync();
+    // printf's failures leave only the stream's error flag.
+    if (buffer_->error() == 0 && !std::ferror(stdout)) return;
+    throw std::runtime_error(std::string("standard output: ") +
+                             (buffer_->error() != 0 ? std::strerror(buffer_->error()) : "write failed"));
 }
 
 }  // namespace envmis::cli

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -137,10 +138,24 @@ private:
 // (silently), for the files that commands write into folders (--plots, --images).
 void prepare_output(const std::filesystem::path& path);
 
-// Flushes standard output (both the C++ and the C stream) and throws
-// std::runtime_error("standard output: REASON") if it or any earlier write failed (a full
-// disk, /dev/full): a report that did not arrive is an error.
-void finish_standard_output();
+// Standard output whose every write is checked (a full disk, /dev/full): a report that
+// did not arrive is an error. While one exists, std::cout writes through it to C's stdout
+// (so that its order with printf is kept), noting the reason of the first failure.
+class StandardOutput {
+public:
+    StandardOutput();
+    StandardOutput(const StandardOutput&) = delete;
+    StandardOutput& operator=(const StandardOutput&) = delete;
+    ~StandardOutput();  // gives std::cout its own buffer back
+    // Flushes both streams; throws std::runtime_error("standard output: REASON") if that
+    // or any earlier write failed.
+    void finish();
+
+private:
+    class Buffer;
+    std::unique_ptr<Buffer> buffer_;
+    std::streambuf* previous_;
+};
 
 // Each subcommand adds itself to the app, with the function that runs it once parsed.
 struct Subcommand {

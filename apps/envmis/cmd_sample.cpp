@@ -69,8 +69,7 @@ void run_sample(const SampleArgs& args) {
     if (!args.output.empty()) prepare_output(args.output);
     const LoadedMap loaded = load_map(args.input, args.map);
     if (args.output.empty()) {
-        write_samples(std::cout, loaded.map, args.count, args.seed);
-        finish_standard_output();
+        write_samples(std::cout, loaded.map, args.count, args.seed);  // main checks standard output
     } else {
         write_file_atomically(args.output,
                               [&](std::ostream& out) { write_samples(out, loaded.map, args.count, args.seed); });

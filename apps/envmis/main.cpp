@@ -28,9 +28,10 @@ int main(int argc, char** argv) {
     // after, instead of the signal killing the process and leaving its temporary file.
     std::signal(SIGXFSZ, SIG_IGN);
     try {
+        StandardOutput standard_output;
         for (const Subcommand& s : subcommands)
             if (s.app->parsed()) s.run();
-        finish_standard_output();
+        standard_output.finish();
     } catch (const std::exception& e) {
         std::cerr << "envmis: " << e.what() << "\n";
         return 1;

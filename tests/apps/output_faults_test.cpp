@@ -31,10 +31,6 @@ using envmis::test::Result;
 
 const std::string kStudio = (fs::path(ENVMIS_DATA_DIR) / "envmaps" / "studio.exr").string();
 
-// What a run may write to a file: its outputs are far larger, its reports and messages
-// far smaller.
-constexpr rlim_t kFileSizeLimit = 32 * 1024;
-
 bool contains(const std::string& text, const std::string& pattern) {
     return std::regex_search(text, std::regex(pattern, std::regex::icase));
 }
@@ -130,6 +126,7 @@ struct FullDiskCase {
     std::string name;
     std::vector<std::string> args;
     std::string output;  // the file that cannot be written, relative to the test's folder
+    rlim_t limit;        // bytes per file: far below the output's size, above the error message's
 };
 
 void PrintTo(const FullDiskCase& c, std::ostream* os) { *os << c.name; }
@@ -139,26 +136,40 @@ class FullDisk : public OutputFaults, public testing::WithParamInterface<FullDis
 TEST_P(FullDisk, FailsWithOneLineNamingTheFileAndLeavesNeitherItNorATemporary) {
     const FullDiskCase& c = GetParam();
     fs::create_directory(file("out"));
-    const Result r = envmis(c.args, {}, kFileSizeLimit);
+    const Result r = envmis(c.args, "/dev/null", c.limit);
     expect_one_line_error(r, c.output, "file too large");
     EXPECT_FALSE(fs::exists(file(c.output))) << r;
     EXPECT_EQ(temporaries(), std::vector<std::string>{}) << r;
 }
 
-// studio.exr is 1024 x 512: its table, remapped EXR, panels and samples all exceed the limit.
+// studio.exr is 1024 x 512: its table, remapped EXR, panels and samples are all far
+// larger than 32 KiB; compare's files (of one shading point) than 1 KiB.
+constexpr rlim_t kKiB = 1024;
+const std::vector<std::string> kComparePoint = {"compare", kStudio, "--normal", "0,0,1", "--spp", "16"};
+
+std::vector<std::string> compare_args(const std::vector<std::string>& more) {
+    std::vector<std::string> args = kComparePoint;
+    args.insert(args.end(), more.begin(), more.end());
+    return args;
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Writers, FullDisk,
     testing::Values(
-        FullDiskCase{"VisualizePng", {"visualize", kStudio, "-o", "out/x.png", "--panel-width", "1024"}, "out/x.png"},
-        FullDiskCase{"PrecomputeTable", {"precompute", kStudio, "-o", "out/x.envmis"}, "out/x.envmis"},
-        FullDiskCase{"ConvertExr", {"convert", kStudio, "-o", "out/x.exr", "--to", "equal-area"}, "out/x.exr"},
-        FullDiskCase{"SampleCsv", {"sample", kStudio, "-n", "100000", "-o", "out/x.csv"}, "out/x.csv"},
-        FullDiskCase{"CompareJson",
-                     {"compare", kStudio, "--points", "2000", "--spp", "1", "--json", "out/x.json"},
-                     "out/x.json"},
-        FullDiskCase{"ComparePlotsPng",
-                     {"compare", kStudio, "--normal", "0,0,1", "--spp", "16", "--plots", "out"},
-                     "out/variance_vs_balance.png"}),
+        FullDiskCase{
+            "VisualizePng", {"visualize", kStudio, "-o", "out/x.png", "--panel-width", "1024"}, "out/x.png", 32 * kKiB},
+        FullDiskCase{"PrecomputeTable", {"precompute", kStudio, "-o", "out/x.envmis"}, "out/x.envmis", 32 * kKiB},
+        FullDiskCase{"ConvertExr",
+                     {"convert", kStudio, "-o", "out/x.exr", "--to", "equal-area", "--size", "256"},
+                     "out/x.exr",
+                     32 * kKiB},
+        FullDiskCase{"SampleCsv", {"sample", kStudio, "-n", "100000", "-o", "out/x.csv"}, "out/x.csv", 32 * kKiB},
+        FullDiskCase{"CompareJson", compare_args({"--json", "out/x.json"}), "out/x.json", kKiB},
+        FullDiskCase{"CompareCsv", compare_args({"--csv", "out/x.csv"}), "out/x.csv", kKiB},
+        FullDiskCase{"ComparePlotsPng", compare_args({"--plots", "out"}), "out/variance_vs_balance.png", kKiB},
+        FullDiskCase{"CompareImagesExr",
+                     compare_args({"--images", "out", "--image", "64x16", "--image-spp", "1", "--reference-spp", "1"}),
+                     "out/reference.exr", kKiB}),
     [](const testing::TestParamInfo<FullDiskCase>& info) { return info.param.name; });
 
 // ---------------------------------------------------------------------------------
@@ -174,8 +185,7 @@ TEST_P(FullStandardOutput, ExitsNonZeroSayingSo) {
 INSTANTIATE_TEST_SUITE_P(Commands, FullStandardOutput,
                          testing::Values(std::vector<std::string>{"info", kStudio},
                                          std::vector<std::string>{"precompute", kStudio, "-o", "x.envmis"},
-                                         std::vector<std::string>{"compare", kStudio, "--normal", "0,0,1", "--spp",
-                                                                  "16"}),
+                                         kComparePoint),
                          [](const testing::TestParamInfo<std::vector<std::string>>& info) { return info.param[0]; });
 
 // ---------------------------------------------------------------------------------

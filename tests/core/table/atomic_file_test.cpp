@@ -8,9 +8,9 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <cstring>
 #include <chrono>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -75,7 +75,8 @@ TEST_F(AtomicFileTest, ACommittedWriteReplacesTheDestinationAndLeavesNoTemporary
 
 TEST_F(AtomicFileTest, TheTemporaryIsHiddenBesideTheDestinationAndNamesThisProcess) {
     AtomicFile f(file("table.envmis"));
-    const std::string name = f.temporary().filename().string(), prefix = ".table.tmp" + std::to_string(::getpid()) + "-";
+    const std::string name = f.temporary().filename().string(),
+                      prefix = ".table.tmp" + std::to_string(::getpid()) + "-";
     EXPECT_EQ(f.temporary().parent_path(), dir_);
     EXPECT_EQ(name.rfind(prefix, 0), 0u) << name;
     EXPECT_TRUE(name.ends_with(".envmis")) << name;
