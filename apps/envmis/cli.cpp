@@ -3,9 +3,11 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -15,6 +17,7 @@
 #include <string_view>
 
 #include "envmis/io/image_io.h"
+#include "envmis/table/atomic_file.h"
 
 namespace envmis::cli {
 
@@ -293,6 +296,57 @@ void Progress::update(uint64_t done) {
     shown_ = percent;
     std::fprintf(stderr, "\r%s %3d%%", label_.c_str(), percent);
     std::fflush(stderr);
+}
+
+void prepare_output(const std::filesystem::path& path) {
+    check_destination(path);
+    for (const std::filesystem::path& removed : remove_stale_temporaries(path))
+        std::cerr << "envmis: removed " << removed.string() << ", the temporary file of an interrupted earlier run\n";
+}
+
+// Writes through C's stdout, as libstdc++'s own synchronised buffer does, but keeps the
+// errno of the first failed write: by the final flush it is long gone (the C stream
+// discards what it failed to write, and a failed std::cout writes nothing more).
+class StandardOutput::Buffer final : public std::streambuf {
+public:
+    int error() const noexcept { return error_; }
+    int sync() override { return std::fflush(stdout) == 0 ? 0 : failed(); }
+
+protected:
+    int_type overflow(int_type c) override {
+        if (traits_type::eq_int_type(c, traits_type::eof()))
+            return sync() == 0 ? traits_type::not_eof(c) : traits_type::eof();
+        if (std::fputc(traits_type::to_char_type(c), stdout) == EOF) {
+            failed();
+            return traits_type::eof();
+        }
+        return c;
+    }
+    std::streamsize xsputn(const char* s, std::streamsize n) override {
+        const size_t written = std::fwrite(s, 1, static_cast<size_t>(n), stdout);
+        if (written < static_cast<size_t>(n)) failed();
+        return static_cast<std::streamsize>(written);
+    }
+
+private:
+    int failed() noexcept {
+        if (error_ == 0) error_ = errno != 0 ? errno : EIO;
+        return -1;
+    }
+    int error_ = 0;
+};
+
+StandardOutput::StandardOutput() : buffer_(std::make_unique<Buffer>()), previous_(std::cout.rdbuf(buffer_.get())) {}
+
+StandardOutput::~StandardOutput() { std::cout.rdbuf(previous_); }
+
+void StandardOutput::finish() {
+    std::cout.flush();
+    buffer_->sync();
+    // printf's failures leave only the stream's error flag.
+    if (buffer_->error() == 0 && !std::ferror(stdout)) return;
+    throw std::runtime_error(std::string("standard output: ") +
+                             (buffer_->error() != 0 ? std::strerror(buffer_->error()) : "write failed"));
 }
 
 }  // namespace envmis::cli

@@ -7,8 +7,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -127,6 +129,32 @@ private:
     uint64_t total_;
     int shown_ = -1;
     bool enabled_;
+};
+
+// An output file given on the command line, before any work: refuses one that exists and
+// is not a regular file (check_destination in atomic_file.h: a device, FIFO, folder or
+// symbolic link is never replaced) and removes its stale temporaries from killed runs,
+// one line on stderr for each ("envmis: removed ..."). The writer itself does both again
+// (silently), for the files that commands write into folders (--plots, --images).
+void prepare_output(const std::filesystem::path& path);
+
+// Standard output whose every write is checked (a full disk, /dev/full): a report that
+// did not arrive is an error. While one exists, std::cout writes through it to C's stdout
+// (so that its order with printf is kept), noting the reason of the first failure.
+class StandardOutput {
+public:
+    StandardOutput();
+    StandardOutput(const StandardOutput&) = delete;
+    StandardOutput& operator=(const StandardOutput&) = delete;
+    ~StandardOutput();  // gives std::cout its own buffer back
+    // Flushes both streams; throws std::runtime_error("standard output: REASON") if that
+    // or any earlier write failed.
+    void finish();
+
+private:
+    class Buffer;
+    std::unique_ptr<Buffer> buffer_;
+    std::streambuf* previous_;
 };
 
 // Each subcommand adds itself to the app, with the function that runs it once parsed.

@@ -233,6 +233,8 @@ Setup prepare(const CompareArgs& args) {
     std::vector<Technique> alpha_techniques, allocation_techniques;
     if (!swept.empty()) alpha_techniques = alpha_sweep_techniques(requested);
     if (args.allocation_sweep) allocation_techniques = allocation_sweep_techniques(requested);
+    for (const std::string* output : {&args.csv, &args.json})
+        if (!output->empty()) prepare_output(*output);
     if (!args.images.empty()) std::filesystem::create_directories(args.images);
     if (!args.plots.empty()) std::filesystem::create_directories(args.plots);
     std::string map_name;

@@ -74,6 +74,7 @@ void print_conversion(const ConvertArgs& args, const io::LoadedImage& image, con
 }
 
 void run_convert(const ConvertArgs& args) {
+    prepare_output(args.output);
     const Mapping from = parse_mapping(args.from), to = parse_mapping(args.to);
     Size size = requested_size(args.size, to);
     const io::LoadedImage image = io::load_image(args.input, {args.colorspace, args.working_space});

@@ -98,6 +98,7 @@ void run_precompute_binned(const PrecomputeArgs& args) {
 }
 
 void run_precompute(const PrecomputeArgs& args) {
+    prepare_output(args.output);
     if (args.bins != 0) return run_precompute_binned(args);
     const LoadedMap loaded = load_map(args.input, args.map);
     if (loaded.from_table) throw std::runtime_error(args.input + ": is already a table; give an image");

@@ -323,6 +323,7 @@ void write_report(std::ostream& out, const std::vector<json>& runs, const Report
 }
 
 void run_report(const ReportArgs& args) {
+    prepare_output(args.output);
     std::vector<json> runs;
     for (const std::string& path : args.inputs) runs.push_back(read_results(path));
     write_file_atomically(args.output, [&](std::ostream& out) { write_report(out, runs, args); });

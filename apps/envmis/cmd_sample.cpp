@@ -66,11 +66,10 @@ void add_sample_flags(CLI::App& sub, SampleArgs& args) {
 }
 
 void run_sample(const SampleArgs& args) {
+    if (!args.output.empty()) prepare_output(args.output);
     const LoadedMap loaded = load_map(args.input, args.map);
     if (args.output.empty()) {
-        write_samples(std::cout, loaded.map, args.count, args.seed);
-        std::cout.flush();
-        if (!std::cout) throw std::runtime_error("standard output: write failed");
+        write_samples(std::cout, loaded.map, args.count, args.seed);  // main checks standard output
     } else {
         write_file_atomically(args.output,
                               [&](std::ostream& out) { write_samples(out, loaded.map, args.count, args.seed); });

@@ -180,6 +180,7 @@ Visualization visualize(const std::string& name, const Densities& d, const std::
 }
 
 void run_visualize(const VisualizeArgs& args) {
+    prepare_output(args.output);
     const LoadedMap loaded = load_map(args.input, args.map);
     const Densities densities{loaded.map, opposite_density(loaded.map)};
     const std::optional<BinPanel> bin = bin_panel(args, loaded, densities.plain());

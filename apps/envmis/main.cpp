@@ -1,4 +1,5 @@
 // envmis: precompute, inspect, sample, visualise and benchmark environment-map samplers.
+#include <csignal>
 #include <exception>
 #include <iostream>
 #include <string>
@@ -23,9 +24,14 @@ int main(int argc, char** argv) {
         return app.exit(e);
     }
     install_interrupt_handler();
+    // Past RLIMIT_FSIZE a write fails with EFBIG, which the writers report and clean up
+    // after, instead of the signal killing the process and leaving its temporary file.
+    std::signal(SIGXFSZ, SIG_IGN);
     try {
+        StandardOutput standard_output;
         for (const Subcommand& s : subcommands)
             if (s.app->parsed()) s.run();
+        standard_output.finish();
     } catch (const std::exception& e) {
         std::cerr << "envmis: " << e.what() << "\n";
         return 1;

@@ -1,7 +1,6 @@
 #include "envmis/io/image_io.h"
 
-#include "envmis/table/atomic_file.h"
-
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <climits>
@@ -103,22 +102,37 @@ void check_writable(const fs::path& path, uint32_t width, uint32_t height, size_
                        std::to_string(elements) + " elements (expected " + std::to_string(expected) + ")");
 }
 
-// Writes `file` in one go; returns OpenImageIO's error, empty on success. The output is
-// closed on return, so that a failed file can be removed.
-std::string write_file(const fs::path& file, const char* format, const OIIO::ImageSpec& spec, const void* pixels) {
+// The file's bytes, encoded in memory: OpenImageIO's writers do not all report a failed
+// write (2.4's PNG writer ignores a short fwrite), so the bytes reach the disk through
+// AtomicFile, which checks every write. Empty with `error` set on failure.
+std::vector<unsigned char> encode(const char* format, const OIIO::ImageSpec& spec, const void* pixels,
+                                  std::string& error) {
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput proxy(bytes);
     auto out = OIIO::ImageOutput::create(format);
-    if (!out) return OIIO::geterror();
-    if (out->open(file.string(), spec) && out->write_image(spec.format, pixels) && out->close()) return {};
-    std::string error = out->geterror();
-    return error.empty() ? "no detail from OpenImageIO" : error;
+    if (!out) {
+        error = OIIO::geterror();
+        return {};
+    }
+    if (!out->supports("ioproxy") || !out->set_ioproxy(&proxy)) {
+        error = std::string("the ") + format + " writer cannot write to memory";
+        return {};
+    }
+    if (out->open("memory." + std::string(format), spec) && out->write_image(spec.format, pixels) && out->close())
+        return bytes;
+    error = out->geterror();
+    if (error.empty()) error = "no detail from OpenImageIO";
+    return {};
 }
 
 // Readers never see a partial file: AtomicFile renames it into place only when complete.
 void write_atomically(const fs::path& path, const char* format, const OIIO::ImageSpec& spec, const void* pixels) {
     try {
         AtomicFile file(path);
-        const std::string error = write_file(file.temporary(), format, spec, pixels);
+        std::string error;
+        const std::vector<unsigned char> bytes = encode(format, spec, pixels, error);
         if (!error.empty()) fail(path, "cannot write (" + error + ")");
+        file.write(std::as_bytes(std::span(bytes)));
         file.commit();
     } catch (const ImageError&) {
         throw;

@@ -9,8 +9,9 @@
 // that built them, so a loaded table samples bit-identically to the saved one, and no
 // index read from a file can ever address memory.
 //
-// Writing goes to a temporary file in the destination's folder, renamed over the
-// destination only when complete: an interrupted run never leaves a partial table.
+// Writing goes to a temporary file in the destination's folder (an AtomicFile,
+// atomic_file.h), renamed over the destination only when complete and flushed to disk:
+// an interrupted run or a full disk never leaves a partial table.
 #pragma once
 
 #include <cstddef>
@@ -68,7 +69,8 @@ public:
 //            EnvMap(rgbe_round(radiance), options). Lossless for .hdr sources.
 enum class TableEncoding { full, compact };
 
-// Writes atomically (temporary file, then rename). Throws TableError on I/O failure.
+// Writes atomically (temporary file, then rename; atomic_file.h). Throws TableError on
+// I/O failure and where the destination exists and is not a regular file.
 void write_table(const std::filesystem::path& path, const EnvMap& map, const TableSource& source,
                  TableEncoding encoding = TableEncoding::full);
 

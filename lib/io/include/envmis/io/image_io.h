@@ -7,7 +7,10 @@
 // to a linear working space (colour.h). Values are returned as read: NaN, Inf and
 // negative values are left for EnvMap to repair and count.
 //
-// Writing: to a temporary file in the destination folder, renamed when complete.
+// Writing: encoded in memory, then written through an AtomicFile (atomic_file.h): a
+// temporary file in the destination folder, every write checked, renamed when complete.
+// A destination that is not a regular file (device, FIFO, folder, symbolic link) is
+// refused; a failure (a full disk) throws and leaves neither it nor the temporary.
 //
 // Errors: ImageError, whose message names the file and the problem (missing, not an
 // image, truncated, unsupported, unknown colour space...).
@@ -52,9 +55,9 @@ struct Image8 {
     std::vector<uint8_t> rgb;  // width * height * 3
 };
 
-// Writes linear float RGB as a 32-bit float OpenEXR file.
+// Writes linear float RGB as a 32-bit float OpenEXR file. Throws ImageError naming the file on failure.
 void write_exr(const std::filesystem::path& path, RgbImageView image);
-// Writes a PNG file.
+// Writes a PNG file. Throws ImageError naming the file on failure.
 void write_png(const std::filesystem::path& path, const Image8& image);
 
 }  // namespace envmis::io
