@@ -1,6 +1,7 @@
 // envmis: precompute, inspect, sample, visualise and benchmark environment-map samplers.
 #include <exception>
 #include <iostream>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,10 @@ int main(int argc, char** argv) {
     try {
         for (const Subcommand& s : subcommands)
             if (s.app->parsed()) s.run();
+    } catch (const std::bad_alloc&) {
+        // The last resort: sizes are checked against free memory before large allocations.
+        std::cerr << "envmis: out of memory (try a smaller size, or free memory)\n";
+        return 1;
     } catch (const std::exception& e) {
         std::cerr << "envmis: " << e.what() << "\n";
         return 1;
