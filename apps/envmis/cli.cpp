@@ -177,9 +177,9 @@ void check_memory(const std::string& what, uint64_t bytes) {
 void check_image_size(const std::string& what, Size size, uint64_t bytes_per_texel) {
     const uint64_t texels = uint64_t{size.width} * size.height;
     if (texels > kMaxTexels)
-        throw std::runtime_error(what + ": " + std::to_string(size.width) + "x" + std::to_string(size.height) +
-                                 " is " + std::to_string(texels) + " texels, above the limit of " +
-                                 std::to_string(kMaxTexels) + " (2^31)");
+        throw std::runtime_error(what + ": " + std::to_string(size.width) + "x" + std::to_string(size.height) + " is " +
+                                 std::to_string(texels) + " texels, above the limit of " + std::to_string(kMaxTexels) +
+                                 " (2^31)");
     check_memory(what, texels * bytes_per_texel);
 }
 
@@ -317,12 +317,12 @@ void print_summary(std::ostream& out, const LoadedMap& loaded, const EnvMap& m) 
     const double texels = static_cast<double>(m.width()) * m.height();
     const auto flags = out.flags();
     out << std::setprecision(4);
-    out << "  source        " << printable(loaded.source.name) << " (" << loaded.format << ", hash " << std::hex << std::setw(16)
-        << std::setfill('0') << loaded.source.content_hash << std::dec << std::setfill(' ') << ")\n";
+    out << "  source        " << printable(loaded.source.name) << " (" << loaded.format << ", hash " << std::hex
+        << std::setw(16) << std::setfill('0') << loaded.source.content_hash << std::dec << std::setfill(' ') << ")\n";
     out << "  size          " << m.width() << " x " << m.height() << "\n";
     out << "  colour        " << printable(loaded.source.input_colorspace) << " -> "
-        << printable(loaded.source.working_colorspace)
-        << ", luma (" << o.luma.r << ", " << o.luma.g << ", " << o.luma.b << ")\n";
+        << printable(loaded.source.working_colorspace) << ", luma (" << o.luma.r << ", " << o.luma.g << ", " << o.luma.b
+        << ")\n";
     out << "  mapping       " << to_string(o.mapping) << ", axes " << o.axes.to_string() << "\n";
     out << "  luminance     max " << s.max_luminance << ", min positive " << s.min_positive_luminance;
     if (s.min_positive_luminance > 0)

@@ -134,8 +134,10 @@ constexpr uint64_t kBytesPerTexel = 64;
 
 void add_bench_flags(CLI::App& sub, BenchArgs& args) {
     sub.add_option("input", args.input, "HDR image or table (default: a synthetic sky with a small sun)");
-    sub.add_option("--size", args.size, "Size of the synthetic sky, WxH, each side 1 to 65536, at most 2^31 texels and about 64 bytes a texel "
-                   "of free memory")
+    sub.add_option(
+           "--size", args.size,
+           "Size of the synthetic sky, WxH, each side 1 to 65536, at most 2^31 texels and about 64 bytes a texel "
+           "of free memory")
         ->type_name("WxH")
         ->capture_default_str()
         ->check(size_validator(false));

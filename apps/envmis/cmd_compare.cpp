@@ -194,8 +194,8 @@ uint32_t worker_threads(uint32_t asked) {
     const uint32_t cores = std::max(1u, std::thread::hardware_concurrency());
     if (asked == 0) return cores;
     if (asked <= kThreadsPerCore * cores) return asked;
-    std::cerr << "note: --threads " << asked << ": more than " << kThreadsPerCore << " per hardware thread ("
-              << cores << "); using " << kThreadsPerCore * cores << "\n";
+    std::cerr << "note: --threads " << asked << ": more than " << kThreadsPerCore << " per hardware thread (" << cores
+              << "); using " << kThreadsPerCore * cores << "\n";
     return kThreadsPerCore * cores;
 }
 

@@ -162,11 +162,10 @@ struct PanelSize {
 
 PanelSize panel_size(const std::string& file, uint32_t w, uint32_t h, uint32_t panel_width) {
     if (uint64_t{h} * kMinPanelWidth > uint64_t{w} * kMaxPanelHeight)
-        throw std::runtime_error(file + ": a " + std::to_string(w) + "x" + std::to_string(h) +
-                                 " map is too tall to draw: at most " +
-                                 std::to_string(kMaxPanelHeight / kMinPanelWidth) +
-                                 " times taller than wide (panels at most " + std::to_string(kMaxPanelHeight) +
-                                 " pixels high)");
+        throw std::runtime_error(
+            file + ": a " + std::to_string(w) + "x" + std::to_string(h) + " map is too tall to draw: at most " +
+            std::to_string(kMaxPanelHeight / kMinPanelWidth) + " times taller than wide (panels at most " +
+            std::to_string(kMaxPanelHeight) + " pixels high)");
     const auto fit = static_cast<uint32_t>(uint64_t{kMaxPanelHeight} * w / h);
     const uint32_t pw = std::min({panel_width, std::max(w, kMinPanelWidth), std::max(fit, kMinPanelWidth)});
     return {pw, std::max(1u, static_cast<uint32_t>(uint64_t{pw} * h / w))};

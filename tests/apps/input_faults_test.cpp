@@ -68,8 +68,8 @@ public:
     // envmis with its address space limited to `mib` MiB, so that a run that tries to
     // allocate too much fails at once instead of taking the machine's memory.
     Result envmis_within(uint64_t mib, const std::vector<std::string>& args) const {
-        std::string command = "cd " + quoted(dir_.string()) + " && ulimit -v " + std::to_string(mib * 1024) +
-                              " && " + quoted(ENVMIS_CLI);
+        std::string command =
+            "cd " + quoted(dir_.string()) + " && ulimit -v " + std::to_string(mib * 1024) + " && " + quoted(ENVMIS_CLI);
         for (const std::string& a : args) command += " " + quoted(a);
         Result r = envmis::test::run_shell(command, dir_ / "..stdout", dir_ / "..stderr");
         fs::remove(dir_ / "..stdout");
@@ -153,12 +153,12 @@ TEST_P(OverflowingMap, IsAnErrorNamingTheMapAndTheFix) {
     EXPECT_FALSE(fs::exists(file("out")));
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Commands, OverflowingMap,
-    testing::Values(std::vector<std::string>{"precompute", "bright.exr", "-o", "out"},
-                    std::vector<std::string>{"info", "bright.exr"},
-                    std::vector<std::string>{"compare", "bright.exr", "--points", "2", "--spp", "8", "--json", "out"}),
-    [](const testing::TestParamInfo<std::vector<std::string>>& info) { return info.param[0]; });
+INSTANTIATE_TEST_SUITE_P(Commands, OverflowingMap,
+                         testing::Values(std::vector<std::string>{"precompute", "bright.exr", "-o", "out"},
+                                         std::vector<std::string>{"info", "bright.exr"},
+                                         std::vector<std::string>{"compare", "bright.exr", "--points", "2", "--spp",
+                                                                  "8", "--json", "out"}),
+                         [](const testing::TestParamInfo<std::vector<std::string>>& info) { return info.param[0]; });
 
 // A sun near float's maximum overflowed the sums of its row to Inf, though the map's
 // power fits: it must keep working, with finite statistics.
@@ -170,7 +170,7 @@ TEST_F(InputFaults, ASunNearFloatsMaximumStillGivesFiniteStatistics) {
     const Result r = envmis({"precompute", "sun.exr", "-o", "sun.envmis"});
     ASSERT_EQ(r.exit_code, 0) << r;
     EXPECT_TRUE(contains(r.out, "fallback +none")) << r;
-    EXPECT_FALSE(contains(r.out, "(nan|inf)")) << r;
+    EXPECT_FALSE(contains(r.out, R"(  (luminance|mean \(Lbar\)|compensation) .*(nan|inf))")) << r;
 }
 
 // ---------------------------------------------------------------------------------

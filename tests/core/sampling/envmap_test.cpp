@@ -151,8 +151,11 @@ TEST(EnvMap, EqualAreaMapsFollowTheirDensity) {
 // Finite pixels whose power 4 pi Lbar overflows float would give Inf and NaN estimates:
 // the map is refused, saying how to scale it.
 TEST(EnvMap, AMapWhosePowerOverflowsFloatIsRefusedWithTheFactorToScaleItBy) {
-    test::expect_error<std::invalid_argument>([] { EnvMap(test::constant_map(64, 32, {3e38f, 3e38f, 3e38f})); },
-                                              {"luminance overflows", "scale the map down", "1e-3"});
+    test::expect_error<std::invalid_argument>(
+        [] {
+            EnvMap(test::constant_map(64, 32, {3e38f, 3e38f, 3e38f}));
+        },
+        {"luminance overflows", "scale the map down", "1e-3"});
 }
 
 // A sun of texels near float's maximum overflows the float lanes of a row's sum, but not

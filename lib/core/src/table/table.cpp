@@ -348,24 +348,24 @@ void check_stats(const Header& header, const Cursor& in) {
     // A mean above the maximum (beyond rounding) or of a map without radiance is made up.
     field(s.mean_luminance <= 1.001 * s.max_luminance && (s.max_luminance > 0) == (s.min_positive_luminance > 0),
           "mean luminance", number(s.mean_luminance), "at most the max luminance, 0 for a black map");
-    field(std::isfinite(s.threshold) && s.threshold >= 0 &&
-              (s.threshold == 0 || (compensated && s.fallback == DensityFallback::none)),
-          "threshold", number(s.threshold), "finite, >= 0, and 0 unless compensated without a fallback");
-    field(s.zeroed_texels <= texels && (s.zeroed_texels == 0 || s.threshold > 0), "zeroed texel count",
-          std::to_string(s.zeroed_texels), "at most the texel count, 0 unless compensated");
-    const uint64_t channels = 3 * texels;
-    for (const auto& [count, name] : {std::pair{s.bad_pixels.nan, "NaN count"},
-                                      std::pair{s.bad_pixels.infinite, "Inf count"},
-                                      std::pair{s.bad_pixels.negative, "negative count"}})
-        field(count <= channels, name, std::to_string(count), "at most 3 x the texel count");
-    field(s.bad_pixels.nan + s.bad_pixels.infinite + s.bad_pixels.negative <= channels, "bad pixel counts",
-          std::to_string(s.bad_pixels.total()), "at most 3 x the texel count in all");
     // EnvMap falls back to uniform exactly when Lbar is 0, and to uncompensated only when compensating.
     const std::string fallback(to_string(s.fallback));
     field((s.fallback == DensityFallback::uniform) == (s.mean_luminance == 0), "fallback", fallback,
           "uniform exactly when the map is black");
     field(s.fallback != DensityFallback::uncompensated || compensated, "fallback", fallback,
           "uncompensated only when compensation was requested");
+    field(std::isfinite(s.threshold) && s.threshold >= 0 &&
+              (s.threshold == 0 || (compensated && s.fallback == DensityFallback::none)),
+          "threshold", number(s.threshold), "finite, >= 0, and 0 unless compensated without a fallback");
+    field(s.zeroed_texels <= texels && (s.zeroed_texels == 0 || s.threshold > 0), "zeroed texel count",
+          std::to_string(s.zeroed_texels), "at most the texel count, 0 unless compensated");
+    const uint64_t channels = 3 * texels;
+    for (const auto& [count, name] :
+         {std::pair{s.bad_pixels.nan, "NaN count"}, std::pair{s.bad_pixels.infinite, "Inf count"},
+          std::pair{s.bad_pixels.negative, "negative count"}})
+        field(count <= channels, name, std::to_string(count), "at most 3 x the texel count");
+    field(s.bad_pixels.nan + s.bad_pixels.infinite + s.bad_pixels.negative <= channels, "bad pixel counts",
+          std::to_string(s.bad_pixels.total()), "at most 3 x the texel count in all");
 }
 
 // Parses and checks the header from `head`, the first bytes of a file of `file_size`
