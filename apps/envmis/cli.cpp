@@ -1,6 +1,7 @@
 #include "cli.h"
 
 #include <signal.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -124,6 +125,67 @@ void throw_if_interrupted() {
     if (g_interrupted) throw std::runtime_error("interrupted");
 }
 
+std::string printable(std::string_view text) {
+    std::string out;
+    out.reserve(text.size());
+    char escape[8];
+    for (size_t i = 0; i < text.size(); ++i) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        const auto next = i + 1 < text.size() ? static_cast<unsigned char>(text[i + 1]) : 0;
+        if (c == '\\') {
+            out += "\\\\";
+        } else if (c < 0x20 || c == 0x7f) {
+            std::snprintf(escape, sizeof escape, "\\x%02x", c);
+            out += escape;
+        } else if (c == 0xc2 && next >= 0x80 && next <= 0x9f) {
+            std::snprintf(escape, sizeof escape, "\\u%04x", next);
+            out += escape;
+            ++i;
+        } else {
+            out += static_cast<char>(c);
+        }
+    }
+    return out;
+}
+
+namespace {
+// A "Key:   N kB" line of a /proc file, in bytes.
+std::optional<uint64_t> proc_kib(const char* file, const std::string& key) {
+    std::ifstream in(file);
+    for (std::string line; std::getline(in, line);)
+        if (line.compare(0, key.size(), key) == 0) return std::stoull(line.substr(key.size())) * 1024;
+    return std::nullopt;
+}
+}  // namespace
+
+std::optional<uint64_t> available_memory() {
+    std::optional<uint64_t> available = proc_kib("/proc/meminfo", "MemAvailable:");
+    rlimit limit{};
+    if (::getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
+        const uint64_t used = proc_kib("/proc/self/status", "VmSize:").value_or(0);
+        const uint64_t left = limit.rlim_cur > used ? limit.rlim_cur - used : 0;
+        available = std::min(available.value_or(left), left);
+    }
+    return available;
+}
+
+void check_memory(const std::string& what, uint64_t bytes) {
+    const std::optional<uint64_t> available = available_memory();
+    if (!available || bytes <= *available) return;
+    const auto mb = [](uint64_t b) { return std::to_string((b + (1 << 20) - 1) >> 20) + " MB"; };
+    throw std::runtime_error(what + ": needs " + mb(bytes) + " of memory, more than the " + mb(*available) +
+                             " available");
+}
+
+void check_image_size(const std::string& what, Size size, uint64_t bytes_per_texel) {
+    const uint64_t texels = uint64_t{size.width} * size.height;
+    if (texels > kMaxTexels)
+        throw std::runtime_error(what + ": " + std::to_string(size.width) + "x" + std::to_string(size.height) + " is " +
+                                 std::to_string(texels) + " texels, above the limit of " + std::to_string(kMaxTexels) +
+                                 " (2^31)");
+    check_memory(what, texels * bytes_per_texel);
+}
+
 double milliseconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -155,6 +217,7 @@ LoadedMap load_map(const std::string& path, const MapFlags& flags) {
         return loaded;
     }
     io::LoadedImage image = io::load_image(path, {flags.colorspace, flags.working_space});
+    for (const std::string& notice : image.notices) std::cerr << "note: " << notice << "\n";
     LoadedMap loaded;
     loaded.load_ms = milliseconds_since(start);
     EnvMapOptions options;
@@ -168,13 +231,18 @@ LoadedMap load_map(const std::string& path, const MapFlags& flags) {
     if (options.mapping == Mapping::equirect && image.image.width == image.image.height && image.image.width > 1)
         std::cerr << "note: " << path << " is square; it is read as equirect (pass --mapping equal-area for an "
                   << "equal-area octahedral map)\n";
-    if (flags.alpha_auto && !flags.no_compensate) {
-        loaded.alpha_choice = choose_alpha(image.image, options);
-        options.compensation.alpha = loaded.alpha_choice->alpha;
+    // What EnvMap refuses in a loaded image (its power overflowing float) is the file's fault.
+    try {
+        if (flags.alpha_auto && !flags.no_compensate) {
+            loaded.alpha_choice = choose_alpha(image.image, options);
+            options.compensation.alpha = loaded.alpha_choice->alpha;
+        }
+        const auto build_start = std::chrono::steady_clock::now();
+        loaded.map = EnvMap(std::move(image.image), options);
+        loaded.build_ms = milliseconds_since(build_start);
+    } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(path + ": " + e.what());
     }
-    const auto build_start = std::chrono::steady_clock::now();
-    loaded.map = EnvMap(std::move(image.image), options);
-    loaded.build_ms = milliseconds_since(build_start);
     loaded.source = {std::filesystem::path(path).filename().string(), image.content_hash, image.input_colorspace,
                      image.working_colorspace};
     loaded.format = image.format;
@@ -252,11 +320,12 @@ void print_summary(std::ostream& out, const LoadedMap& loaded, const EnvMap& m) 
     const double texels = static_cast<double>(m.width()) * m.height();
     const auto flags = out.flags();
     out << std::setprecision(4);
-    out << "  source        " << loaded.source.name << " (" << loaded.format << ", hash " << std::hex << std::setw(16)
-        << std::setfill('0') << loaded.source.content_hash << std::dec << std::setfill(' ') << ")\n";
+    out << "  source        " << printable(loaded.source.name) << " (" << loaded.format << ", hash " << std::hex
+        << std::setw(16) << std::setfill('0') << loaded.source.content_hash << std::dec << std::setfill(' ') << ")\n";
     out << "  size          " << m.width() << " x " << m.height() << "\n";
-    out << "  colour        " << loaded.source.input_colorspace << " -> " << loaded.source.working_colorspace
-        << ", luma (" << o.luma.r << ", " << o.luma.g << ", " << o.luma.b << ")\n";
+    out << "  colour        " << printable(loaded.source.input_colorspace) << " -> "
+        << printable(loaded.source.working_colorspace) << ", luma (" << o.luma.r << ", " << o.luma.g << ", " << o.luma.b
+        << ")\n";
     out << "  mapping       " << to_string(o.mapping) << ", axes " << o.axes.to_string() << "\n";
     out << "  luminance     max " << s.max_luminance << ", min positive " << s.min_positive_luminance;
     if (s.min_positive_luminance > 0)

@@ -14,6 +14,7 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <type_traits>
 
@@ -77,6 +78,26 @@ inline uint32_t bins_per_side(uint32_t bins) {
     return static_cast<uint32_t>(std::lround(std::sqrt(static_cast<double>(bins))));
 }
 
+// `text`, read from a file, made safe to print on a terminal: control characters (C0,
+// DEL and UTF-8-encoded C1, which can start escape sequences) and backslashes become
+// C-style escapes ("\x1b", "\u009b", "\\"); everything else is kept byte for byte.
+std::string printable(std::string_view text);
+
+// The bytes this process can still allocate: the smaller of MemAvailable
+// (/proc/meminfo) and what its address-space limit (RLIMIT_AS) leaves; empty where
+// neither is known (not Linux, no limit).
+std::optional<uint64_t> available_memory();
+// Throws "WHAT: needs N MB of memory, more than the M MB available" when `bytes` is more
+// than available_memory(); `what` names the flag or the file that asks for it.
+void check_memory(const std::string& what, uint64_t bytes);
+
+// The most texels of a map or image a command makes (an EnvMap's limit, 2^31).
+inline constexpr uint64_t kMaxTexels = uint64_t{1} << 31;
+// Checks a size that `what` (the flag and its value) asks for, before anything is
+// allocated for it: at most kMaxTexels, and `bytes_per_texel` times its texels within
+// available_memory(). Throws a one-line error naming `what` and the limit.
+void check_image_size(const std::string& what, Size size, uint64_t bytes_per_texel);
+
 // A map ready to sample, and where it came from.
 struct LoadedMap {
     EnvMap map;
@@ -91,7 +112,9 @@ struct LoadedMap {
     std::optional<BinLayout> bins = {};            // a binned table's bins (map: the plain map)
 };
 
-// Reads a table (recognised by its magic) or loads an image and builds its map.
+// Reads a table (recognised by its magic) or loads an image and builds its map; the
+// loader's notices go to stderr, each a line "note: FILE: ...". An image whose map
+// cannot be built (its power overflows float, say) is an error naming the file.
 LoadedMap load_map(const std::string& path, const MapFlags& flags);
 
 // The summary that precompute and info print, of `loaded`'s map or of `map` (precompute

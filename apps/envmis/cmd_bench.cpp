@@ -128,10 +128,16 @@ struct BenchArgs {
 // sample (2.7 GB at the limit); at most 1000 repeats.
 constexpr uint32_t kMaxBenchSamples = 1u << 26;
 constexpr int kMaxRepeats = 1000;
+// What a texel of the synthetic sky costs at the peak of a run, about: the sky, the map's
+// radiance, luminance and tables, the textbook sampler's and the bins'.
+constexpr uint64_t kBytesPerTexel = 64;
 
 void add_bench_flags(CLI::App& sub, BenchArgs& args) {
     sub.add_option("input", args.input, "HDR image or table (default: a synthetic sky with a small sun)");
-    sub.add_option("--size", args.size, "Size of the synthetic sky, WxH, each side 1 to 65536")
+    sub.add_option(
+           "--size", args.size,
+           "Size of the synthetic sky, WxH, each side 1 to 65536, at most 2^31 texels and about 64 bytes a texel "
+           "of free memory")
         ->type_name("WxH")
         ->capture_default_str()
         ->check(size_validator(false));
@@ -164,6 +170,7 @@ struct BenchMap {
 BenchMap bench_map(const BenchArgs& args) {
     if (args.input.empty()) {
         const Size size = *parse_size(args.size, false);  // the flag's validator has accepted it
+        check_image_size("--size " + args.size, size, kBytesPerTexel);
         return {reference::synthetic_sky(size.width, size.height), "synthetic-sky"};
     }
     MapFlags flags;

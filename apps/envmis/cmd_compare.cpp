@@ -46,6 +46,8 @@ constexpr uint32_t kMaxSpp = std::numeric_limits<uint32_t>::max();
 constexpr uint32_t kMaxSamples = 65536;  // per estimate, of each kind
 constexpr uint32_t kMaxPoints = 1000000;
 constexpr uint32_t kMaxThreads = 1024;
+// Workers beyond this many per hardware thread only add start-up cost and contention.
+constexpr uint32_t kThreadsPerCore = 4;
 constexpr uint32_t kMaxImageSpp = 65536, kMaxReferenceSpp = 1 << 20;
 
 // Everything a run is set up with: the parsed flags, the plain map, the points, the
@@ -122,7 +124,8 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
         ->check(in_range(uint32_t{0}, kMaxSamples));
     sub.add_option("--seed", args.seed, "Random seed")->capture_default_str()->check(any_seed());
     sub.add_option("--threads", args.threads,
-                   "Worker threads, 1 to 1024 (default: all cores); results do not depend on it")
+                   "Worker threads, 1 to 1024, at most 4 per hardware thread (more are reduced to that, with a "
+                   "note; default: all cores); results do not depend on it")
         ->check(in_range(uint32_t{1}, kMaxThreads));
     sub.add_option("--normal", args.normal, "One shading point with this normal x,y,z");
     sub.add_option("--view", args.view, "View direction x,y,z for --normal (default: the normal)");
@@ -186,6 +189,16 @@ std::pair<EnvMap, float> load_plain(const CompareArgs& args, std::string& map_na
     return {std::move(loaded.map), fixed_alpha};
 }
 
+// --threads (0: every hardware thread), at most kThreadsPerCore per hardware thread.
+uint32_t worker_threads(uint32_t asked) {
+    const uint32_t cores = std::max(1u, std::thread::hardware_concurrency());
+    if (asked == 0) return cores;
+    if (asked <= kThreadsPerCore * cores) return asked;
+    std::cerr << "note: --threads " << asked << ": more than " << kThreadsPerCore << " per hardware thread (" << cores
+              << "); using " << kThreadsPerCore * cores << "\n";
+    return kThreadsPerCore * cores;
+}
+
 ComparisonOptions comparison_options(const CompareArgs& args, std::vector<Technique>& requested) {
     ComparisonOptions options;
     options.spp = args.spp;
@@ -195,7 +208,7 @@ ComparisonOptions comparison_options(const CompareArgs& args, std::vector<Techni
     for (const std::string& t : split(args.techniques)) requested.push_back(Technique::parse(t));
     if (!requested.empty()) options.techniques = requested;
     options.allocation = {args.env_samples, args.bsdf_samples};
-    options.threads = args.threads ? args.threads : std::max(1u, std::thread::hardware_concurrency());
+    options.threads = worker_threads(args.threads);
     return options;
 }
 
@@ -360,7 +373,7 @@ std::string header_line(const Setup& s, size_t points_done) {
     }
     const ComparisonOptions& o = s.options;
     std::ostringstream header;
-    header << "envmis compare: " << s.map_name << " (" << s.plain.width() << "x" << s.plain.height() << "), "
+    header << "envmis compare: " << printable(s.map_name) << " (" << s.plain.width() << "x" << s.plain.height() << "), "
            << points_done << (points_done < s.points.size() ? " of " + std::to_string(s.points.size()) : "")
            << (s.points.size() == 1 ? " shading point" : " shading points") << ", " << o.spp << " estimates each, "
            << o.allocation.env << " env + " << o.allocation.bsdf << " BSDF samples per estimate ("

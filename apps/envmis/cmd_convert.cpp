@@ -26,8 +26,8 @@ void add_convert_flags(CLI::App& sub, ConvertArgs& args) {
     sub.add_option("--from", args.from, "Mapping of the input")->capture_default_str()->check(mappings);
     sub.add_option("--to", args.to, "Mapping of the output")->capture_default_str()->check(mappings);
     sub.add_option("--size", args.size,
-                   "Output size: N (equal-area N x N, equirect 2N x N) or WxH, each side 1 to 65536 (default: "
-                   "about the input's texel count)")
+                   "Output size: N (equal-area N x N, equirect 2N x N) or WxH, each side 1 to 65536, at most 2^31 "
+                   "texels and about 24 bytes a texel of free memory (default: about the input's texel count)")
         ->type_name("N|WxH")
         ->check(size_validator(true));
     sub.add_option("--supersampling", args.supersampling,
@@ -36,6 +36,9 @@ void add_convert_flags(CLI::App& sub, ConvertArgs& args) {
     sub.add_option("--colorspace", args.colorspace, "Input colour space (default: from the file's metadata)");
     sub.add_option("--working-space", args.working_space, "Colour space of the output")->capture_default_str();
 }
+
+// What an output texel costs at the peak: the remapped image and the writer's copy of it.
+constexpr uint64_t kBytesPerTexel = 2 * sizeof(Rgb);
 
 // The output size --size asks for (checked before any work), or 0 x 0 for the default.
 Size requested_size(const std::string& text, Mapping to) {
@@ -77,7 +80,9 @@ void run_convert(const ConvertArgs& args) {
     prepare_output(args.output);
     const Mapping from = parse_mapping(args.from), to = parse_mapping(args.to);
     Size size = requested_size(args.size, to);
+    if (size.width != 0) check_image_size("--size " + args.size, size, kBytesPerTexel);
     const io::LoadedImage image = io::load_image(args.input, {args.colorspace, args.working_space});
+    for (const std::string& notice : image.notices) std::cerr << "note: " << notice << "\n";
     if (size.width == 0) size = default_size(image.image, to);
     const auto start = std::chrono::steady_clock::now();
     const RemapResult result = remap(image.image, from, to, size.width, size.height, args.supersampling);

@@ -29,7 +29,7 @@ void print_bins_rebuild(const InfoArgs& args, const LoadedMap& loaded) {
 }
 
 void print_info(const InfoArgs& args, const LoadedMap& loaded) {
-    std::cout << args.input << ": ";
+    std::cout << printable(args.input) << ": ";
     if (loaded.from_table)
         std::cout << "envmis table, format version " << loaded.table_version
                   << (loaded.mapped ? ", radiance used in place from a mapping of the file" : "") << "\n";

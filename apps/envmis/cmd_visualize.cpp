@@ -59,7 +59,9 @@ struct VisualizeArgs {
 void add_visualize_flags(CLI::App& sub, VisualizeArgs& args) {
     sub.add_option("input", args.input, "HDR image or table")->required();
     sub.add_option("-o,--output", args.output, "PNG file to write")->required();
-    sub.add_option("--panel-width", args.panel_width, "Width of each panel in pixels")
+    sub.add_option("--panel-width", args.panel_width,
+                   "Width of each panel in pixels (panels keep the map's aspect and are at most 4096 high: a tall "
+                   "map's are narrower; a map over 64 times taller than wide is refused)")
         ->capture_default_str()
         ->check(in_range(uint32_t{64}, uint32_t{4096}));
     sub.add_option("--normal", args.normal,
@@ -149,11 +151,30 @@ struct Visualization {
     pictures::ColourScale scale;
 };
 
+// Panels keep the map's aspect and are at most kMaxPanelHeight pixels high: a tall map's
+// are narrowed to fit, down to kMinPanelWidth; a map taller than that allows (more than
+// 64 times taller than wide) is refused, naming `file`, before anything is drawn.
+constexpr uint32_t kMinPanelWidth = 64, kMaxPanelHeight = 4096;
+
+struct PanelSize {
+    uint32_t width = 0, height = 0;
+};
+
+PanelSize panel_size(const std::string& file, uint32_t w, uint32_t h, uint32_t panel_width) {
+    if (uint64_t{h} * kMinPanelWidth > uint64_t{w} * kMaxPanelHeight)
+        throw std::runtime_error(
+            file + ": a " + std::to_string(w) + "x" + std::to_string(h) + " map is too tall to draw: at most " +
+            std::to_string(kMaxPanelHeight / kMinPanelWidth) + " times taller than wide (panels at most " +
+            std::to_string(kMaxPanelHeight) + " pixels high)");
+    const auto fit = static_cast<uint32_t>(uint64_t{kMaxPanelHeight} * w / h);
+    const uint32_t pw = std::min({panel_width, std::max(w, kMinPanelWidth), std::max(fit, kMinPanelWidth)});
+    return {pw, std::max(1u, static_cast<uint32_t>(uint64_t{pw} * h / w))};
+}
+
 Visualization visualize(const std::string& name, const Densities& d, const std::optional<BinPanel>& bin,
-                        uint32_t panel_width) {
+                        PanelSize panel) {
     const uint32_t w = d.loaded.width(), h = d.loaded.height();
-    const uint32_t pw = std::min(panel_width, std::max(w, 64u));
-    const uint32_t ph = std::max(1u, static_cast<uint32_t>(static_cast<uint64_t>(pw) * h / w));
+    const uint32_t pw = panel.width, ph = panel.height;
     std::vector<std::vector<float>> pdfs = {pictures::resize(pdf_image(d.plain()), w, h, pw, ph),
                                             pictures::resize(pdf_image(d.compensated()), w, h, pw, ph)};
     if (bin) {
@@ -182,9 +203,10 @@ Visualization visualize(const std::string& name, const Densities& d, const std::
 void run_visualize(const VisualizeArgs& args) {
     prepare_output(args.output);
     const LoadedMap loaded = load_map(args.input, args.map);
+    const PanelSize panel = panel_size(args.input, loaded.map.width(), loaded.map.height(), args.panel_width);
     const Densities densities{loaded.map, opposite_density(loaded.map)};
     const std::optional<BinPanel> bin = bin_panel(args, loaded, densities.plain());
-    const Visualization v = visualize(loaded.source.name, densities, bin, args.panel_width);
+    const Visualization v = visualize(loaded.source.name, densities, bin, panel);
     io::write_png(args.output, v.picture);
     std::printf("envmis visualize: %s -> %s (%ux%u panels, pdf scale %.3g to %.3g per sr)\n", args.input.c_str(),
                 args.output.c_str(), v.panel_width, v.panel_height, v.scale.lo, v.scale.hi);

@@ -2,6 +2,7 @@
 #include <csignal>
 #include <exception>
 #include <iostream>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,10 @@ int main(int argc, char** argv) {
         for (const Subcommand& s : subcommands)
             if (s.app->parsed()) s.run();
         standard_output.finish();
+    } catch (const std::bad_alloc&) {
+        // The last resort: sizes are checked against free memory before large allocations.
+        std::cerr << "envmis: out of memory (try a smaller size, or free memory)\n";
+        return 1;
     } catch (const std::exception& e) {
         std::cerr << "envmis: " << e.what() << "\n";
         return 1;

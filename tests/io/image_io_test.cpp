@@ -153,6 +153,58 @@ TEST_F(ImageIo, ReadsTheFirstPartOfAMultiPartExr) {
     for (const Rgb& p : load_image(file("parts.exr")).image.pixels) expect_same(p, {1, 1, 1}, 0);
 }
 
+// An EXR whose data window (the pixels stored: the pattern, data_w x data_h at
+// (data_x, data_y)) differs from its display window (display_w x display_h at the origin).
+void write_windowed_exr(const fs::path& path, int data_x, int data_y, uint32_t data_w, uint32_t data_h,
+                        uint32_t display_w, uint32_t display_h) {
+    OIIO::ImageSpec spec(static_cast<int>(data_w), static_cast<int>(data_h), 3, OIIO::TypeDesc::FLOAT);
+    spec.x = data_x;
+    spec.y = data_y;
+    spec.full_x = spec.full_y = 0;
+    spec.full_width = static_cast<int>(display_w);
+    spec.full_height = static_cast<int>(display_h);
+    write_oiio(path, "openexr", spec, pattern(data_w, data_h, 3).data());
+}
+
+// The EXR rule: the image is the display window; where the data window does not
+// cover it, black.
+TEST_F(ImageIo, ACroppedExrIsItsDisplayWindowBlackOutsideTheDataWithANotice) {
+    write_windowed_exr(file("crop.exr"), 2, 1, 3, 2, 8, 4);
+    const LoadedImage loaded = load_image(file("crop.exr"));
+    ASSERT_EQ(loaded.image.width, 8u);
+    ASSERT_EQ(loaded.image.height, 4u);
+    const auto values = pattern(3, 2, 3);
+    for (uint32_t y = 0; y < 4; ++y)
+        for (uint32_t x = 0; x < 8; ++x) {
+            const bool inside = x >= 2 && x < 5 && y >= 1 && y < 3;
+            const Rgb expected = inside ? expected_rgb(values, (y - 1) * 3 + (x - 2), 3) : Rgb{};
+            expect_same(loaded.image.pixels[y * 8 + x], expected, y * 8 + x);
+        }
+    ASSERT_EQ(loaded.notices.size(), 1u);
+    EXPECT_NE(loaded.notices[0].find(file("crop.exr").string()), std::string::npos) << loaded.notices[0];
+    EXPECT_NE(loaded.notices[0].find("black where it has no data"), std::string::npos) << loaded.notices[0];
+}
+
+// Overscan: data beyond the display window is cropped away.
+TEST_F(ImageIo, AnOverscanExrIsCroppedToItsDisplayWindowWithANotice) {
+    write_windowed_exr(file("overscan.exr"), -1, -2, 8, 6, 4, 2);
+    const LoadedImage loaded = load_image(file("overscan.exr"));
+    ASSERT_EQ(loaded.image.width, 4u);
+    ASSERT_EQ(loaded.image.height, 2u);
+    const auto values = pattern(8, 6, 3);
+    for (uint32_t y = 0; y < 2; ++y)
+        for (uint32_t x = 0; x < 4; ++x)
+            expect_same(loaded.image.pixels[y * 4 + x], expected_rgb(values, (y + 2) * 8 + (x + 1), 3), y * 4 + x);
+    ASSERT_EQ(loaded.notices.size(), 1u);
+    EXPECT_NE(loaded.notices[0].find("data outside it cropped"), std::string::npos) << loaded.notices[0];
+    EXPECT_EQ(loaded.notices[0].find("black"), std::string::npos) << loaded.notices[0];
+}
+
+TEST_F(ImageIo, MatchingWindowsGiveNoNotice) {
+    write_pattern(file("a.exr"), "openexr", 7, 3, 3);
+    EXPECT_TRUE(load_image(file("a.exr")).notices.empty());
+}
+
 TEST_F(ImageIo, ReadsRadianceHdrWithinItsEightBitMantissa) {
     write_pattern(file("a.hdr"), "hdr", 5, 4, 3);
     const LoadedImage loaded = load_image(file("a.hdr"));

@@ -3,6 +3,7 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <climits>
 #include <fstream>
 #include <span>
@@ -64,8 +65,17 @@ std::unique_ptr<OIIO::ImageInput> open_image(const fs::path& path) {
     return in;
 }
 
-// The first subimage's top MIP level, as float RGB.
-RgbImage read_pixels(const fs::path& path, OIIO::ImageInput& in) {
+// A rectangle of pixels in OpenEXR's image coordinates.
+struct Window {
+    int64_t x = 0, y = 0, width = 0, height = 0;
+    std::string to_string() const {
+        return std::to_string(width) + "x" + std::to_string(height) + " at (" + std::to_string(x) + ", " +
+               std::to_string(y) + ")";
+    }
+};
+
+// The first subimage's data window (the pixels stored) at its top MIP level, as float RGB.
+RgbImage read_data_window(const fs::path& path, OIIO::ImageInput& in) {
     const OIIO::ImageSpec& spec = in.spec();
     RgbImage image{static_cast<uint32_t>(spec.width), static_cast<uint32_t>(spec.height), {}};
     image.pixels.resize(size_t{image.width} * image.height);
@@ -78,6 +88,37 @@ RgbImage read_pixels(const fs::path& path, OIIO::ImageInput& in) {
         fail(path, "truncated or corrupt: cannot read the pixels (" + (error.empty() ? "no detail" : error) + ")");
     if (channels == 1)
         for (Rgb& p : image.pixels) p.g = p.b = p.r;
+    return image;
+}
+
+// The image is the display window, as the OpenEXR specification defines it: its pixels
+// outside the data window are black, and data outside it (overscan) is cropped away.
+// Formats without windows have both the same, and keep the pixels as read.
+RgbImage read_pixels(const fs::path& path, OIIO::ImageInput& in, std::vector<std::string>& notices) {
+    const OIIO::ImageSpec& spec = in.spec();
+    const Window data{spec.x, spec.y, spec.width, spec.height};
+    const Window display{spec.full_x, spec.full_y, spec.full_width, spec.full_height};
+    if (display.width <= 0 || display.height <= 0 ||
+        (display.x == data.x && display.y == data.y && display.width == data.width && display.height == data.height))
+        return read_data_window(path, in);
+    if (static_cast<uint64_t>(display.width) * static_cast<uint64_t>(display.height) > kMaxPixels)
+        fail(path, "display window too large (" + display.to_string() + ")");
+    const RgbImage stored = read_data_window(path, in);
+    RgbImage image{static_cast<uint32_t>(display.width), static_cast<uint32_t>(display.height), {}};
+    image.pixels.resize(size_t{image.width} * image.height);
+    const int64_t x0 = std::max(data.x, display.x), x1 = std::min(data.x + data.width, display.x + display.width);
+    const int64_t y0 = std::max(data.y, display.y), y1 = std::min(data.y + data.height, display.y + display.height);
+    for (int64_t y = y0; y < y1 && x0 < x1; ++y)
+        std::copy_n(stored.pixels.begin() + ((y - data.y) * data.width + (x0 - data.x)), x1 - x0,
+                    image.pixels.begin() + ((y - display.y) * display.width + (x0 - display.x)));
+    const bool black_border = x0 > display.x || y0 > display.y || x1 < display.x + display.width ||
+                              y1 < display.y + display.height || x0 >= x1 || y0 >= y1;
+    const bool cropped = data.x < x0 || data.y < y0 || data.x + data.width > x1 || data.y + data.height > y1;
+    std::string notice = path.string() + ": data window " + data.to_string() + " differs from the display window " +
+                         display.to_string() + ": the map is the display window";
+    if (black_border) notice += ", black where it has no data";
+    if (cropped) notice += ", data outside it cropped";
+    notices.push_back(notice);
     return image;
 }
 
@@ -151,7 +192,7 @@ LoadedImage load_image(const fs::path& path, const LoadOptions& options) {
     loaded.working_colorspace = require_space(path, colour, options.working_space);
     loaded.format = in->format_name();
     loaded.channels = static_cast<uint32_t>(in->spec().nchannels);
-    loaded.image = read_pixels(path, *in);
+    loaded.image = read_pixels(path, *in, loaded.notices);
     colour.convert(loaded.image.pixels, loaded.input_colorspace, loaded.working_colorspace);
     loaded.luma = colour.luma(loaded.working_colorspace);
     loaded.content_hash = hash_file(path);

@@ -4,8 +4,10 @@
 
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
 
 #include "envmis/sampling/envmap.h"
+#include "errors.h"
 #include "maps.h"
 #include "stats.h"
 
@@ -146,6 +148,28 @@ TEST(EnvMap, EqualAreaMapsFollowTheirDensity) {
 }
 
 // The table writer streams the density a row at a time: the rows are density()'s.
+// Finite pixels whose power 4 pi Lbar overflows float would give Inf and NaN estimates:
+// the map is refused, saying how to scale it.
+TEST(EnvMap, AMapWhosePowerOverflowsFloatIsRefusedWithTheFactorToScaleItBy) {
+    test::expect_error<std::invalid_argument>(
+        [] {
+            EnvMap(test::constant_map(64, 32, {3e38f, 3e38f, 3e38f}));
+        },
+        {"luminance overflows", "scale the map down", "1e-3"});
+}
+
+// A sun of texels near float's maximum overflows the float lanes of a row's sum, but not
+// the map's power: its statistics stay exact and finite.
+TEST(EnvMap, ASunNearFloatsMaximumKeepsFiniteStatistics) {
+    RgbImage image = test::constant_map(256, 128, {1, 1, 1});
+    for (uint32_t x = 100; x < 164; ++x) image.pixels[64 * 256 + x] = {3e38f, 3e38f, 3e38f};
+    const EnvMap map(image, EnvMapOptions{});
+    const EnvMapStats& s = map.stats();
+    EXPECT_TRUE(std::isfinite(s.mean_luminance) && s.mean_luminance > 1e35) << s.mean_luminance;
+    EXPECT_EQ(s.fallback, DensityFallback::none);
+    EXPECT_GT(s.threshold, 0.0f);
+}
+
 TEST(EnvMap, DensityRowsAreTheDensity) {
     const EnvMap map(test::random_map(13, 7, 8), options(true));
     const std::vector<float> all = map.density();

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <vector>
 
 #include "envmis/math/hash.h"
@@ -354,6 +355,48 @@ TEST_F(TableTest, ImplausibleSizesAreRejectedBeforeAllocating) {
     std::memcpy(bytes.data() + 24, &big, sizeof big);  // metadata size
     write_bytes(path, bytes);
     expect_rejected(path, "too large");
+}
+
+// Offsets of the statistics in the metadata block (docs/table-format.md), from the file's start.
+constexpr size_t kReservedAt = 28, kMeanAt = kPreamble + 36, kThresholdAt = kPreamble + 44, kMaxAt = kPreamble + 48,
+                 kMinAt = kPreamble + 52, kZeroedAt = kPreamble + 56, kFallbackAt = kPreamble + 64,
+                 kNanCountAt = kPreamble + 68;
+
+// A crafted table passes its checksums: every statistic is checked for what a writer
+// could have made of the map, and a bad one is named.
+TEST_F(TableTest, ImpossibleStatisticsAreRejectedNamingTheField) {
+    const fs::path path = saved_table();
+    const std::vector<char> good = bytes_of(path);
+    ASSERT_NO_THROW(read_table(path));
+    const auto edited = [&](size_t offset, auto value, const std::string& problem) {
+        std::vector<char> bytes = good;
+        std::memcpy(bytes.data() + offset, &value, sizeof value);
+        reseal(bytes);
+        write_bytes(path, bytes);
+        SCOPED_TRACE(problem);
+        expect_rejected(path, problem);
+    };
+    const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+    edited(kMeanAt, nan, "invalid mean luminance");
+    edited(kMeanAt, inf, "invalid mean luminance");
+    edited(kMeanAt, -1.0, "invalid mean luminance");
+    edited(kMeanAt, 3e38, "invalid mean luminance");  // above the max luminance, and 4 pi of it overflows
+    edited(kThresholdAt, std::numeric_limits<float>::quiet_NaN(), "invalid threshold");
+    edited(kMaxAt, std::numeric_limits<float>::infinity(), "invalid max luminance");
+    edited(kMinAt, -1.0f, "invalid min luminance");
+    edited(kZeroedAt, uint64_t{96 * 48 + 1}, "invalid zeroed texel count");
+    edited(kNanCountAt, ~uint64_t{0}, "invalid NaN count");
+    edited(kFallbackAt, uint32_t{2}, "invalid fallback uniform");  // on a map that is not black
+    edited(kReservedAt, uint32_t{1}, "reserved field is 1");
+}
+
+// The statistics of a black map and of a constant one (fallbacks) are what the reader expects.
+TEST_F(TableTest, FallbackTablesPassTheStatisticsChecks) {
+    for (const Rgb c : {Rgb{0, 0, 0}, Rgb{0.5f, 0.5f, 0.5f}}) {
+        const EnvMap map(test::constant_map(16, 8, c));
+        write_table(dir_ / "fallback.envmis", map, source_);
+        EXPECT_EQ(read_table(dir_ / "fallback.envmis").map.stats().fallback, map.stats().fallback);
+    }
 }
 
 TEST_F(TableTest, WritingIsAtomic) {

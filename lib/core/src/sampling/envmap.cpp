@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -160,6 +161,27 @@ bool scan_row(const Rgb* pixels, uint32_t w, const LumaCoefficients& luma, uint3
     return !(dirty >> 31);
 }
 
+// A row's luminance sum in double from its texels' (clamped) luminance bits: for a row
+// whose float lanes overflowed (channels near float's maximum), where scan_row's sum is Inf.
+double exact_row_sum(const uint32_t* luminance, uint32_t w) noexcept {
+    double sum = 0;
+    for (uint32_t x = 0; x < w; ++x) sum += std::bit_cast<float>(luminance[x]);
+    return sum;
+}
+
+// Every estimate and pdf is a float scaled by the map's power 4 pi Lbar: a map whose
+// power is not a finite float gives Inf and NaN estimates, so it is refused, however
+// finite its pixels.
+void check_power(double mean_luminance) {
+    if (4 * kPi * mean_luminance <= std::numeric_limits<float>::max()) return;
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "luminance overflows: the map's power 4 pi Lbar (Lbar %.3g) is above float's maximum 3.4e38; scale "
+                  "the map down (e.g. multiply it by 1e-%d)",
+                  mean_luminance, 1 + static_cast<int>(std::ceil(std::log10(4 * kPi * mean_luminance / 3.4e38))));
+    throw std::invalid_argument(text);
+}
+
 // Pass 2: row y of the density q w_y (mapping.h: row_weight) from its luminance bits; returns the
 // number of texels with L > 0 that compensation zeroes.
 uint32_t fill_density_row(const uint32_t* luminance, uint32_t w, float weight, float threshold, bool uniform,
@@ -199,6 +221,7 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : options_(options)
                     for (uint32_t x = 0; x < w; ++x) sanitize_pixel(row[x], rows[y].bad);
                     scan_row(row, w, options_.luma, bits.data() + offset, rows[y]);
                 }
+                if (!std::isfinite(rows[y].sum)) rows[y].sum = exact_row_sum(bits.data() + offset, w);
             }
         });
         return bits;
@@ -210,6 +233,7 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : options_(options)
         stats_.bad_pixels += rows[y].bad;
     }
     stats_.mean_luminance = solid_angle_mean_of_rows(row_sums, w, options_.mapping);
+    check_power(stats_.mean_luminance);
 
     // A black map is sampled uniformly; a map that compensation zeroes whole (a constant
     // one) is rebuilt without compensation, from its luminance computed again.

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <bit>
 #include <cerrno>
+#include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <optional>
@@ -318,6 +320,54 @@ void check_payload_size(const Header& header, uint64_t left, const Cursor& in) {
     if (payload < left) in.fail(std::to_string(left - payload) + " bytes of trailing data after the payload");
 }
 
+// The statistics a writer can have made (EnvMap's constructor) for the header's size and
+// options: the renderer trusts them (Lbar, the threshold) and info prints them, so a
+// crafted value is refused here, naming its field.
+void check_stats(const Header& header, const Cursor& in) {
+    const EnvMapStats& s = header.stats;
+    const bool compensated = header.options.compensation.enabled;
+    const uint64_t texels = uint64_t{header.w} * header.h;
+    const auto field = [&](bool ok, const char* name, const std::string& value, const char* expected) {
+        if (!ok) in.fail(std::string("invalid ") + name + " " + value + " (expected " + expected + ")");
+    };
+    const auto number = [](double v) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%g", v);
+        return std::string(text);
+    };
+    const float alpha = header.options.compensation.alpha;
+    field(std::isfinite(alpha) && alpha >= 0, "alpha", number(alpha), "finite and >= 0");
+    // EnvMap refuses a map whose power 4 pi Lbar overflows float.
+    field(std::isfinite(s.mean_luminance) && s.mean_luminance >= 0 && 4 * kPi * s.mean_luminance <= FLT_MAX,
+          "mean luminance", number(s.mean_luminance), "finite, >= 0 and 4 pi times it at most 3.4e38");
+    field(std::isfinite(s.max_luminance) && s.max_luminance >= 0, "max luminance", number(s.max_luminance),
+          "finite and >= 0");
+    field(std::isfinite(s.min_positive_luminance) && s.min_positive_luminance >= 0 &&
+              s.min_positive_luminance <= s.max_luminance,
+          "min luminance", number(s.min_positive_luminance), "finite, >= 0 and at most the max luminance");
+    // A mean above the maximum (beyond rounding) or of a map without radiance is made up.
+    field(s.mean_luminance <= 1.001 * s.max_luminance && (s.max_luminance > 0) == (s.min_positive_luminance > 0),
+          "mean luminance", number(s.mean_luminance), "at most the max luminance, 0 for a black map");
+    // EnvMap falls back to uniform exactly when Lbar is 0, and to uncompensated only when compensating.
+    const std::string fallback(to_string(s.fallback));
+    field((s.fallback == DensityFallback::uniform) == (s.mean_luminance == 0), "fallback", fallback,
+          "uniform exactly when the map is black");
+    field(s.fallback != DensityFallback::uncompensated || compensated, "fallback", fallback,
+          "uncompensated only when compensation was requested");
+    field(std::isfinite(s.threshold) && s.threshold >= 0 &&
+              (s.threshold == 0 || (compensated && s.fallback == DensityFallback::none)),
+          "threshold", number(s.threshold), "finite, >= 0, and 0 unless compensated without a fallback");
+    field(s.zeroed_texels <= texels && (s.zeroed_texels == 0 || s.threshold > 0), "zeroed texel count",
+          std::to_string(s.zeroed_texels), "at most the texel count, 0 unless compensated");
+    const uint64_t channels = 3 * texels;
+    for (const auto& [count, name] :
+         {std::pair{s.bad_pixels.nan, "NaN count"}, std::pair{s.bad_pixels.infinite, "Inf count"},
+          std::pair{s.bad_pixels.negative, "negative count"}})
+        field(count <= channels, name, std::to_string(count), "at most 3 x the texel count");
+    field(s.bad_pixels.nan + s.bad_pixels.infinite + s.bad_pixels.negative <= channels, "bad pixel counts",
+          std::to_string(s.bad_pixels.total()), "at most 3 x the texel count in all");
+}
+
 // Parses and checks the header from `head`, the first bytes of a file of `file_size`
 // bytes (all of it, or at least the preamble, metadata and header checksum).
 Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::string_view name) {
@@ -340,7 +390,8 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
                                   : "header says " + std::to_string(total) + " bytes, file has " +
                                         std::to_string(file_size) + " (trailing data)");
     const auto metadata_size = in.take<uint32_t>("metadata size");
-    in.take<uint32_t>("reserved");
+    if (const auto reserved = in.take<uint32_t>("reserved"); reserved != 0)
+        in.fail("reserved field is " + std::to_string(reserved) + ", not 0");
     if (metadata_size > kMaxMetadataSize)
         in.fail("metadata block of " + std::to_string(metadata_size) + " bytes is too large");
     in.need(uint64_t{metadata_size} + 8, "metadata and header checksum");
@@ -400,6 +451,7 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
     if (fallback > static_cast<uint32_t>(DensityFallback::uniform))
         in.fail("unknown fallback " + std::to_string(fallback));
     stats.fallback = static_cast<DensityFallback>(fallback);
+    check_stats(out, in);
 
     out.payload_offset = in.position();
     check_payload_size(out, file_size - out.payload_offset, in);

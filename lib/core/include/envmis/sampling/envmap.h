@@ -183,7 +183,9 @@ public:
     EnvMap() = default;
     // Builds the sampler from a radiance image, repairing bad pixels (counted in
     // stats().bad_pixels). Throws std::invalid_argument for an empty image, a pixel count
-    // that does not match the size, more than 2^31 texels, or invalid options.
+    // that does not match the size, more than 2^31 texels, invalid options, or finite
+    // pixels whose power overflows float (4 pi Lbar above 3.4e38: "luminance overflows",
+    // with the factor to scale the map by), which would make every estimate Inf or NaN.
     explicit EnvMap(RgbImage image, const EnvMapOptions& options = {});
 
     // Rebuilds a saved sampler from its parts (the table reader's path): the image

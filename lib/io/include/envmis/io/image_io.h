@@ -5,7 +5,9 @@
 // or 4+ (RGBA...: alpha and extra channels ignored) channels. Pixels are converted with
 // OpenColorIO from the input colour space (the file's metadata, or the caller's choice)
 // to a linear working space (colour.h). Values are returned as read: NaN, Inf and
-// negative values are left for EnvMap to repair and count.
+// negative values are left for EnvMap to repair and count. The image is the display
+// window (OpenEXR): pixels outside the data window are black, data outside the display
+// window is cropped, and LoadedImage::notices says so. At most 2^30 pixels in either window.
 //
 // Writing: encoded in memory, then written through an AtomicFile (atomic_file.h): a
 // temporary file in the destination folder, every write checked, renamed when complete.
@@ -45,6 +47,11 @@ struct LoadedImage {
     uint64_t content_hash = 0;       // envmis::hash64 of the file's bytes
     std::string format;              // OpenImageIO's format name, e.g. "openexr", "hdr"
     uint32_t channels = 0;           // channels in the file
+    // What the caller should tell the user about how the file was read, one line each,
+    // starting with the file's name: an OpenEXR data window that differs from the
+    // display window (the map is the display window: black where there is no data, data
+    // outside it cropped).
+    std::vector<std::string> notices;
 };
 
 LoadedImage load_image(const std::filesystem::path& path, const LoadOptions& options = {});

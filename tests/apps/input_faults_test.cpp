@@ -1,0 +1,190 @@
+// Specification of the `envmis` command on inputs that are valid files but odd or
+// absurd: EXR windows, sizes beyond the documented limits or free memory, maps whose
+// power overflows float, and names with terminal escape sequences. Every test runs the
+// real binary (ENVMIS_CLI) in a temporary folder of its own.
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <regex>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli_run.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using envmis::test::quoted;
+using envmis::test::Result;
+
+// Float RGB pixels, row-major from the top, written as a 32-bit float EXR; with a data
+// window (x, y, w, h) inside a display window of `display_w` x `display_h` when given.
+struct Pixels {
+    int w = 0, h = 0;
+    std::vector<float> rgb;
+};
+
+Pixels constant(int w, int h, float value) { return {w, h, std::vector<float>(size_t(w) * h * 3, value)}; }
+
+void write_exr(const fs::path& path, const Pixels& p, int x = 0, int y = 0, int display_w = 0, int display_h = 0) {
+    OIIO::ImageSpec spec(p.w, p.h, 3, OIIO::TypeDesc::FLOAT);
+    spec.x = x;
+    spec.y = y;
+    if (display_w > 0) {
+        spec.full_x = spec.full_y = 0;
+        spec.full_width = display_w;
+        spec.full_height = display_h;
+    }
+    auto out = OIIO::ImageOutput::create("openexr");
+    if (!out || !out->open(path.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, p.rgb.data()) ||
+        !out->close())
+        throw std::runtime_error("test setup: cannot write " + path.string());
+}
+
+bool contains(const std::string& text, const std::string& pattern) {
+    return std::regex_search(text, std::regex(pattern, std::regex::icase | std::regex::ECMAScript));
+}
+
+// A refusal as the user must see it: non-zero exit, nothing on stdout, one line on
+// stderr that names `what` (the file or the flag) and matches `problem`.
+void expect_one_line_error(const Result& r, const std::string& what, const std::string& problem) {
+    EXPECT_NE(r.exit_code, 0) << r;
+    EXPECT_EQ(r.out, "") << r;
+    EXPECT_TRUE(!r.err.empty() && r.err.find('\n') == r.err.size() - 1) << "expected exactly one line on stderr" << r;
+    EXPECT_NE(r.err.find(what), std::string::npos) << "stderr does not name " << what << r;
+    EXPECT_TRUE(contains(r.err, problem)) << "stderr does not say /" << problem << "/" << r;
+}
+
+class InputFaults : public envmis::test::TempFolder {
+public:
+    InputFaults() : TempFolder("envmis_input_faults_") {}
+
+    Result envmis(const std::vector<std::string>& args) const {
+        return envmis::test::run_envmis(dir_, args, dir_ / "..stdout", dir_ / "..stderr");
+    }
+
+    // envmis with its address space limited to `mib` MiB, so that a run that tries to
+    // allocate too much fails at once instead of taking the machine's memory.
+    Result envmis_within(uint64_t mib, const std::vector<std::string>& args) const {
+        std::string command =
+            "cd " + quoted(dir_.string()) + " && ulimit -v " + std::to_string(mib * 1024) + " && " + quoted(ENVMIS_CLI);
+        for (const std::string& a : args) command += " " + quoted(a);
+        Result r = envmis::test::run_shell(command, dir_ / "..stdout", dir_ / "..stderr");
+        fs::remove(dir_ / "..stdout");
+        fs::remove(dir_ / "..stderr");
+        return r;
+    }
+};
+
+// ---------------------------------------------------------------------------------
+// EXR data and display windows.
+
+TEST_F(InputFaults, ACroppedExrIsReadAsItsDisplayWindowWithANoteNamingIt) {
+    write_exr(file("crop.exr"), constant(4, 2, 1.0f), 2, 1, 16, 8);
+    const Result r = envmis({"info", "crop.exr"});
+    ASSERT_EQ(r.exit_code, 0) << r;
+    EXPECT_TRUE(contains(r.out, R"(size +16 x 8\n)")) << r;
+    EXPECT_TRUE(contains(r.err, R"(^note: crop\.exr: data window 4x2 at \(2, 1\) differs from the display window)"))
+        << r;
+}
+
+TEST_F(InputFaults, AnOverscanExrIsCroppedToItsDisplayWindowWithANote) {
+    write_exr(file("overscan.exr"), constant(20, 10, 1.0f), -2, -1, 16, 8);
+    const Result r = envmis({"convert", "overscan.exr", "-o", "out.exr", "--to", "equirect", "--size", "16x8"});
+    ASSERT_EQ(r.exit_code, 0) << r;
+    EXPECT_TRUE(contains(r.out, R"(overscan\.exr \(16x8 equirect\))")) << r;
+    EXPECT_TRUE(contains(r.err, R"(^note: overscan\.exr: .*data outside it cropped)")) << r;
+}
+
+// ---------------------------------------------------------------------------------
+// Sizes: each checked against its documented limit and free memory before allocating.
+
+// The panels keep the map's aspect: a 1x65536 map once asked for 64x4194304-pixel panels.
+TEST_F(InputFaults, VisualizeRefusesAMapFarTallerThanWideNamingItAndTheLimit) {
+    write_exr(file("tall.exr"), constant(1, 65536, 1.0f));
+    const Result r = envmis_within(4096, {"visualize", "tall.exr", "-o", "tall.png"});
+    expect_one_line_error(r, "tall.exr", R"(1x65536 map is too tall to draw: at most 64 times taller than wide)");
+    EXPECT_FALSE(fs::exists(file("tall.png")));
+}
+
+TEST_F(InputFaults, ConvertRefusesAnOutputAboveTheTexelLimitNamingTheFlag) {
+    write_exr(file("map.exr"), constant(16, 8, 1.0f));
+    const Result r = envmis_within(4096, {"convert", "map.exr", "-o", "out.exr", "--size", "65536"});
+    expect_one_line_error(r, "--size 65536", R"(65536x65536 is 4294967296 texels, above the limit of 2147483648)");
+    EXPECT_FALSE(fs::exists(file("out.exr")));
+}
+
+// Memory is the address space ulimit leaves (or MemAvailable, whichever is smaller).
+TEST_F(InputFaults, ConvertRefusesAnOutputAboveFreeMemoryNamingTheFlag) {
+    write_exr(file("map.exr"), constant(16, 8, 1.0f));
+    const Result r = envmis_within(1024, {"convert", "map.exr", "-o", "out.exr", "--size", "20000"});
+    expect_one_line_error(r, "--size 20000", R"(needs 9156 MB of memory, more than the \d+ MB available)");
+    EXPECT_FALSE(fs::exists(file("out.exr")));
+}
+
+TEST_F(InputFaults, BenchRefusesASkyAboveTheTexelLimitNamingTheFlag) {
+    const Result r = envmis_within(4096, {"bench", "--size", "65536x65536"});
+    expect_one_line_error(r, "--size 65536x65536", "above the limit of 2147483648");
+}
+
+TEST_F(InputFaults, CompareUsesAtMostFourThreadsPerHardwareThreadWithANote) {
+    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    if (4 * cores >= 1024) GTEST_SKIP() << cores << " hardware threads: --threads 1024 is within the limit";
+    write_exr(file("map.exr"), constant(16, 8, 1.0f));
+    const Result r = envmis({"compare", "map.exr", "--points", "1", "--spp", "4", "--bsdf", "lambert", "--threads",
+                             "1024", "--json", "out.json"});
+    ASSERT_EQ(r.exit_code, 0) << r;
+    EXPECT_TRUE(contains(r.err, "note: --threads 1024: more than 4 per hardware thread \\(" + std::to_string(cores) +
+                                    "\\); using " + std::to_string(4 * cores) + "\n"))
+        << r;
+}
+
+// ---------------------------------------------------------------------------------
+// Overflow: finite pixels whose power does not fit a float.
+
+class OverflowingMap : public InputFaults, public testing::WithParamInterface<std::vector<std::string>> {};
+
+TEST_P(OverflowingMap, IsAnErrorNamingTheMapAndTheFix) {
+    write_exr(file("bright.exr"), constant(32, 16, 3e38f));
+    const Result r = envmis(GetParam());
+    expect_one_line_error(r, "bright.exr", R"(luminance overflows.*scale the map down \(e\.g\. multiply it by 1e-3\))");
+    EXPECT_FALSE(fs::exists(file("out")));
+}
+
+INSTANTIATE_TEST_SUITE_P(Commands, OverflowingMap,
+                         testing::Values(std::vector<std::string>{"precompute", "bright.exr", "-o", "out"},
+                                         std::vector<std::string>{"info", "bright.exr"},
+                                         std::vector<std::string>{"compare", "bright.exr", "--points", "2", "--spp",
+                                                                  "8", "--json", "out"}),
+                         [](const testing::TestParamInfo<std::vector<std::string>>& info) { return info.param[0]; });
+
+// A sun near float's maximum overflowed the sums of its row to Inf, though the map's
+// power fits: it must keep working, with finite statistics.
+TEST_F(InputFaults, ASunNearFloatsMaximumStillGivesFiniteStatistics) {
+    Pixels p = constant(128, 64, 1.0f);
+    for (int x = 40; x < 72; ++x)
+        for (int c = 0; c < 3; ++c) p.rgb[(32 * 128 + x) * 3 + c] = 3e38f;
+    write_exr(file("sun.exr"), p);
+    const Result r = envmis({"precompute", "sun.exr", "-o", "sun.envmis"});
+    ASSERT_EQ(r.exit_code, 0) << r;
+    EXPECT_TRUE(contains(r.out, "fallback +none")) << r;
+    EXPECT_FALSE(contains(r.out, R"(  (luminance|mean \(Lbar\)|compensation) .*(nan|inf))")) << r;
+}
+
+// ---------------------------------------------------------------------------------
+// Names read from files are printed with their control characters escaped.
+
+TEST_F(InputFaults, InfoEscapesControlCharactersInTheSourceName) {
+    const std::string name = "evil\x1b]0;owned\x07\x1b[2J.exr";
+    write_exr(file(name), constant(16, 8, 1.0f));
+    ASSERT_EQ(envmis({"precompute", name, "-o", "t.envmis"}).exit_code, 0);
+    const Result r = envmis({"info", "t.envmis"});
+    ASSERT_EQ(r.exit_code, 0) << r;
+    EXPECT_EQ(r.out.find('\x1b'), std::string::npos) << r;
+    EXPECT_EQ(r.out.find('\x07'), std::string::npos) << r;
+    EXPECT_NE(r.out.find(R"(source        evil\x1b]0;owned\x07\x1b[2J.exr (envmis table)"), std::string::npos) << r;
+}
+
+}  // namespace
