@@ -149,11 +149,15 @@ std::string printable(std::string_view text) {
 }
 
 namespace {
-// A "Key:   N kB" line of a /proc file, in bytes.
+// A "Key:   N kB" line of a /proc file, in bytes; empty where there is none.
 std::optional<uint64_t> proc_kib(const char* file, const std::string& key) {
     std::ifstream in(file);
     for (std::string line; std::getline(in, line);)
-        if (line.compare(0, key.size(), key) == 0) return std::stoull(line.substr(key.size())) * 1024;
+        if (line.compare(0, key.size(), key) == 0) {
+            std::istringstream fields(line.substr(key.size()));
+            uint64_t kib = 0;
+            if (fields >> kib) return kib * 1024;
+        }
     return std::nullopt;
 }
 }  // namespace
