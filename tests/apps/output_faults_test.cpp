@@ -3,6 +3,7 @@
 // are special files, and the temporaries that killed runs leave. Whatever fails, the
 // command says so in one line naming the file, exits non-zero, and leaves nothing at the
 // destination and no temporary file. Every test runs the real binary (ENVMIS_CLI).
+#include <OpenImageIO/imageio.h>
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/resource.h>
@@ -90,6 +91,18 @@ public:
         r.err = read_file(err);
         fs::remove(err);
         return r;
+    }
+
+    // A small map, map.exr (16 x 8), for the tests that let the command do all its work.
+    std::string small_map() const {
+        std::vector<float> rgb;
+        for (int i = 0; i < 16 * 8; ++i) rgb.insert(rgb.end(), {0.1f + i % 7, 0.2f + i % 5, 0.3f + i % 3});
+        const OIIO::ImageSpec spec(16, 8, 3, OIIO::TypeDesc::FLOAT);
+        auto out = OIIO::ImageOutput::create("openexr");
+        const std::string path = file("map.exr").string();
+        if (!out || !out->open(path, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, rgb.data()) || !out->close())
+            throw std::runtime_error("test setup: cannot write " + path);
+        return path;
     }
 
     // Every name below the test's folder (hidden ones included), relative to it.
@@ -196,8 +209,8 @@ struct Writer {
 };
 const Writer kWriters[] = {{"sample", "out.csv"}, {"precompute", "out.envmis"}, {"visualize", "out.png"}};
 
-std::vector<std::string> writer_args(const Writer& w, const std::string& output) {
-    return {w.subcommand, kStudio, "-o", output};
+std::vector<std::string> writer_args(const Writer& w, const std::string& output, const std::string& input = kStudio) {
+    return {w.subcommand, input, "-o", output};
 }
 
 TEST_F(OutputFaults, AFifoAsOutputIsRefusedAndStaysAFifo) {
@@ -252,9 +265,10 @@ TEST_F(OutputFaults, ARefusedOutputIsReportedBeforeAMissingInput) {
 }
 
 TEST_F(OutputFaults, RewritingAPrivateTableKeepsItPrivate) {
-    ASSERT_EQ(envmis({"precompute", kStudio, "-o", "t.envmis"}).exit_code, 0);
+    const std::string map = small_map();
+    ASSERT_EQ(envmis({"precompute", map, "-o", "t.envmis"}).exit_code, 0);
     fs::permissions(file("t.envmis"), fs::perms::owner_read | fs::perms::owner_write);
-    const Result r = envmis({"precompute", kStudio, "-o", "t.envmis"});
+    const Result r = envmis({"precompute", map, "-o", "t.envmis"});
     EXPECT_EQ(r.exit_code, 0) << r;
     EXPECT_EQ(fs::status(file("t.envmis")).permissions(), fs::perms::owner_read | fs::perms::owner_write);
 }
@@ -263,7 +277,7 @@ TEST_F(OutputFaults, RewritingAPrivateTableKeepsItPrivate) {
 // Killed runs: their temporaries are removed by the next write of the same output.
 
 TEST_F(OutputFaults, TheNextWriteOfAnOutputRemovesTheTemporariesOfKilledRunsAndSaysSo) {
-    const std::string dead = std::to_string(dead_pid()), live = std::to_string(::getpid());
+    const std::string dead = std::to_string(dead_pid()), live = std::to_string(::getpid()), map = small_map();
     for (const Writer& w : kWriters) {
         const fs::path out(w.output);
         const std::string hidden = "." + out.stem().string() + ".tmp";
@@ -274,9 +288,9 @@ TEST_F(OutputFaults, TheNextWriteOfAnOutputRemovesTheTemporariesOfKilledRunsAndS
         for (const std::string& name : {old_stale, stale, live_one}) write_text(file(name), "partial");
         fs::last_write_time(file(old_stale), fs::file_time_type::clock::now() - std::chrono::hours(1));
 
-        const Result r = envmis(writer_args(w, w.output));
+        const Result r = envmis(writer_args(w, w.output, map));
         EXPECT_EQ(r.exit_code, 0) << r;
-        EXPECT_EQ(listing(), (std::set<std::string>{live_one, w.output})) << r;
+        EXPECT_EQ(listing(), (std::set<std::string>{"map.exr", live_one, w.output})) << r;
         for (const std::string& name : {old_stale, stale})
             EXPECT_TRUE(contains(r.err, "removed .*" + std::regex_replace(name, std::regex(R"(\.)"), R"(\.)")))
                 << name << r;

@@ -9,6 +9,7 @@
 #include <array>
 #include <cerrno>
 #include <charconv>
+#include <chrono>
 #include <cstring>
 #include <ios>
 #include <random>
@@ -22,9 +23,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// When this process started, near enough: before main. A temporary without a process id
-// last modified before it cannot be this run's.
-const fs::file_time_type kProcessStart = fs::file_time_type::clock::now();
+// A temporary without a process id last modified before this process started cannot be
+// this run's. Taken before main, less a second: file times come from a coarser clock
+// (a file made just after this instant can be stamped a few milliseconds before it).
+const fs::file_time_type kBeforeThisRun = fs::file_time_type::clock::now() - std::chrono::seconds(1);
 
 [[noreturn]] void fail(const fs::path& destination, const std::string& problem) {
     throw std::runtime_error(destination.string() + ": " + problem);
@@ -70,7 +72,7 @@ bool stale(const fs::directory_entry& entry, std::string_view id) {
     if (dash == std::string_view::npos) {
         std::error_code ec;
         const auto modified = entry.last_write_time(ec);
-        return all_digits(id) && !ec && modified < kProcessStart;
+        return all_digits(id) && !ec && modified < kBeforeThisRun;
     }
     const std::string_view pid_text = id.substr(0, dash);
     int pid = 0;

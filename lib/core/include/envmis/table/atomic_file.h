@@ -37,10 +37,11 @@ void check_destination(const std::filesystem::path& destination);
 
 // Removes the stale temporaries of `destination` (names of either pattern above, for this
 // destination only): those whose process id names no running process, and those without
-// one last modified before this process started. A running process's temporary and every
-// other file are left alone; a process id reused since the kill keeps its stale file until
-// that process ends. Returns the paths removed; a file that cannot be removed is skipped.
-// Never throws.
+// one last modified over a second before this process started. A running process's
+// temporary and every other file are left alone; a process id reused since the kill keeps
+// its stale file until that process ends. Process ids are this machine's: on a folder
+// shared between machines, another machine's live writer can look dead. Returns the
+// paths removed; a file that cannot be removed is skipped. Never throws.
 std::vector<std::filesystem::path> remove_stale_temporaries(const std::filesystem::path& destination) noexcept;
 
 class AtomicFile {
