@@ -26,9 +26,17 @@ int main(int argc, char** argv) {
     try {
         for (const Subcommand& s : subcommands)
             if (s.app->parsed()) s.run();
+    } catch (const envmis::Interrupted& e) {
+        return exit_interrupted(e.what());
     } catch (const std::exception& e) {
+        // A failure caused by the interruption (a library's read stopped half-way) is the
+        // interruption's.
+        if (interrupted()) return exit_interrupted("");
         std::cerr << "envmis: " << e.what() << "\n";
         return 1;
     }
+    // A signal during the last of the work, after its last check, still says so: the
+    // outputs are complete, but the exit status must not tell a script the run was whole.
+    if (interrupted()) return exit_interrupted("");
     return 0;
 }

@@ -65,14 +65,20 @@ std::unique_ptr<OIIO::ImageInput> open_image(const fs::path& path) {
     return in;
 }
 
+// OpenImageIO's progress callback: true stops the read.
+bool stop_reading(void* stop, float) { return stop_requested(static_cast<StopFlag>(stop)); }
+
 // The first subimage's top MIP level, as float RGB.
-RgbImage read_pixels(const fs::path& path, OIIO::ImageInput& in) {
+RgbImage read_pixels(const fs::path& path, OIIO::ImageInput& in, StopFlag stop) {
     const OIIO::ImageSpec& spec = in.spec();
     RgbImage image{static_cast<uint32_t>(spec.width), static_cast<uint32_t>(spec.height), {}};
     image.pixels.resize(size_t{image.width} * image.height);
     // Grey files (alpha, if any, ignored) are read into R and copied to G and B.
     const int channels = spec.nchannels >= 3 ? 3 : 1;
-    const bool ok = in.read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, image.pixels.data(), sizeof(Rgb));
+    const bool ok =
+        in.read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, image.pixels.data(), sizeof(Rgb), OIIO::AutoStride,
+                      OIIO::AutoStride, stop ? stop_reading : nullptr, const_cast<std::atomic<bool>*>(stop));
+    throw_if_stopped(stop);
     // Either signal means the pixels are incomplete; the PNM reader fails on a short file
     // without a message.
     if (std::string error = in.geterror(); !ok || !error.empty())
@@ -82,12 +88,13 @@ RgbImage read_pixels(const fs::path& path, OIIO::ImageInput& in) {
     return image;
 }
 
-uint64_t hash_file(const fs::path& path) {
+uint64_t hash_file(const fs::path& path, StopFlag stop) {
     std::ifstream in(path, std::ios::binary);
     if (!in) fail(path, "cannot open to hash");
     Hasher hasher;
     std::vector<char> chunk(size_t{1} << 20);
     do {
+        throw_if_stopped(stop);
         in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
         hasher.update(std::as_bytes(std::span(chunk.data(), static_cast<size_t>(in.gcount()))));
     } while (in);
@@ -137,10 +144,10 @@ LoadedImage load_image(const fs::path& path, const LoadOptions& options) {
     loaded.working_colorspace = require_space(path, colour, options.working_space);
     loaded.format = in->format_name();
     loaded.channels = static_cast<uint32_t>(in->spec().nchannels);
-    loaded.image = read_pixels(path, *in);
+    loaded.image = read_pixels(path, *in, options.stop);
     colour.convert(loaded.image.pixels, loaded.input_colorspace, loaded.working_colorspace);
     loaded.luma = colour.luma(loaded.working_colorspace);
-    loaded.content_hash = hash_file(path);
+    loaded.content_hash = hash_file(path, options.stop);
     return loaded;
 }
 
