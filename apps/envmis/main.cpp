@@ -8,6 +8,8 @@
 
 int main(int argc, char** argv) {
     using namespace envmis::cli;
+    // First of all: a signal from here on is seen by the command's first check.
+    install_interrupt_handler();
     CLI::App app{"envmis: importance sampling of HDR environment maps, with and without MIS compensation"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "envmis 0.1.0");
@@ -22,7 +24,6 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
     }
-    install_interrupt_handler();
     try {
         for (const Subcommand& s : subcommands)
             if (s.app->parsed()) s.run();
