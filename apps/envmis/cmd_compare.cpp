@@ -560,8 +560,10 @@ Subcommand add_compare(CLI::App& app) {
     return {sub, [args] {
                 const Setup setup = prepare(*args);
                 const Outcome outcome = run_compare(*args, setup);
-                if (!interrupted()) return write_compare(*args, setup, outcome);
-                write_partial(*args, setup, outcome);
+                if (interrupted())
+                    write_partial(*args, setup, outcome);
+                else
+                    write_compare(*args, setup, outcome);
             }};
 }
 
