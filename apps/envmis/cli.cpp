@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -107,7 +108,11 @@ CLI::Validator bins_validator() {
 namespace {
 // A signal handler can reach only static storage.
 std::atomic<bool> g_interrupted{false};
-extern "C" void on_signal(int) { g_interrupted = true; }
+std::atomic<int> g_signal{0};
+extern "C" void on_signal(int signal) {
+    g_signal = signal;
+    g_interrupted = true;
+}
 }  // namespace
 
 void install_interrupt_handler() {
@@ -121,8 +126,17 @@ void install_interrupt_handler() {
 
 const std::atomic<bool>& interrupted() { return g_interrupted; }
 
+int interrupting_signal() { return g_signal; }
+
 void throw_if_interrupted() {
-    if (g_interrupted) throw std::runtime_error("interrupted");
+    if (g_interrupted) throw Interrupted();
+}
+
+int exit_interrupted(const std::string& detail) {
+    const int signal = interrupting_signal();
+    std::cerr << "envmis: interrupted by " << (signal == SIGTERM ? "SIGTERM" : "SIGINT")
+              << (detail.empty() || detail == Interrupted().what() ? "" : ": " + detail) << "\n";
+    return 128 + (signal ? signal : SIGINT);
 }
 
 std::string printable(std::string_view text) {
@@ -220,7 +234,7 @@ LoadedMap load_map(const std::string& path, const MapFlags& flags) {
         loaded.load_ms = milliseconds_since(start);
         return loaded;
     }
-    io::LoadedImage image = io::load_image(path, {flags.colorspace, flags.working_space});
+    io::LoadedImage image = io::load_image(path, {flags.colorspace, flags.working_space, &interrupted()});
     for (const std::string& notice : image.notices) std::cerr << "note: " << notice << "\n";
     LoadedMap loaded;
     loaded.load_ms = milliseconds_since(start);
@@ -242,7 +256,7 @@ LoadedMap load_map(const std::string& path, const MapFlags& flags) {
             options.compensation.alpha = loaded.alpha_choice->alpha;
         }
         const auto build_start = std::chrono::steady_clock::now();
-        loaded.map = EnvMap(std::move(image.image), options);
+        loaded.map = EnvMap(std::move(image.image), options, &interrupted());
         loaded.build_ms = milliseconds_since(build_start);
     } catch (const std::invalid_argument& e) {
         throw std::runtime_error(path + ": " + e.what());
@@ -355,19 +369,31 @@ void print_summary(std::ostream& out, const LoadedMap& loaded, const EnvMap& m) 
     if (loaded.bins) print_bins(out, *loaded.bins);
 }
 
+namespace {
+bool progress_lines() {
+    const char* value = std::getenv("ENVMIS_PROGRESS");
+    return value && std::string_view(value) == "1";
+}
+}  // namespace
+
 Progress::Progress(std::string label, uint64_t total)
-    : label_(std::move(label)), total_(total), enabled_(total > 0 && ::isatty(STDERR_FILENO)) {}
+    : label_(std::move(label)),
+      total_(total),
+      terminal_(total > 0 && ::isatty(STDERR_FILENO)),
+      lines_(total > 0 && !terminal_ && progress_lines()) {
+    update(0);
+}
 
 Progress::~Progress() {
-    if (enabled_ && shown_ >= 0) std::fprintf(stderr, "\r%*s\r", static_cast<int>(label_.size()) + 6, "");
+    if (terminal_ && shown_ >= 0) std::fprintf(stderr, "\r%*s\r", static_cast<int>(label_.size()) + 6, "");
 }
 
 void Progress::update(uint64_t done) {
-    if (!enabled_) return;
-    const int percent = static_cast<int>(100 * done / total_);
+    if (!terminal_ && !lines_) return;
+    const int percent = static_cast<int>(100 * std::min(done, total_) / total_);
     if (percent == shown_) return;
     shown_ = percent;
-    std::fprintf(stderr, "\r%s %3d%%", label_.c_str(), percent);
+    std::fprintf(stderr, terminal_ ? "\r%s %3d%%" : "%s %3d%%\n", label_.c_str(), percent);
     std::fflush(stderr);
 }
 

@@ -20,6 +20,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "envmis/interrupt.h"
 #include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"
 #include "envmis/study/comparison/alpha.h"
@@ -114,7 +115,8 @@ struct LoadedMap {
 
 // Reads a table (recognised by its magic) or loads an image and builds its map; the
 // loader's notices go to stderr, each a line "note: FILE: ...". An image whose map
-// cannot be built (its power overflows float, say) is an error naming the file.
+// cannot be built (its power overflows float, say) is an error naming the file; an
+// interruption (above) stops the load and the build.
 LoadedMap load_map(const std::string& path, const MapFlags& flags);
 
 // The summary that precompute and info print, of `loaded`'s map or of `map` (precompute
@@ -132,15 +134,26 @@ double milliseconds_since(std::chrono::steady_clock::time_point start);
 // memory and of mapped files' pages; empty where the system does not say (not Linux).
 std::string resident_memory();
 
-// Ctrl-C (SIGINT) and SIGTERM set a flag that long loops check, so that they stop
-// cleanly: `compare` reports what is done, writers throw and remove their temporary
-// files. A second signal ends the process at once.
+// Ctrl-C (SIGINT) and SIGTERM set a flag that every long loop checks (the core's builds
+// through their StopFlag, interrupt.h), so that the command stops within about a second:
+// the work under way throws Interrupted, whose unwinding removes the temporary files,
+// and main exits 128 + the signal's number (130, 143) with "envmis: interrupted by
+// SIGINT". A second signal ends the process at once (the default action), for a loop
+// that does not check; its temporary files are then left behind.
 void install_interrupt_handler();
 const std::atomic<bool>& interrupted();
-// Throws std::runtime_error("interrupted") once a signal has arrived.
+// The signal that set the flag (SIGINT or SIGTERM), 0 before one arrived.
+int interrupting_signal();
+// Throws envmis::Interrupted once a signal has arrived.
 void throw_if_interrupted();
+// What main prints and returns once a signal has arrived, `detail` (Interrupted's
+// message, unless it is the plain "interrupted") after the signal's name.
+int exit_interrupted(const std::string& detail);
 
-// Progress on stderr, only when stderr is a terminal: "label  42%".
+// Progress on stderr: "label  42%", redrawn in place when stderr is a terminal; where it
+// is not, one line each time the percentage changes if the environment variable
+// ENVMIS_PROGRESS is 1 (for logs, and for tests that act at a known point of the work),
+// else nothing. A bar is shown from its construction ("label   0%").
 class Progress {
 public:
     Progress(std::string label, uint64_t total);
@@ -151,7 +164,7 @@ private:
     std::string label_;
     uint64_t total_;
     int shown_ = -1;
-    bool enabled_;
+    bool terminal_, lines_;
 };
 
 // An output file given on the command line, before any work: refuses one that exists and

@@ -105,6 +105,7 @@ std::pair<std::unique_ptr<Sampler>, double> build_repeatedly(const Source& sourc
     std::vector<double> builds;
     std::unique_ptr<Sampler> sampler;
     for (int r = 0; r < repeats; ++r) {
+        throw_if_interrupted();
         Source copy = source;
         const auto start = std::chrono::steady_clock::now();
         sampler = std::make_unique<Sampler>(build(copy));
@@ -236,6 +237,7 @@ CallTimes time_calls(const EnvMap& guided, const reference::TextbookEnvMap& text
     BatchInputs batch(points.us, points.directions);
     CallTimes c;
     for (int r = 0; r < repeats; ++r) {
+        throw_if_interrupted();
         const double t[6] = {sample_cost(view),  sample_cost(textbook),   pdf_cost(view),
                              pdf_cost(textbook), batch.sample_cost(view), batch.lookup_cost(view)};
         for (int k = 0; k < 6; ++k) c.times[k].push_back(t[k]);
@@ -297,6 +299,7 @@ void time_binned_calls(const EnvMapView (&today)[2], const BinnedEnvMapView& bin
     BatchInputs batch(points.us, points.directions, points.normals);
     std::vector<double> ns[3][4], ratio[2][4];
     for (int r = 0; r < repeats; ++r) {
+        throw_if_interrupted();
         double t[3][4];
         for (int k = 0; k < 2; ++k) {
             t[k][0] = ns_per_call(samples, [&](const auto& in) { return sum(today[k].sample(in.first)); });

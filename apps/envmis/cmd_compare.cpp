@@ -234,7 +234,7 @@ std::shared_ptr<const BinnedEnvMap> build_bins(const CompareArgs& args, const En
     options.bins_per_side = g;
     options.auto_alpha = bins_auto_alpha(args);
     options.alpha = args.map.alpha;
-    return std::make_shared<const BinnedEnvMap>(EnvMap(plain), options);
+    return std::make_shared<const BinnedEnvMap>(EnvMap(plain), options, &interrupted());
 }
 
 Setup prepare(const CompareArgs& args) {
@@ -543,6 +543,24 @@ void write_compare(const CompareArgs& args, const Setup& s, const Outcome& outco
     if (!args.images.empty()) write_pictures(args, s);
 }
 
+// A run stopped early prints the tables of what is done (each says it is partial) and
+// writes no file: a reader of the JSON, CSV or pictures could not tell them from a
+// whole run's. Then it throws Interrupted, saying so.
+void write_partial(const CompareArgs& args, const Setup& s, const Outcome& outcome) {
+    CompareArgs printed = args;
+    printed.json.clear();
+    printed.csv.clear();
+    printed.plots.clear();
+    printed.images.clear();
+    write_compare(printed, s, outcome);
+    const bool outputs = !(args.json.empty() && args.csv.empty() && args.plots.empty() && args.images.empty());
+    std::string detail = "the results above are partial";
+    if (outcome.comparison)
+        detail = "the results above cover " + std::to_string(outcome.comparison->points_done) + " of " +
+                 std::to_string(s.points.size()) + " points";
+    throw Interrupted(detail + (outputs ? "; no file written" : ""));
+}
+
 }  // namespace
 
 Subcommand add_compare(CLI::App& app) {
@@ -556,7 +574,11 @@ Subcommand add_compare(CLI::App& app) {
     args->alpha_flag = sub->get_option("--alpha");
     return {sub, [args] {
                 const Setup setup = prepare(*args);
-                write_compare(*args, setup, run_compare(*args, setup));
+                const Outcome outcome = run_compare(*args, setup);
+                if (interrupted())
+                    write_partial(*args, setup, outcome);
+                else
+                    write_compare(*args, setup, outcome);
             }};
 }
 

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "cli.h"
 #include "envmis/image/remap.h"
@@ -81,11 +82,14 @@ void run_convert(const ConvertArgs& args) {
     const Mapping from = parse_mapping(args.from), to = parse_mapping(args.to);
     Size size = requested_size(args.size, to);
     if (size.width != 0) check_image_size("--size " + args.size, size, kBytesPerTexel);
-    const io::LoadedImage image = io::load_image(args.input, {args.colorspace, args.working_space});
+    const io::LoadedImage image = io::load_image(args.input, {args.colorspace, args.working_space, &interrupted()});
     for (const std::string& notice : image.notices) std::cerr << "note: " << notice << "\n";
     if (size.width == 0) size = default_size(image.image, to);
     const auto start = std::chrono::steady_clock::now();
-    const RemapResult result = remap(image.image, from, to, size.width, size.height, args.supersampling);
+    std::optional<Progress> progress(std::in_place, "remapping", 1);
+    const RemapResult result =
+        remap(image.image, from, to, size.width, size.height, args.supersampling, &interrupted());
+    progress.reset();
     const double ms = milliseconds_since(start);
     io::write_exr(args.output, result.image);
     print_conversion(args, image, result, ms);

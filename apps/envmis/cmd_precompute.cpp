@@ -6,6 +6,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "cli.h"
 
@@ -22,7 +23,7 @@ void print_compact_error(std::ostream& out, const EnvMap& map) {
         const double l = luminance(map.radiance().pixels[i], map.options().luma);
         if (l > 0) worst = std::max(worst, std::abs(luminance(rounded.pixels[i], map.options().luma) - l) / l);
     }
-    const std::vector<float> p = map.density(), q = EnvMap(rounded, map.options()).density();
+    const std::vector<float> p = map.density(), q = EnvMap(rounded, map.options(), &interrupted()).density();
     double sum_p = 0, sum_q = 0, distance = 0;
     for (size_t i = 0; i < p.size(); ++i) sum_p += p[i], sum_q += q[i];
     for (size_t i = 0; i < p.size(); ++i) distance += std::abs(p[i] / sum_p - q[i] / sum_q);
@@ -89,11 +90,14 @@ void run_precompute_binned(const PrecomputeArgs& args) {
     LoadedMap loaded = load_map(args.input, plain);
     if (loaded.from_table) throw std::runtime_error(args.input + ": is already a table; give an image");
     const auto build_start = std::chrono::steady_clock::now();
-    const BinnedEnvMap binned(std::move(loaded.map), binned_options(args));
+    std::optional<Progress> progress(std::in_place, "building bins", 1);
+    const BinnedEnvMap binned(std::move(loaded.map), binned_options(args), &interrupted());
+    progress.reset();
     const double bins_ms = milliseconds_since(build_start);
     loaded.bins = binned.layout();
     const auto start = std::chrono::steady_clock::now();
-    write_table(args.output, binned, loaded.source, args.compact ? TableEncoding::compact : TableEncoding::full);
+    write_table(args.output, binned, loaded.source, args.compact ? TableEncoding::compact : TableEncoding::full,
+                &interrupted());
     print_precompute(args, loaded, binned.plain(), &binned, bins_ms, milliseconds_since(start));
 }
 
@@ -103,7 +107,8 @@ void run_precompute(const PrecomputeArgs& args) {
     const LoadedMap loaded = load_map(args.input, args.map);
     if (loaded.from_table) throw std::runtime_error(args.input + ": is already a table; give an image");
     const auto start = std::chrono::steady_clock::now();
-    write_table(args.output, loaded.map, loaded.source, args.compact ? TableEncoding::compact : TableEncoding::full);
+    write_table(args.output, loaded.map, loaded.source, args.compact ? TableEncoding::compact : TableEncoding::full,
+                &interrupted());
     print_precompute(args, loaded, loaded.map, nullptr, 0, milliseconds_since(start));
 }
 

@@ -25,8 +25,10 @@ namespace {
 template <class Density>
 std::vector<float> pdf_image(const Density& density, uint32_t w, uint32_t h) {
     std::vector<float> pdf(size_t{w} * h);
-    for (uint32_t y = 0; y < h; ++y)
+    for (uint32_t y = 0; y < h; ++y) {
+        throw_if_interrupted();
         for (uint32_t x = 0; x < w; ++x) pdf[size_t{y} * w + x] = density.pdf_uv({(x + 0.5f) / w, (y + 0.5f) / h});
+    }
     return pdf;
 }
 std::vector<float> pdf_image(const EnvMap& map) { return pdf_image(map, map.width(), map.height()); }
@@ -113,8 +115,10 @@ std::optional<BinPanel> bin_panel(const VisualizeArgs& args, const LoadedMap& lo
     const Vec3 n = *parse_normal(args.normal);  // the flag's validator has accepted it
     const Bsdf bsdf = Bsdf::parse(args.lobe);
     BinPanel p;
+    std::optional<Progress> progress(std::in_place, "building bins", 1);
     p.binned = loaded.bins ? std::make_unique<BinnedEnvMap>(EnvMap(plain), *loaded.bins)
-                           : std::make_unique<BinnedEnvMap>(EnvMap(plain), options);
+                           : std::make_unique<BinnedEnvMap>(EnvMap(plain), options, &interrupted());
+    progress.reset();
     p.normal = n;
     p.lobe = p.binned->lobe_class(bsdf.phong_exponent());
     const uint32_t lobe = p.lobe;
@@ -141,7 +145,7 @@ struct Densities {
 EnvMap opposite_density(const EnvMap& map) {
     EnvMapOptions options = map.options();
     options.compensation.enabled = !options.compensation.enabled;
-    return EnvMap(to_image(map.radiance()), options);
+    return EnvMap(to_image(map.radiance()), options, &interrupted());
 }
 
 // The picture and what the command says about it.

@@ -10,6 +10,11 @@
 
 int main(int argc, char** argv) {
     using namespace envmis::cli;
+    // First of all: a signal from here on is seen by the command's first check.
+    install_interrupt_handler();
+    // Past RLIMIT_FSIZE a write fails with EFBIG, which the writers report and clean up
+    // after, instead of the signal killing the process and leaving its temporary file.
+    std::signal(SIGXFSZ, SIG_IGN);
     CLI::App app{"envmis: importance sampling of HDR environment maps, with and without MIS compensation"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "envmis 0.1.0");
@@ -24,22 +29,26 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
     }
-    install_interrupt_handler();
-    // Past RLIMIT_FSIZE a write fails with EFBIG, which the writers report and clean up
-    // after, instead of the signal killing the process and leaving its temporary file.
-    std::signal(SIGXFSZ, SIG_IGN);
     try {
         StandardOutput standard_output;
         for (const Subcommand& s : subcommands)
             if (s.app->parsed()) s.run();
         standard_output.finish();
+    } catch (const envmis::Interrupted& e) {
+        return exit_interrupted(e.what());
     } catch (const std::bad_alloc&) {
         // The last resort: sizes are checked against free memory before large allocations.
         std::cerr << "envmis: out of memory (try a smaller size, or free memory)\n";
         return 1;
     } catch (const std::exception& e) {
+        // A failure caused by the interruption (a library's read stopped half-way) is the
+        // interruption's.
+        if (interrupted()) return exit_interrupted("");
         std::cerr << "envmis: " << e.what() << "\n";
         return 1;
     }
+    // A signal during the last of the work, after its last check, still says so: the
+    // outputs are complete, but the exit status must not tell a script the run was whole.
+    if (interrupted()) return exit_interrupted("");
     return 0;
 }

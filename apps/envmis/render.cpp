@@ -34,12 +34,13 @@ struct Scene {
 
 // Renders one technique: each pixel the mean of `spp` estimates, rows shared among threads.
 RgbImage render(const Scene& scene, const DirectLightingEstimator& estimator, const std::vector<Bsdf>& bsdfs,
-                uint32_t spp, uint64_t seed, uint32_t threads, const std::atomic<bool>* stop) {
+                uint32_t spp, uint64_t seed, uint32_t threads, StopFlag stop) {
     RgbImage image{scene.w, scene.h, std::vector<Rgb>(size_t{scene.w} * scene.h)};
     std::atomic<uint32_t> next_row{0};
     auto work = [&] {
-        for (uint32_t y; (y = next_row.fetch_add(1)) < scene.h && !(stop && stop->load());)
+        for (uint32_t y; (y = next_row.fetch_add(1)) < scene.h;)
             for (uint32_t x = 0; x < scene.w; ++x) {
+                if (stop_requested(stop)) return;
                 ShadingPoint p;
                 uint32_t sphere = 0;
                 if (scene.point(x, y, p, sphere))
@@ -47,9 +48,12 @@ RgbImage render(const Scene& scene, const DirectLightingEstimator& estimator, co
                         average_estimate(estimator, p, bsdfs[sphere], spp, seed, uint64_t{y} * scene.w + x);
             }
     };
-    std::vector<std::jthread> pool;
-    for (uint32_t i = 1; i < threads; ++i) pool.emplace_back(work);
-    work();
+    {
+        std::vector<std::jthread> pool;
+        for (uint32_t i = 1; i < threads; ++i) pool.emplace_back(work);
+        work();
+    }
+    throw_if_stopped(stop);  // a picture is written whole or not at all
     return image;
 }
 

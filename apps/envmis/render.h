@@ -24,8 +24,9 @@ struct RenderOptions {
 // Renders every technique of inputs.options, every sphere sampling the first map of
 // inputs.compensated (inputs.points are not used: the pixels are the points), and writes
 // reference.{exr,png}, <technique>.{exr,png}, <technique>-relmse.png and montage.png into
-// `folder` (created if missing). Stops at control.stop (the pictures then hold the rows
-// done). Returns the montage's path. Cost: pixels x (spp x techniques + reference_spp)
+// `folder` (created if missing). At control.stop (checked every pixel) it throws
+// Interrupted: the pictures written by then are whole, the one under way and the
+// montage are not written. Returns the montage's path. Cost: pixels x (spp x techniques + reference_spp)
 // estimates.
 std::filesystem::path render_comparison(const StudyInputs& inputs, const RenderOptions& render,
                                         const std::filesystem::path& folder, const std::string& map_name,

@@ -74,14 +74,41 @@ struct Window {
     }
 };
 
+// OpenImageIO's progress callback: true stops the read.
+bool stop_reading(void* stop, float) { return stop_requested(static_cast<StopFlag>(stop)); }
+
+// Rows read at a time when the read may be stopped: OpenImageIO calls its progress
+// callback only every few hundred megabytes (after 1.4 s, then at 69% and 100% of a
+// 4096x2048 EXR), so scanline files are read a block at a time and the flag checked
+// between blocks. Tiled files are read whole, stopped through the callback.
+constexpr int kRowsPerRead = 256;
+
+// The pixels of `in` into `pixels` (RGB, or grey into R): OpenImageIO's verdict, false
+// also when stopped.
+bool read_rows(OIIO::ImageInput& in, int channels, Rgb* pixels, StopFlag stop) {
+    const OIIO::ImageSpec& spec = in.spec();
+    if (!stop || spec.tile_width > 0)
+        return in.read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels, sizeof(Rgb), OIIO::AutoStride,
+                             OIIO::AutoStride, stop ? stop_reading : nullptr, const_cast<std::atomic<bool>*>(stop));
+    for (int y = 0; y < spec.height; y += kRowsPerRead) {
+        const int rows = std::min(kRowsPerRead, spec.height - y);
+        if (stop_requested(stop) ||
+            !in.read_scanlines(0, 0, spec.y + y, spec.y + y + rows, spec.z, 0, channels, OIIO::TypeDesc::FLOAT,
+                               pixels + size_t(y) * spec.width, sizeof(Rgb)))
+            return false;
+    }
+    return true;
+}
+
 // The first subimage's data window (the pixels stored) at its top MIP level, as float RGB.
-RgbImage read_data_window(const fs::path& path, OIIO::ImageInput& in) {
+RgbImage read_data_window(const fs::path& path, OIIO::ImageInput& in, StopFlag stop) {
     const OIIO::ImageSpec& spec = in.spec();
     RgbImage image{static_cast<uint32_t>(spec.width), static_cast<uint32_t>(spec.height), {}};
     image.pixels.resize(size_t{image.width} * image.height);
     // Grey files (alpha, if any, ignored) are read into R and copied to G and B.
     const int channels = spec.nchannels >= 3 ? 3 : 1;
-    const bool ok = in.read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, image.pixels.data(), sizeof(Rgb));
+    const bool ok = read_rows(in, channels, image.pixels.data(), stop);
+    throw_if_stopped(stop);
     // Either signal means the pixels are incomplete; the PNM reader fails on a short file
     // without a message.
     if (std::string error = in.geterror(); !ok || !error.empty())
@@ -94,16 +121,17 @@ RgbImage read_data_window(const fs::path& path, OIIO::ImageInput& in) {
 // The image is the display window, as the OpenEXR specification defines it: its pixels
 // outside the data window are black, and data outside it (overscan) is cropped away.
 // Formats without windows have both the same, and keep the pixels as read.
-RgbImage read_pixels(const fs::path& path, OIIO::ImageInput& in, std::vector<std::string>& notices) {
+RgbImage read_pixels(const fs::path& path, OIIO::ImageInput& in, std::vector<std::string>& notices,
+                     StopFlag stop) {
     const OIIO::ImageSpec& spec = in.spec();
     const Window data{spec.x, spec.y, spec.width, spec.height};
     const Window display{spec.full_x, spec.full_y, spec.full_width, spec.full_height};
     if (display.width <= 0 || display.height <= 0 ||
         (display.x == data.x && display.y == data.y && display.width == data.width && display.height == data.height))
-        return read_data_window(path, in);
+        return read_data_window(path, in, stop);
     if (static_cast<uint64_t>(display.width) * static_cast<uint64_t>(display.height) > kMaxPixels)
         fail(path, "display window too large (" + display.to_string() + ")");
-    const RgbImage stored = read_data_window(path, in);
+    const RgbImage stored = read_data_window(path, in, stop);
     RgbImage image{static_cast<uint32_t>(display.width), static_cast<uint32_t>(display.height), {}};
     image.pixels.resize(size_t{image.width} * image.height);
     const int64_t x0 = std::max(data.x, display.x), x1 = std::min(data.x + data.width, display.x + display.width);
@@ -122,12 +150,13 @@ RgbImage read_pixels(const fs::path& path, OIIO::ImageInput& in, std::vector<std
     return image;
 }
 
-uint64_t hash_file(const fs::path& path) {
+uint64_t hash_file(const fs::path& path, StopFlag stop) {
     std::ifstream in(path, std::ios::binary);
     if (!in) fail(path, "cannot open to hash");
     Hasher hasher;
     std::vector<char> chunk(size_t{1} << 20);
     do {
+        throw_if_stopped(stop);
         in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
         hasher.update(std::as_bytes(std::span(chunk.data(), static_cast<size_t>(in.gcount()))));
     } while (in);
@@ -192,10 +221,10 @@ LoadedImage load_image(const fs::path& path, const LoadOptions& options) {
     loaded.working_colorspace = require_space(path, colour, options.working_space);
     loaded.format = in->format_name();
     loaded.channels = static_cast<uint32_t>(in->spec().nchannels);
-    loaded.image = read_pixels(path, *in, loaded.notices);
+    loaded.image = read_pixels(path, *in, loaded.notices, options.stop);
     colour.convert(loaded.image.pixels, loaded.input_colorspace, loaded.working_colorspace);
     loaded.luma = colour.luma(loaded.working_colorspace);
-    loaded.content_hash = hash_file(path);
+    loaded.content_hash = hash_file(path, options.stop);
     return loaded;
 }
 

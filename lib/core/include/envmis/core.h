@@ -7,12 +7,14 @@
 //   sampling/      2D distributions and the environment-map sampler, with batch calls;
 //                  binned.h: normal-aware bins (a density per bin of shading normals)
 //   table/         table files (written atomically, read or memory-mapped)
+// interrupt.h, used by every stage, lets a caller stop the long builds.
 #pragma once
 
 #include "envmis/compensation/compensation.h"
 #include "envmis/image/image.h"
 #include "envmis/image/mapping.h"
 #include "envmis/image/remap.h"
+#include "envmis/interrupt.h"
 #include "envmis/math/fast_math.h"
 #include "envmis/math/hash.h"
 #include "envmis/math/math.h"

@@ -64,8 +64,8 @@ std::array<double, 3> total_power(const RgbImage& image, Mapping m) {
     return power;
 }
 
-RemapResult remap(const RgbImage& in, Mapping from, Mapping to, uint32_t width, uint32_t height,
-                  uint32_t supersampling) {
+RemapResult remap(const RgbImage& in, Mapping from, Mapping to, uint32_t width, uint32_t height, uint32_t supersampling,
+                  StopFlag stop) {
     check_size("input", from, in.width, in.height);
     if (in.pixels.size() != size_t{in.width} * in.height)
         throw std::invalid_argument("remap: " + std::to_string(in.pixels.size()) + " pixels do not make a " +
@@ -95,6 +95,7 @@ RemapResult remap(const RgbImage& in, Mapping from, Mapping to, uint32_t width, 
     }
     std::vector<float> sub_z(s), sub_r(s);
     for (uint32_t y = 0; y < in.height; ++y) {
+        throw_if_stopped(stop);
         const double solid_angle = texel_solid_angle(from, y, in.width, in.height);
         const double z_top = std::cos(kPi * y / in.height), z_bottom = std::cos(kPi * (y + 1.0) / in.height);
         for (uint32_t b = 0; b < s; ++b) {
@@ -139,6 +140,7 @@ RemapResult remap(const RgbImage& in, Mapping from, Mapping to, uint32_t width, 
     // the input's radiance at their centre.
     std::array<double, 3> received{};
     for (uint32_t y = 0; y < height; ++y) {
+        throw_if_stopped(stop);
         const double texel = texel_solid_angle(to, y, width, height);
         for (uint32_t x = 0; x < width; ++x) {
             double* p = &power[4 * (size_t{y} * width + x)];

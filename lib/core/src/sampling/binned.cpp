@@ -157,7 +157,7 @@ CellGrid grid_for(const EnvMap& plain, uint32_t columns) {
 
 }  // namespace
 
-BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinnedOptions& options) : plain_(std::move(plain)) {
+BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinnedOptions& options, StopFlag stop) : plain_(std::move(plain)) {
     if (plain_.options().compensation.enabled && plain_.stats().fallback == DensityFallback::none)
         throw std::invalid_argument("a binned map is built over the plain (uncompensated) map");
     check_options(options);
@@ -165,9 +165,9 @@ BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinnedOptions& options) : plain_(
     const CellGrid grid = grid_for(plain_, options.cell_columns);
     const detail::Geometry geometry(grid, options.bins_per_side);
     layout_ = {options.bins_per_side, grid.cw, grid.ch, options.lobe_exponents,
-               detail::choose_bins(plain_, grid, geometry, options)};
+               detail::choose_bins(plain_, grid, geometry, options, stop)};
     choice_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    build(detail::bin_masses(plain_, grid, geometry, layout_));
+    build(detail::bin_masses(plain_, grid, geometry, layout_, stop), stop);
 }
 
 BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinLayout& layout) : plain_(std::move(plain)), layout_(layout) {
@@ -189,10 +189,10 @@ BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinLayout& layout) : plain_(std::
               detail::on_histogram_edge(c.threshold)))
             throw std::invalid_argument("bin layout: invalid alpha or threshold");
     const CellGrid grid(w, h, layout.cell_columns, layout.cell_rows, plain_.options().mapping);
-    build(detail::bin_masses(plain_, grid, detail::Geometry(grid, g), layout_));
+    build(detail::bin_masses(plain_, grid, detail::Geometry(grid, g), layout_), nullptr);
 }
 
-void BinnedEnvMap::build(const std::vector<std::vector<float>>& masses) {
+void BinnedEnvMap::build(const std::vector<std::vector<float>>& masses, StopFlag stop) {
     const CellGrid grid(plain_.width(), plain_.height(), layout_.cell_columns, layout_.cell_rows,
                         plain_.options().mapping);
     column_edges_ = grid.column_edges;
@@ -212,7 +212,7 @@ void BinnedEnvMap::build(const std::vector<std::vector<float>>& masses) {
     const uint32_t h = grid.h;
     rows_start_.resize(size_t{grid.cw} * h);
     rows_guide_.resize(size_t{grid.cw} * h);
-    detail::parallel_for(grid.cw, 1, [&](uint32_t lo, uint32_t hi) {
+    detail::parallel_for(grid.cw, 1, stop, [&](uint32_t lo, uint32_t hi) {
         std::vector<double> mass(h);
         detail::CdfScratch scratch(h);
         for (uint32_t cx = lo; cx < hi; ++cx) {

@@ -32,7 +32,7 @@ struct CellHistogram {
 
 // The histograms of the cells, with a window of buckets from the lowest to the highest of
 // `thresholds` (positive histogram edges; at most 512 buckets, see clamp_thresholds).
-CellHistogram histogram(const EnvMap& plain, const CellGrid& grid, std::span<const float> thresholds) {
+CellHistogram histogram(const EnvMap& plain, const CellGrid& grid, std::span<const float> thresholds, StopFlag stop) {
     CellHistogram hist;
     int64_t lo = std::numeric_limits<int64_t>::max(), hi = 0;
     for (float t : thresholds) {
@@ -48,7 +48,7 @@ CellHistogram histogram(const EnvMap& plain, const CellGrid& grid, std::span<con
     hist.max_l.assign(cells, 0);
     const Rgb* pixels = plain.radiance().pixels.data();
     const LumaCoefficients luma = plain.options().luma;
-    parallel_for(grid.ch, 1, [&](uint32_t r0, uint32_t r1) {
+    parallel_for(grid.ch, 1, stop, [&](uint32_t r0, uint32_t r1) {
         for (uint32_t cy = r0; cy < r1; ++cy)
             for (uint32_t y = grid.row_edges[cy]; y < grid.row_edges[cy + 1]; ++y) {
                 const double w = row_weight(grid.mapping, y, grid.h);
@@ -88,7 +88,7 @@ struct Nodes {
     double steradians_per_weight = 0;  // solid angle of a texel of weight 1
 };
 
-Nodes nodes_of(const EnvMap& plain, const CellGrid& grid) {
+Nodes nodes_of(const EnvMap& plain, const CellGrid& grid, StopFlag stop) {
     Nodes n;
     n.k = std::max(1u, std::min({kNodeColumns / grid.cw, grid.w / grid.cw, grid.h / grid.ch, 4u}));
     n.w = grid.cw * n.k, n.h = grid.ch * n.k;
@@ -96,7 +96,7 @@ Nodes nodes_of(const EnvMap& plain, const CellGrid& grid) {
     n.sum_w.assign(n.sum_l.size(), 0);
     const Rgb* pixels = plain.radiance().pixels.data();
     const LumaCoefficients luma = plain.options().luma;
-    parallel_for(n.h, 1, [&](uint32_t lo, uint32_t hi) {
+    parallel_for(n.h, 1, stop, [&](uint32_t lo, uint32_t hi) {
         for (uint32_t ny = lo; ny < hi; ++ny) {
             const auto y0 = static_cast<uint32_t>((uint64_t{ny} * grid.h + n.h - 1) / n.h);
             const auto y1 = static_cast<uint32_t>((uint64_t{ny + 1} * grid.h + n.h - 1) / n.h);
@@ -208,8 +208,8 @@ std::vector<Vec3> bin_samples(uint32_t bin, uint32_t g) {
 }  // namespace
 
 std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, const Geometry& geometry,
-                                   const BinnedOptions& options) {
-    const Nodes nodes = nodes_of(plain, grid);
+                                   const BinnedOptions& options, StopFlag stop) {
+    const Nodes nodes = nodes_of(plain, grid, stop);
     const std::vector<double> means = hemisphere_means(nodes, geometry);
     const uint32_t k = options.bins_per_side * options.bins_per_side;
     const auto classes = static_cast<uint32_t>(options.lobe_exponents.size());
@@ -224,10 +224,10 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
         for (size_t i = 0; i < choices.size(); ++i) choices[i] = {options.alpha, thresholds[i % k]};
         return choices;
     }
-    const CellHistogram hist = histogram(plain, grid, thresholds);
+    const CellHistogram hist = histogram(plain, grid, thresholds, stop);
     const size_t cells = size_t{grid.cw} * grid.ch;
     const std::vector<double> plain_p = probabilities(hist.total_l);
-    parallel_for(k, 1, [&](uint32_t lo, uint32_t hi) {
+    parallel_for(k, 1, stop, [&](uint32_t lo, uint32_t hi) {
         std::vector<double> mass(cells);
         for (uint32_t b = lo; b < hi; ++b) {
             std::vector<std::vector<double>> p(alphas.size());
@@ -257,13 +257,13 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
 }
 
 std::vector<std::vector<float>> bin_masses(const EnvMap& plain, const CellGrid& grid, const Geometry& geometry,
-                                           const BinLayout& layout) {
+                                           const BinLayout& layout, StopFlag stop) {
     std::vector<float> thresholds;
     for (const BinChoice& c : layout.choices) thresholds.push_back(c.plain() ? 0.0f : c.threshold);
-    const CellHistogram hist = histogram(plain, grid, thresholds);
+    const CellHistogram hist = histogram(plain, grid, thresholds, stop);
     const size_t cells = size_t{grid.cw} * grid.ch, k = size_t{layout.bins_per_side} * layout.bins_per_side;
     std::vector<std::vector<float>> masses(layout.choices.size(), std::vector<float>(cells));
-    parallel_for(static_cast<uint32_t>(masses.size()), 1, [&](uint32_t lo, uint32_t hi) {
+    parallel_for(static_cast<uint32_t>(masses.size()), 1, stop, [&](uint32_t lo, uint32_t hi) {
         for (uint32_t cb = lo; cb < hi; ++cb)
             for (size_t c = 0; c < cells; ++c) {
                 const BinChoice& choice = layout.choices[cb];

@@ -44,14 +44,15 @@ inline bool on_histogram_edge(float t) noexcept {
     return (std::bit_cast<uint32_t>(t) & ((1u << kHistogramShift) - 1)) == 0;
 }
 
-// The choice of every (class, bin), class-major, as BinnedOptions asks.
+// The choice of every (class, bin), class-major, as BinnedOptions asks. Both builds
+// throw Interrupted once `stop` is set (interrupt.h).
 std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, const Geometry& geometry,
-                                   const BinnedOptions& options);
+                                   const BinnedOptions& options, StopFlag stop);
 
 // The cell masses (cw ch floats) of every (class, bin) of the layout: the weight times the sum
 // over the cell of max(L - threshold, 0) times the texels' relative solid angle, or the
 // plain mass for a plain choice. Deterministic: the same for any number of threads.
 std::vector<std::vector<float>> bin_masses(const EnvMap& plain, const CellGrid& grid, const Geometry& geometry,
-                                           const BinLayout& layout);
+                                           const BinLayout& layout, StopFlag stop = nullptr);
 
 }  // namespace envmis::detail

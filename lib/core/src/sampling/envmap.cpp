@@ -202,7 +202,7 @@ uint32_t fill_density_row(const uint32_t* luminance, uint32_t w, float weight, f
 
 }  // namespace
 
-EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : options_(options) {
+EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options, StopFlag stop) : options_(options) {
     check_image(image, options_.mapping);
     check_options(options_);
     const uint32_t w = image.width, h = image.height;
@@ -213,7 +213,7 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : options_(options)
     std::vector<RowStats> rows(h);
     auto luminance = [&] {
         LargeVector<uint32_t> bits(size_t{w} * h);
-        detail::parallel_for(h, kRowsPerChunk, [&](uint32_t lo, uint32_t hi) {
+        detail::parallel_for(h, kRowsPerChunk, stop, [&](uint32_t lo, uint32_t hi) {
             for (uint32_t y = lo; y < hi; ++y) {
                 const size_t offset = size_t{y} * w;
                 Rgb* row = pixels + offset;
@@ -245,6 +245,7 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options) : options_(options)
                                           stats_.fallback == DensityFallback::uniform, row.data());
     };
     distribution_ = Distribution2D(w, h, std::move(luminance_bits), density);
+    throw_if_stopped(stop);
     if (stats_.threshold > 0 && distribution_.uniform_fallback()) {
         stats_.fallback = DensityFallback::uncompensated;
         stats_.threshold = 0;

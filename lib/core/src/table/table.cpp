@@ -27,6 +27,9 @@ constexpr uint32_t kByteOrderMark = 0x01020304;
 constexpr size_t kPreambleSize = 32;
 constexpr uint32_t kMaxMetadataSize = 64 * 1024;
 constexpr uint32_t kMaxStringSize = 4096;
+// Texels handed to the writer at a time: small enough that a stop is seen within
+// milliseconds, large enough that the calls cost nothing.
+constexpr size_t kTexelsPerWrite = size_t{1} << 17;
 constexpr uint64_t kMaxTexels = uint64_t{1} << 31;
 constexpr uint32_t kSamplerCdf = 1;
 constexpr uint32_t kFlagCompensation = 1;
@@ -183,10 +186,11 @@ namespace {
 // Writes the preamble, `metadata`, the header checksum, the payload of `payload_size`
 // bytes that for_each_chunk(use) hands to `use` in order (it is called twice: for the
 // payload checksum, then to write), the payload checksum, and `bins` with its checksum
-// unless empty; atomically.
+// unless empty; atomically. Between chunks, `stop` (interrupt.h) ends it with Interrupted
+// and no file.
 template <class ForEachChunk>
 void write_file(const std::filesystem::path& path, const std::vector<std::byte>& metadata, uint64_t payload_size,
-                const std::vector<std::byte>& bins, ForEachChunk&& for_each_chunk) {
+                const std::vector<std::byte>& bins, StopFlag stop, ForEachChunk&& for_each_chunk) {
     ByteWriter head;
     for (std::byte b : kMagic) head.put(b);
     head.put(kTableVersion);
@@ -199,11 +203,15 @@ void write_file(const std::filesystem::path& path, const std::vector<std::byte>&
     head.put(hash64(head.bytes));
 
     Hasher payload_hash;
-    for_each_chunk([&](std::span<const std::byte> bytes) { payload_hash.update(bytes); });
+    for_each_chunk([&](std::span<const std::byte> bytes) {
+        throw_if_stopped(stop);
+        payload_hash.update(bytes);
+    });
     const uint64_t payload_digest = payload_hash.digest(), bins_digest = hash64(bins);
     try {
         write_file_atomically(path, [&](std::ostream& out) {
             auto write = [&](std::span<const std::byte> bytes) {
+                throw_if_stopped(stop);
                 out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
             };
             write(head.bytes);
@@ -214,6 +222,8 @@ void write_file(const std::filesystem::path& path, const std::vector<std::byte>&
                 write(std::as_bytes(std::span(&bins_digest, 1)));
             }
         });
+    } catch (const Interrupted&) {
+        throw;
     } catch (const std::runtime_error& e) {
         throw TableError(e.what());
     }
@@ -237,7 +247,7 @@ namespace {
 
 // The plain map's table, with `layout`'s bins section if not null.
 void write_map(const std::filesystem::path& path, const EnvMap& map, const TableSource& source, TableEncoding encoding,
-               const BinLayout* layout) {
+               const BinLayout* layout, StopFlag stop) {
     for (const std::string* s : {&source.name, &source.input_colorspace, &source.working_colorspace})
         if (s->size() > kMaxStringSize)
             throw TableError(path.string() + ": metadata string longer than " + std::to_string(kMaxStringSize) +
@@ -249,7 +259,7 @@ void write_map(const std::filesystem::path& path, const EnvMap& map, const Table
         // The table holds the rounded map: its statistics (Lbar, threshold) are the
         // rounded map's, which the reader's rebuild reproduces exactly; the bad-pixel
         // counts are the source's.
-        const EnvMap rounded(rgbe_round(map.radiance()), map.options());
+        const EnvMap rounded(rgbe_round(map.radiance()), map.options(), stop);
         EnvMapStats stats = rounded.stats();
         stats.bad_pixels = map.stats().bad_pixels;
         std::vector<uint32_t> rgbe(radiance.size());
@@ -257,39 +267,44 @@ void write_map(const std::filesystem::path& path, const EnvMap& map, const Table
         detail::parallel_for(map.height(), 16, [&](uint32_t lo, uint32_t hi) {
             for (size_t i = size_t{lo} * w; i < size_t{hi} * w; ++i) rgbe[i] = rgbe_encode(radiance[i]);
         });
-        write_file(path, metadata_block(map, stats, source, encoding, bins_size), rgbe.size() * sizeof(uint32_t), bins,
-                   [&](auto&& use) { use(as_bytes_of<uint32_t>(rgbe)); });
+        write_file(
+            path, metadata_block(map, stats, source, encoding, bins_size), rgbe.size() * sizeof(uint32_t), bins, stop,
+            [&](auto&& use) {
+                for (size_t i = 0; i < rgbe.size(); i += kTexelsPerWrite)
+                    use(as_bytes_of<uint32_t>(std::span(rgbe).subspan(i, std::min(kTexelsPerWrite, rgbe.size() - i))));
+            });
         return;
     }
     // The density is computed a row at a time, twice (for the checksum, then to write):
     // cheaper than holding a copy of the map's size.
     std::vector<float> row(map.width());
     write_file(path, metadata_block(map, map.stats(), source, encoding, bins_size),
-               radiance.size() * (sizeof(float) + sizeof(Rgb)), bins, [&](auto&& use) {
+               radiance.size() * (sizeof(float) + sizeof(Rgb)), bins, stop, [&](auto&& use) {
                    for (uint32_t y = 0; y < map.height(); ++y) {
                        map.density_row(y, row);
                        use(as_bytes_of<float>(row));
                    }
-                   use(as_bytes_of<Rgb>(radiance));
+                   for (size_t i = 0; i < radiance.size(); i += kTexelsPerWrite)
+                       use(as_bytes_of<Rgb>(radiance.subspan(i, std::min(kTexelsPerWrite, radiance.size() - i))));
                });
 }
 
 }  // namespace
 
 void write_table(const std::filesystem::path& path, const EnvMap& map, const TableSource& source,
-                 TableEncoding encoding) {
-    write_map(path, map, source, encoding, nullptr);
+                 TableEncoding encoding, StopFlag stop) {
+    write_map(path, map, source, encoding, nullptr, stop);
 }
 
 void write_table(const std::filesystem::path& path, const BinnedEnvMap& binned, const TableSource& source,
-                 TableEncoding encoding) {
+                 TableEncoding encoding, StopFlag stop) {
     // Never write what the reader would refuse (a default-constructed BinnedEnvMap has no bins).
     const BinLayout& layout = binned.layout();
     const uint32_t g = layout.bins_per_side, classes = static_cast<uint32_t>(layout.lobe_exponents.size());
     if (g < 1 || g > kMaxBinsPerSide || classes < 1 || classes > kMaxLobeClasses ||
         layout.choices.size() != size_t{classes} * g * g)
         throw TableError(path.string() + ": the binned map has no valid bins to write");
-    write_map(path, binned.plain(), source, encoding, &binned.layout());
+    write_map(path, binned.plain(), source, encoding, &binned.layout(), stop);
 }
 
 namespace {

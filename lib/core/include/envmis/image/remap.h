@@ -22,6 +22,7 @@
 
 #include "envmis/image/image.h"
 #include "envmis/image/mapping.h"
+#include "envmis/interrupt.h"
 
 namespace envmis {
 
@@ -41,8 +42,9 @@ struct RemapResult {
 // Converts `in` (mapping `from`) into a width x height image under mapping `to`.
 // supersampling = 0 picks s so that output texels of average size receive at least 16
 // sub-samples where the input texels are largest (s from 2 to 16). Throws std::invalid_argument for an empty or
-// inconsistent image, a zero or too large output size, or a non-square equal-area size.
+// inconsistent image, a zero or too large output size, or a non-square equal-area size;
+// Interrupted once `stop` is set (interrupt.h; checked every input row).
 RemapResult remap(const RgbImage& in, Mapping from, Mapping to, uint32_t width, uint32_t height,
-                  uint32_t supersampling = 0);
+                  uint32_t supersampling = 0, StopFlag stop = nullptr);
 
 }  // namespace envmis

@@ -251,8 +251,9 @@ public:
     BinnedEnvMap() = default;
     // Builds the bins over `plain`, which must be uncompensated (its density is the
     // texel level of every bin). Throws std::invalid_argument for a compensated map or
-    // invalid options.
-    BinnedEnvMap(EnvMap plain, const BinnedOptions& options = {});
+    // invalid options; throws Interrupted once `stop` is set (interrupt.h; checked every
+    // bin and block of rows).
+    BinnedEnvMap(EnvMap plain, const BinnedOptions& options = {}, StopFlag stop = nullptr);
     // Rebuilds the bins a layout describes (a table's), bit-identical to the build that
     // chose it. Throws std::invalid_argument on a layout that does not fit the map.
     BinnedEnvMap(EnvMap plain, const BinLayout& layout);
@@ -274,7 +275,7 @@ public:
     double choice_seconds() const noexcept { return choice_seconds_; }
 
 private:
-    void build(const std::vector<std::vector<float>>& masses);
+    void build(const std::vector<std::vector<float>>& masses, StopFlag stop);
 
     EnvMap plain_;
     BinLayout layout_;

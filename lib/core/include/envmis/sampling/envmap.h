@@ -26,6 +26,7 @@
 #include "envmis/compensation/compensation.h"
 #include "envmis/image/image.h"
 #include "envmis/image/mapping.h"
+#include "envmis/interrupt.h"
 #include "envmis/math/math.h"
 #include "envmis/sampling/distribution.h"
 
@@ -185,8 +186,9 @@ public:
     // stats().bad_pixels). Throws std::invalid_argument for an empty image, a pixel count
     // that does not match the size, more than 2^31 texels, invalid options, or finite
     // pixels whose power overflows float (4 pi Lbar above 3.4e38: "luminance overflows",
-    // with the factor to scale the map by), which would make every estimate Inf or NaN.
-    explicit EnvMap(RgbImage image, const EnvMapOptions& options = {});
+    // with the factor to scale the map by), which would make every estimate Inf or NaN;
+    // throws Interrupted once `stop` is set (interrupt.h; checked every block of rows).
+    explicit EnvMap(RgbImage image, const EnvMapOptions& options = {}, StopFlag stop = nullptr);
 
     // Rebuilds a saved sampler from its parts (the table reader's path): the image
     // density q(x, y) w_y exactly as density() returned it, as float bit patterns; that

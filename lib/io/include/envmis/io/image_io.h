@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "envmis/image/image.h"
+#include "envmis/interrupt.h"
 #include "envmis/math/math.h"
 
 namespace envmis::io {
@@ -37,6 +38,8 @@ public:
 struct LoadOptions {
     std::string colorspace;                    // input colour space; empty: from the file's metadata
     std::string working_space = "lin_rec709";  // a colour space of the OCIO config (colour.h)
+    // Once set, the load stops within a few scanlines and throws Interrupted (interrupt.h).
+    StopFlag stop = nullptr;
 };
 
 struct LoadedImage {

@@ -122,9 +122,10 @@ DirectLightingEstimator study_estimator(const EnvMap& plain, const EnvMap& compe
 std::vector<double> exact_point_variances(const StudyInputs& inputs, const Technique& technique, size_t bsdf,
                                           int subdivisions);
 
-// How a long run is watched and stopped: `stop` is checked between points (the run
-// returns what is done); `progress(done, total)` is called after each point, in units
-// the caller does not need to know (points times runs).
+// How a long run is watched and stopped: `stop` is checked between points and every
+// 4096 estimates within one (the run returns the points completed; a point cut short
+// is dropped); `progress(done, total)` is called as each run starts and after each
+// point, in units the caller does not need to know (points times runs).
 struct RunControl {
     const std::atomic<bool>* stop = nullptr;
     std::function<void(size_t done, size_t total)> progress = {};
