@@ -121,8 +121,7 @@ RgbImage read_data_window(const fs::path& path, OIIO::ImageInput& in, StopFlag s
 // The image is the display window, as the OpenEXR specification defines it: its pixels
 // outside the data window are black, and data outside it (overscan) is cropped away.
 // Formats without windows have both the same, and keep the pixels as read.
-RgbImage read_pixels(const fs::path& path, OIIO::ImageInput& in, std::vector<std::string>& notices,
-                     StopFlag stop) {
+RgbImage read_pixels(const fs::path& path, OIIO::ImageInput& in, std::vector<std::string>& notices, StopFlag stop) {
     const OIIO::ImageSpec& spec = in.spec();
     const Window data{spec.x, spec.y, spec.width, spec.height};
     const Window display{spec.full_x, spec.full_y, spec.full_width, spec.full_height};
