@@ -10,6 +10,7 @@
 #   hang / slow    ran past its time limit / a signal took more than 2 s to act on
 #   leftovers      the run left a partial or temporary file behind
 # Usage: scripts/faults.sh [path/to/envmis]   (default build/apps/envmis)
+#        FAULTS_ONLY=REGEX scripts/faults.sh ...  runs only the cases whose names match
 # Every output is bounded: file sizes by `ulimit -f`, runs by `timeout`.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -30,6 +31,7 @@ leftovers() { (cd "$1" && find . -mindepth 1 ! -type d ! -name 'in.*' -printf '%
 # command exits 77 when the machine cannot set the case up (mknod without privilege).
 # Arguments: name, expect, limit in seconds, then a shell command run in the folder.
 case_() {
+  [[ $1 =~ ${FAULTS_ONLY:-.} ]] || return 0
   local name=$1 expect=$2 limit=$3 dir=$work/$RANDOM$RANDOM
   shift 3
   mkdir -p "$dir/out" && cp "$maps/studio.exr" "$dir/in.exr"
@@ -53,6 +55,7 @@ case_() {
 
 # A run signalled after `delay` seconds; it must exit 128 + signal within 2 s.
 signal_case() {
+  [[ $1 =~ ${FAULTS_ONLY:-.} ]] || return 0
   local name=$1 signal=$2 delay=$3 dir=$work/$RANDOM$RANDOM
   shift 3
   mkdir -p "$dir/out" && cp "$maps/studio.exr" "$dir/in.exr"

@@ -520,10 +520,7 @@ BinLayout parse_bins(std::span<const std::byte> section, uint64_t digest, const 
 template <class Build>
 Table checked_table(std::string_view name, const Header& header, std::optional<BinLayout> bins, Build&& build) {
     try {
-        Table table{build(), header.source, header.version};
-        table.bins = std::move(bins);
-        table.name = name;
-        return table;
+        return Table{build(), header.source, header.version, false, std::move(bins), std::string(name)};
     } catch (const std::invalid_argument& e) {
         fail(name, std::string("inconsistent contents: ") + e.what());
     }
