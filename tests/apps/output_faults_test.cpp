@@ -27,27 +27,15 @@
 namespace {
 
 namespace fs = std::filesystem;
+using envmis::test::dead_pid;
 using envmis::test::read_file;
 using envmis::test::Result;
+using envmis::test::write_text;
 
 const std::string kStudio = (fs::path(ENVMIS_DATA_DIR) / "envmaps" / "studio.exr").string();
 
 bool contains(const std::string& text, const std::string& pattern) {
     return std::regex_search(text, std::regex(pattern, std::regex::icase));
-}
-
-void write_text(const fs::path& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-    if (!out) throw std::runtime_error("test setup: cannot write " + path.string());
-}
-
-// A process id that names no process: a child that has exited and been reaped.
-pid_t dead_pid() {
-    const pid_t pid = ::fork();
-    if (pid == 0) ::_exit(0);
-    ::waitpid(pid, nullptr, 0);
-    return pid;
 }
 
 class OutputFaults : public envmis::test::TempFolder {
@@ -280,7 +268,7 @@ TEST_F(OutputFaults, TheNextWriteOfAnOutputRemovesTheTemporariesOfKilledRunsAndS
     const std::string dead = std::to_string(dead_pid()), live = std::to_string(::getpid()), map = small_map();
     for (const Writer& w : kWriters) {
         const fs::path out(w.output);
-        const std::string hidden = "." + out.stem().string() + ".tmp";
+        const std::string hidden = std::string(".").append(out.stem().string()).append(".tmp");
         // Of an envmis that recorded no process id (killed an hour ago), of a dead process, of a live one.
         const std::string old_stale = hidden + "123456789" + out.extension().string(),
                           stale = hidden + dead + "-42" + out.extension().string(),

@@ -25,21 +25,9 @@ namespace envmis {
 namespace {
 
 namespace fs = std::filesystem;
+using test::dead_pid;
 using test::read_file;
-
-void write_text(const fs::path& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-    if (!out) throw std::runtime_error("test setup: cannot write " + path.string());
-}
-
-// A process id that names no process: a child that has exited and been reaped.
-pid_t dead_pid() {
-    const pid_t pid = ::fork();
-    if (pid == 0) ::_exit(0);
-    ::waitpid(pid, nullptr, 0);
-    return pid;
-}
+using test::write_text;
 
 // The message of what `f` throws; "" if it does not throw.
 template <class F>
