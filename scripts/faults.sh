@@ -75,6 +75,7 @@ signal_case() {
   elif ((rc == 137)); then verdict=hang
   elif ((rc != want)); then verdict="exit $rc"
   elif ((secs > 2)); then verdict=slow
+  elif [[ $left == *.tmp* ]]; then verdict=leftovers
   elif [[ -n $left ]] && grep -L partial "$dir"/out/* 2>/dev/null | grep -q .; then verdict=leftovers
   else verdict="clean stop"
   fi

@@ -174,10 +174,36 @@ std::optional<uint64_t> proc_kib(const char* file, const std::string& key) {
         }
     return std::nullopt;
 }
+
+// What this process's control group still allows, where it has a limit: in a container
+// or a CI runner MemAvailable counts the whole machine. cgroup v2 ("0::PATH": memory.max,
+// "max" where unlimited) or v1 (":memory:PATH": memory.limit_in_bytes, a huge number
+// where unlimited).
+std::optional<uint64_t> cgroup_memory_left() {
+    std::ifstream self("/proc/self/cgroup");
+    for (std::string line; std::getline(self, line);) {
+        std::filesystem::path limit_file, usage_file;
+        if (line.rfind("0::", 0) == 0) {
+            const std::filesystem::path group = "/sys/fs/cgroup" + line.substr(3);
+            limit_file = group / "memory.max", usage_file = group / "memory.current";
+        } else if (const size_t at = line.find(":memory:"); at != std::string::npos) {
+            const std::filesystem::path group = "/sys/fs/cgroup/memory" + line.substr(at + 8);
+            limit_file = group / "memory.limit_in_bytes", usage_file = group / "memory.usage_in_bytes";
+        } else {
+            continue;
+        }
+        uint64_t limit = 0, usage = 0;
+        std::ifstream limit_in(limit_file), usage_in(usage_file);
+        if ((limit_in >> limit) && (usage_in >> usage)) return limit > usage ? limit - usage : 0;
+    }
+    return std::nullopt;
+}
 }  // namespace
 
 std::optional<uint64_t> available_memory() {
     std::optional<uint64_t> available = proc_kib("/proc/meminfo", "MemAvailable:");
+    if (const std::optional<uint64_t> group = cgroup_memory_left())
+        available = std::min(available.value_or(*group), *group);
     rlimit limit{};
     if (::getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
         const uint64_t used = proc_kib("/proc/self/status", "VmSize:").value_or(0);

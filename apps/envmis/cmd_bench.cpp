@@ -254,7 +254,8 @@ BenchResult measure(const RgbImage& image, const EnvMapOptions& options, const B
     Progress progress("bench", 3 * repeats);
     int step = 0;
     const auto [guided, guided_build] = build_repeatedly<EnvMap, RgbImage>(
-        image, repeats, [&](RgbImage& copy) { return EnvMap(std::move(copy), options); }, progress, step);
+        image, repeats, [&](RgbImage& copy) { return EnvMap(std::move(copy), options, &interrupted()); }, progress,
+        step);
     const auto [textbook, textbook_build] = build_repeatedly<reference::TextbookEnvMap, RgbImage>(
         image, repeats, [&](RgbImage&) { return reference::TextbookEnvMap(image, options); }, progress, step);
     const CallTimes c = time_calls(*guided, *textbook, points, repeats, progress, step);
@@ -332,14 +333,16 @@ BinnedResult measure_binned(const RgbImage& image, uint32_t bins, const BenchPoi
         EnvMapOptions options;
         options.compensation.enabled = k == kCompensated;
         std::tie(today[k], result.build_ms[k]) = build_repeatedly<EnvMap, RgbImage>(
-            image, repeats, [&](RgbImage& copy) { return EnvMap(std::move(copy), options); }, progress, step);
+            image, repeats, [&](RgbImage& copy) { return EnvMap(std::move(copy), options, &interrupted()); }, progress,
+            step);
         result.bytes[k] = static_cast<double>(today[k]->distribution().bytes()) +
                           static_cast<double>(sizeof(Rgb)) * image.width * image.height;
     }
     BinnedOptions options;
     options.bins_per_side = bins_per_side(bins);
     const auto [binned, bins_ms] = build_repeatedly<BinnedEnvMap, EnvMap>(
-        *today[kPlain], repeats, [&](EnvMap& copy) { return BinnedEnvMap(std::move(copy), options); }, progress, step);
+        *today[kPlain], repeats, [&](EnvMap& copy) { return BinnedEnvMap(std::move(copy), options, &interrupted()); },
+        progress, step);
     result.bins = bins;
     result.cells_w = binned->layout().cell_columns, result.cells_h = binned->layout().cell_rows;
     result.build_ms[2] = bins_ms;

@@ -463,6 +463,7 @@ void write_exact(const Setup& s, Written& w) {
         std::cout << "  " << s.options.bsdfs[b].name() << ":";
         for (const Technique& t : s.options.techniques) {
             if (t.adaptive() || t.mixture) continue;
+            throw_if_interrupted();  // each technique's quadrature over every point takes up to seconds
             const std::vector<double> v = exact_point_variances(inputs, t, b, 1);
             double worst = 0;
             for (size_t p = 0; p < v.size(); ++p)

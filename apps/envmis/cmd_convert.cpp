@@ -38,8 +38,9 @@ void add_convert_flags(CLI::App& sub, ConvertArgs& args) {
     sub.add_option("--working-space", args.working_space, "Colour space of the output")->capture_default_str();
 }
 
-// What an output texel costs at the peak: the remapped image and the writer's copy of it.
-constexpr uint64_t kBytesPerTexel = 2 * sizeof(Rgb);
+// What an output texel costs at the peak: remap's accumulator (power and solid angle, 4
+// doubles) beside the remapped image, then the image and the writer's encoded copy.
+constexpr uint64_t kBytesPerTexel = 4 * sizeof(double) + 2 * sizeof(Rgb);
 
 // The output size --size asks for (checked before any work), or 0 x 0 for the default.
 Size requested_size(const std::string& text, Mapping to) {
@@ -84,7 +85,11 @@ void run_convert(const ConvertArgs& args) {
     if (size.width != 0) check_image_size("--size " + args.size, size, kBytesPerTexel);
     const io::LoadedImage image = io::load_image(args.input, {args.colorspace, args.working_space, &interrupted()});
     for (const std::string& notice : image.notices) std::cerr << "note: " << notice << "\n";
-    if (size.width == 0) size = default_size(image.image, to);
+    if (size.width == 0) {
+        size = default_size(image.image, to);
+        check_image_size(args.input + ": output of " + std::to_string(size.width) + "x" + std::to_string(size.height),
+                         size, kBytesPerTexel);
+    }
     const auto start = std::chrono::steady_clock::now();
     std::optional<Progress> progress(std::in_place, "remapping", 1);
     const RemapResult result =

@@ -37,6 +37,7 @@ void write_samples(std::ostream& out, const EnvMap& map, uint64_t n, uint64_t se
         put(line, s.pdf, '\n');
         out << line;
         if ((i & 0xffff) == 0) {
+            if (!out) return;  // the caller reports the stream's failure; no point in going on
             progress.update(i);
             throw_if_interrupted();
         }

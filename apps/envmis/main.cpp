@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
     } catch (const std::exception& e) {
         // A failure caused by the interruption (a library's read stopped half-way) is the
         // interruption's.
-        if (interrupted()) return exit_interrupted("");
+        if (interrupted()) return exit_interrupted(e.what());
         std::cerr << "envmis: " << e.what() << "\n";
         return 1;
     }

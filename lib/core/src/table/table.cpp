@@ -383,10 +383,13 @@ void check_stats(const Header& header, const Cursor& in) {
           std::to_string(s.bad_pixels.total()), "at most 3 x the texel count in all");
 }
 
-// Parses and checks the header from `head`, the first bytes of a file of `file_size`
-// bytes (all of it, or at least the preamble, metadata and header checksum).
-Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::string_view name) {
-    Cursor in(head, name);
+// The fixed fields before the metadata (magic, version, byte order, file size, metadata
+// size, reserved), each checked; returns the version and the metadata's size.
+struct Preamble {
+    uint32_t version = 0, metadata_size = 0;
+};
+
+Preamble parse_preamble(Cursor& in, std::span<const std::byte> head, uint64_t file_size) {
     if (head.size() < sizeof kMagic || std::memcmp(head.data(), kMagic, sizeof kMagic) != 0)
         in.fail("not an envmis table (bad magic)");
     in.take_bytes(sizeof kMagic, "magic");
@@ -409,6 +412,14 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
         in.fail("reserved field is " + std::to_string(reserved) + ", not 0");
     if (metadata_size > kMaxMetadataSize)
         in.fail("metadata block of " + std::to_string(metadata_size) + " bytes is too large");
+    return {version, metadata_size};
+}
+
+// Parses and checks the header from `head`, the first bytes of a file of `file_size`
+// bytes (all of it, or at least the preamble, metadata and header checksum).
+Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::string_view name) {
+    Cursor in(head, name);
+    const auto [version, metadata_size] = parse_preamble(in, head, file_size);
     in.need(uint64_t{metadata_size} + 8, "metadata and header checksum");
     const uint64_t header_digest = hash64(head.first(kPreambleSize + metadata_size));
 

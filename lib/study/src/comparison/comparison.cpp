@@ -111,6 +111,55 @@ std::vector<double> exact_point_variances(const StudyInputs& inputs, const Techn
 
 namespace {
 
+// The cells of a run over `done` points: one per (point, BSDF, technique), and the
+// reference of each (point, BSDF).
+struct CellTable {
+    const std::vector<Cell>& cells;
+    const std::vector<double>& references;
+    size_t done, nb, nt;
+    const Cell& at(size_t p, size_t b, size_t t) const { return cells[(p * nb + b) * nt + t]; }
+};
+
+// Technique t's statistics on BSDF b over the points, with its variance ratio to
+// mis-balance (the technique at mis_index; nt where the run has none).
+TechniqueStats technique_stats(const CellTable& table, size_t b, size_t t, size_t mis_index,
+                               const Technique& technique) {
+    const size_t done = table.done, nt = table.nt;
+    TechniqueStats s;
+    s.technique = technique;
+    RunningStats rel;
+    double seconds = 0, variance_sum = 0, log_ratio = 0, log_ratio_se2 = 0;
+    size_t ratios = 0;
+    for (size_t p = 0; p < done; ++p) {
+        const Cell& c = table.at(p, b, t);
+        s.mean += c.estimates.mean() / done;
+        s.reference += table.references[p * table.nb + b] / done;
+        s.variance += c.estimates.variance() / done;
+        variance_sum += c.estimates.variance() / c.estimates.count();
+        rel.merge(c.squared_relative_error);
+        seconds += c.seconds;
+        s.estimates += c.estimates.count();
+        s.ill_conditioned_points += c.ill_conditioned;
+        s.point_variances.push_back(c.estimates.variance());
+        s.point_variance_rel_se.push_back(relative_standard_error(c));
+        if (mis_index < nt && t != mis_index) {
+            const Cell& mis = table.at(p, b, mis_index);
+            const double v = c.estimates.variance(), v_mis = mis.estimates.variance();
+            if (v > 0 && v_mis > 0) {
+                log_ratio += std::log(v / v_mis), ++ratios;
+                log_ratio_se2 += square(relative_standard_error(c)) + square(relative_standard_error(mis));
+            }
+        }
+    }
+    s.std_error = std::sqrt(variance_sum) / done;
+    s.rel_mse = rel.mean();
+    s.ns_per_estimate = 1e9 * seconds / static_cast<double>(s.estimates);
+    s.efficiency = s.variance > 0 ? 1 / (s.variance * seconds / static_cast<double>(s.estimates)) : 0;
+    s.variance_ratio_vs_mis = t == mis_index ? 1.0 : (ratios ? std::exp(log_ratio / ratios) : 0);
+    s.variance_ratio_log_std_error = ratios ? std::sqrt(log_ratio_se2) / static_cast<double>(ratios) : 0;
+    return s;
+}
+
 // The study with one compensated map for every BSDF.
 Comparison compare_one(const EnvMap& plain, const EnvMap& compensated, const BinnedEnvMap* binned,
                        std::span<const ShadingPoint> points, const ComparisonOptions& options,
@@ -179,46 +228,14 @@ Comparison compare_one(const EnvMap& plain, const EnvMap& compensated, const Bin
 
     Comparison result{{}, done, points.size()};
     if (done == 0) return result;
+    const CellTable table{cells, references, done, nb, nt};
     size_t mis_index = nt;
     for (size_t t = 0; t < nt; ++t)
         if (options.techniques[t] == Technique::parse("mis-balance")) mis_index = t;
     for (size_t b = 0; b < nb; ++b) {
         BsdfComparison bc{options.bsdfs[b], {}};
-        for (size_t t = 0; t < nt; ++t) {
-            TechniqueStats s;
-            s.technique = options.techniques[t];
-            RunningStats rel;
-            double seconds = 0, variance_sum = 0, log_ratio = 0, log_ratio_se2 = 0;
-            size_t ratios = 0;
-            for (size_t p = 0; p < done; ++p) {
-                const Cell& c = cells[(p * nb + b) * nt + t];
-                s.mean += c.estimates.mean() / done;
-                s.reference += references[p * nb + b] / done;
-                s.variance += c.estimates.variance() / done;
-                variance_sum += c.estimates.variance() / c.estimates.count();
-                rel.merge(c.squared_relative_error);
-                seconds += c.seconds;
-                s.estimates += c.estimates.count();
-                s.ill_conditioned_points += c.ill_conditioned;
-                s.point_variances.push_back(c.estimates.variance());
-                s.point_variance_rel_se.push_back(relative_standard_error(c));
-                if (mis_index < nt && t != mis_index) {
-                    const Cell& mis = cells[(p * nb + b) * nt + mis_index];
-                    const double v = c.estimates.variance(), v_mis = mis.estimates.variance();
-                    if (v > 0 && v_mis > 0) {
-                        log_ratio += std::log(v / v_mis), ++ratios;
-                        log_ratio_se2 += square(relative_standard_error(c)) + square(relative_standard_error(mis));
-                    }
-                }
-            }
-            s.std_error = std::sqrt(variance_sum) / done;
-            s.rel_mse = rel.mean();
-            s.ns_per_estimate = 1e9 * seconds / static_cast<double>(s.estimates);
-            s.efficiency = s.variance > 0 ? 1 / (s.variance * seconds / static_cast<double>(s.estimates)) : 0;
-            s.variance_ratio_vs_mis = t == mis_index ? 1.0 : (ratios ? std::exp(log_ratio / ratios) : 0);
-            s.variance_ratio_log_std_error = ratios ? std::sqrt(log_ratio_se2) / static_cast<double>(ratios) : 0;
-            bc.techniques.push_back(s);
-        }
+        for (size_t t = 0; t < nt; ++t)
+            bc.techniques.push_back(technique_stats(table, b, t, mis_index, options.techniques[t]));
         result.bsdfs.push_back(std::move(bc));
     }
     return result;
