@@ -34,6 +34,8 @@ extern char** environ;
 namespace {
 
 namespace fs = std::filesystem;
+using envmis::test::contains;
+using envmis::test::expect_one_line_error;
 using envmis::test::read_file;
 using envmis::test::Result;
 
@@ -49,11 +51,6 @@ void write_file(const fs::path& path, const std::string& bytes) {
     std::ofstream out(path, std::ios::binary);
     out << bytes;
     if (!out) throw std::runtime_error("test setup: cannot write " + path.string());
-}
-
-// A regex search, case-insensitive, across lines.
-bool contains(const std::string& text, const std::string& pattern) {
-    return std::regex_search(text, std::regex(pattern, std::regex::icase | std::regex::ECMAScript));
 }
 
 // The rows of a CSV file after its header.
@@ -131,17 +128,6 @@ public:
         return p;
     }
 };
-
-// A failure as the user must see it: exit code != 0, nothing on stdout, and one line on
-// stderr that names `file` and says what is wrong with it (`problem`, a regex).
-void expect_one_line_error(const Result& r, const std::string& file, const std::string& problem) {
-    EXPECT_NE(r.exit_code, 0) << r;
-    EXPECT_EQ(r.out, "") << r;
-    EXPECT_TRUE(!r.err.empty() && r.err.back() == '\n' && r.err.find('\n') == r.err.size() - 1)
-        << "expected exactly one line on stderr" << r;
-    EXPECT_NE(r.err.find(file), std::string::npos) << "stderr does not name " << file << r;
-    EXPECT_TRUE(contains(r.err, problem)) << "stderr does not say /" << problem << "/" << r;
-}
 
 // ---------------------------------------------------------------------------------
 // Help.

@@ -25,6 +25,8 @@ constexpr bool kAddressSanitizer = true;
 #else
 constexpr bool kAddressSanitizer = false;
 #endif
+using envmis::test::contains;
+using envmis::test::expect_one_line_error;
 using envmis::test::quoted;
 using envmis::test::Result;
 
@@ -50,20 +52,6 @@ void write_exr(const fs::path& path, const Pixels& p, int x = 0, int y = 0, int 
     if (!out || !out->open(path.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, p.rgb.data()) ||
         !out->close())
         throw std::runtime_error("test setup: cannot write " + path.string());
-}
-
-bool contains(const std::string& text, const std::string& pattern) {
-    return std::regex_search(text, std::regex(pattern, std::regex::icase | std::regex::ECMAScript));
-}
-
-// A refusal as the user must see it: non-zero exit, nothing on stdout, one line on
-// stderr that names `what` (the file or the flag) and matches `problem`.
-void expect_one_line_error(const Result& r, const std::string& what, const std::string& problem) {
-    EXPECT_NE(r.exit_code, 0) << r;
-    EXPECT_EQ(r.out, "") << r;
-    EXPECT_TRUE(!r.err.empty() && r.err.find('\n') == r.err.size() - 1) << "expected exactly one line on stderr" << r;
-    EXPECT_NE(r.err.find(what), std::string::npos) << "stderr does not name " << what << r;
-    EXPECT_TRUE(contains(r.err, problem)) << "stderr does not say /" << problem << "/" << r;
 }
 
 class InputFaults : public envmis::test::TempFolder {

@@ -27,16 +27,14 @@
 namespace {
 
 namespace fs = std::filesystem;
+using envmis::test::contains;
 using envmis::test::dead_pid;
+using envmis::test::expect_one_line_error;
 using envmis::test::read_file;
 using envmis::test::Result;
 using envmis::test::write_text;
 
 const std::string kStudio = (fs::path(ENVMIS_DATA_DIR) / "envmaps" / "studio.exr").string();
-
-bool contains(const std::string& text, const std::string& pattern) {
-    return std::regex_search(text, std::regex(pattern, std::regex::icase));
-}
 
 class OutputFaults : public envmis::test::TempFolder {
 public:
@@ -109,16 +107,6 @@ public:
         return found;
     }
 };
-
-// A failure as the user must see it: exit code != 0, and one line on stderr that names
-// `file` and says what is wrong (`problem`, a regex).
-void expect_one_line_error(const Result& r, const std::string& file, const std::string& problem) {
-    EXPECT_NE(r.exit_code, 0) << r;
-    EXPECT_TRUE(!r.err.empty() && r.err.back() == '\n' && r.err.find('\n') == r.err.size() - 1)
-        << "expected exactly one line on stderr" << r;
-    EXPECT_NE(r.err.find(file), std::string::npos) << "stderr does not name " << file << r;
-    EXPECT_TRUE(contains(r.err, problem)) << "stderr does not say /" << problem << "/" << r;
-}
 
 // ---------------------------------------------------------------------------------
 // A full disk: every writer's file larger than the limit fails cleanly.

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iterator>
 #include <ostream>
+#include <regex>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -61,6 +62,22 @@ inline std::ostream& operator<<(std::ostream& os, const Result& r) {
     return os << "\n$ " << r.command << "\nexit code " << r.exit_code << "\n--- stdout:\n"
               << r.out.substr(0, 2000) << "--- stderr:\n"
               << r.err;
+}
+
+// A regex search, case-insensitive, across lines.
+inline bool contains(const std::string& text, const std::string& pattern) {
+    return std::regex_search(text, std::regex(pattern, std::regex::icase | std::regex::ECMAScript));
+}
+
+// A failure as the user must see it: exit code != 0, nothing on stdout, and one line on
+// stderr that names `what` (the file or the flag) and says what is wrong (`problem`, a regex).
+inline void expect_one_line_error(const Result& r, const std::string& what, const std::string& problem) {
+    EXPECT_NE(r.exit_code, 0) << r;
+    EXPECT_EQ(r.out, "") << r;
+    EXPECT_TRUE(!r.err.empty() && r.err.back() == '\n' && r.err.find('\n') == r.err.size() - 1)
+        << "expected exactly one line on stderr" << r;
+    EXPECT_NE(r.err.find(what), std::string::npos) << "stderr does not name " << what << r;
+    EXPECT_TRUE(contains(r.err, problem)) << "stderr does not say /" << problem << "/" << r;
 }
 
 // Runs the shell command line `command` with its stdout written to `out` and its stderr
