@@ -4,12 +4,14 @@
 set -euo pipefail
 
 # The one list of build dependencies (clang and libclang-rt-14-dev: the libFuzzer build;
-# clang-format: the style check in CI).
+# clang-format: the style check in CI; the python3-* and pybind11: the Python package, its
+# tests and examples, for /usr/bin/python3; parallel: the cluster recipe's test).
 packages=(
   cmake g++ pkg-config
   libopenimageio-dev libopencolorio-dev libopenexr-dev libeigen3-dev
   libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev clang-format
+  python3-dev python3-numpy python3-pytest python3-matplotlib pybind11-dev parallel
 )
 
 missing=()

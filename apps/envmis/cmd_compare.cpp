@@ -19,7 +19,7 @@
 #include "envmis/study/comparison/sweeps.h"
 #include "envmis/table/atomic_file.h"
 #include "render.h"
-#include "results.h"
+#include "envmis/report/results.h"
 #include "sweeps.h"
 
 namespace envmis::cli {

@@ -18,7 +18,7 @@
 
 #include "cli.h"
 #include "envmis/table/atomic_file.h"
-#include "results.h"
+#include "envmis/report/results.h"
 
 namespace envmis::cli {
 namespace {

@@ -6,7 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "results.h"
+#include "envmis/report/results.h"
 
 namespace envmis::cli {
 namespace {

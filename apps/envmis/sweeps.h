@@ -41,7 +41,7 @@ pictures::LinePlot allocation_plot(const AllocationSweep& sweep, const std::stri
 // reference line at 1.
 pictures::BarChart variance_chart(const Comparison& comparison, const std::string& map_name);
 
-// A sweep row as the JSON arrays hold it (the TechniqueStats through results.h).
+// A sweep row as the JSON arrays hold it (the TechniqueStats through envmis/report/results.h).
 nlohmann::json sweep_row_json(const SweepRow& row);
 // The CSV header (no newline) and one row: `prefix` holds the leading map,spp,seed,points
 // fields with their trailing comma.

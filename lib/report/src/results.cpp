@@ -1,9 +1,9 @@
-#include "results.h"
+#include "envmis/report/results.h"
 
 #include <cstdio>
 #include <stdexcept>
 
-namespace envmis::cli {
+namespace envmis {
 namespace {
 
 struct Figure {
@@ -126,4 +126,4 @@ nlohmann::json stats_results_json(const Comparison& comparison, const std::funct
     return results;
 }
 
-}  // namespace envmis::cli
+}  // namespace envmis

@@ -14,7 +14,7 @@
 
 #include "envmis/study/comparison/comparison.h"
 
-namespace envmis::cli {
+namespace envmis {
 
 // A figure of TechniqueStats by key: mean, reference, variance, std_error, rel_mse,
 // ns_per_estimate, efficiency, variance_ratio_vs_mis, variance_ratio_log_std_error.
@@ -67,4 +67,4 @@ void write_stats_csv(std::ostream& out, const Comparison& comparison, const std:
 // compare's JSON "results": one full object per BSDF and technique, with "bsdf" and "alpha".
 nlohmann::json stats_results_json(const Comparison& comparison, const std::function<float(const Bsdf&)>& alpha_of);
 
-}  // namespace envmis::cli
+}  // namespace envmis
