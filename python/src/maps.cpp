@@ -129,7 +129,7 @@ py::object radiance_view(const py::object& self) {
 }
 
 std::shared_ptr<EnvMap> from_array(const py::object& radiance, const BuildOptions& options) {
-    const auto array = float_array(radiance, "envmis.EnvMap", "radiance", {-1, -1, 3});
+    const auto array = float_array(radiance, "envmis.EnvMap", "radiance", {-1, -1, 3}, "HW");
     if (array.shape(0) > UINT32_MAX || array.shape(1) > UINT32_MAX)
         throw std::invalid_argument("envmis.EnvMap: radiance: more than 2^32 - 1 rows or columns");
     RgbImage image{static_cast<uint32_t>(array.shape(1)), static_cast<uint32_t>(array.shape(0)),

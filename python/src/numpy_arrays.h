@@ -10,6 +10,7 @@
 #include <initializer_list>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace envmis::python {
@@ -17,17 +18,18 @@ namespace envmis::python {
 namespace py = pybind11;
 
 // A C-contiguous float32 array. `shape` lists the expected extents, -1 for any
-// ("(N, 3)" is {-1, 3}). Throws ValueError (std::invalid_argument) otherwise:
-// "envmis.EnvMap.sample: u must be a float32 array of shape (N, 2); got a float64 array of shape (10, 2)".
-// Arrays of another dtype are never converted silently: a float64 array of directions
-// rounded to float32 would give other samples than the caller's values.
+// ("(N, 3)" is {-1, 3}), named in the message by `symbols` in turn ("HW": "(H, W, 3)"). Throws ValueError
+// (std::invalid_argument) otherwise: "envmis.EnvMap.sample: u must be a float32 array of shape (N, 2); got a float64
+// array of shape (10, 2)". Arrays of another dtype are never converted silently: a float64 array of directions rounded
+// to float32 would give other samples than the caller's values.
 inline py::array_t<float, py::array::c_style> float_array(const py::handle& object, const char* where, const char* name,
-                                                          std::initializer_list<py::ssize_t> shape) {
+                                                          std::initializer_list<py::ssize_t> shape,
+                                                          std::string_view symbols = "NM") {
     std::string expected = "(";
-    char symbol = 'N';
+    size_t symbol = 0;
     for (const py::ssize_t extent : shape) {
         if (expected.size() > 1) expected += ", ";
-        expected += extent < 0 ? std::string(1, symbol++) : std::to_string(extent);
+        expected += extent < 0 ? std::string(1, symbols.at(symbol++)) : std::to_string(extent);
     }
     expected += shape.size() == 1 ? ",)" : ")";
     auto fail = [&](const std::string& given) {

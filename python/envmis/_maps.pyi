@@ -1,0 +1,128 @@
+"""envmis maps, tables and sampling (type stubs; the docstrings are in the module).
+
+Directions: float32 unit vectors in the map's world frame. pdf: per steradian.
+Radiance: linear RGB in the map's working colour space. uv: image points in [0, 1)^2.
+Every array argument must be float32 and C-contiguous; others raise ValueError.
+"""
+
+import os
+from typing import Literal, NamedTuple, TypedDict
+
+import numpy as np
+import numpy.typing as npt
+
+_F32 = npt.NDArray[np.float32]
+_Path = str | os.PathLike[str]
+
+class ImageError(OSError): ...
+class TableError(OSError): ...
+
+class Samples(NamedTuple):
+    direction: _F32  # (N, 3) unit vectors, world frame
+    pdf: _F32  # (N,) per steradian
+    radiance: _F32  # (N, 3) linear RGB, working space
+    uv: _F32  # (N, 2) image points in [0, 1)^2
+
+class BadPixels(TypedDict):
+    nan: int
+    infinite: int
+    negative: int
+
+class MapStats(TypedDict):
+    bad_pixels: BadPixels
+    mean_luminance: float
+    threshold: float
+    max_luminance: float
+    min_positive_luminance: float
+    zeroed_texels: int
+    fallback: Literal["none", "uncompensated", "uniform"]
+
+class MapOptions(TypedDict):
+    compensate: bool
+    alpha: float
+    axes: str
+    mapping: Literal["equirect", "equal-area"]
+    luma: tuple[float, float, float]
+
+class MapSource(TypedDict):
+    name: str
+    content_hash: int
+    input_colorspace: str
+    working_colorspace: str
+
+class EnvMap:
+    def __init__(
+        self,
+        radiance: _F32,
+        *,
+        compensate: bool = True,
+        alpha: float | Literal["auto"] = 1.0,
+        axes: str = "z-up",
+        mapping: Literal["equirect", "equal-area"] = "equirect",
+        colorspace: str | None = None,
+        working_space: str = "lin_rec709",
+    ) -> None: ...
+    @property
+    def width(self) -> int: ...
+    @property
+    def height(self) -> int: ...
+    @property
+    def compensated(self) -> bool: ...
+    @property
+    def complete(self) -> bool: ...
+    @property
+    def options(self) -> MapOptions: ...
+    @property
+    def stats(self) -> MapStats: ...
+    @property
+    def source(self) -> MapSource: ...
+    @property
+    def mapped(self) -> bool: ...
+    @property
+    def radiance(self) -> _F32: ...  # (H, W, 3), read-only view
+    @property
+    def density(self) -> _F32: ...  # (H, W), read-only, computed on first access
+    def sample(self, u: _F32) -> Samples: ...
+    def pdf(self, directions: _F32) -> _F32: ...
+    def eval(self, directions: _F32) -> _F32: ...
+    def save(self, path: _Path, *, compact: bool = False) -> None: ...
+
+class BinnedEnvMap:
+    @property
+    def plain(self) -> EnvMap: ...
+    @property
+    def width(self) -> int: ...
+    @property
+    def height(self) -> int: ...
+    @property
+    def bins(self) -> int: ...
+    @property
+    def classes(self) -> int: ...
+    @property
+    def lobe_exponents(self) -> list[float]: ...
+    @property
+    def source(self) -> MapSource: ...
+    @property
+    def mapped(self) -> bool: ...
+    def lobe_class(self, phong_exponent: float) -> int: ...
+    def complete(self, lobe: int) -> bool: ...
+    def sample(self, u: _F32, normals: _F32, lobe: int = 0) -> Samples: ...
+    def pdf(self, directions: _F32, normals: _F32, lobe: int = 0) -> _F32: ...
+    def eval(self, directions: _F32) -> _F32: ...
+    def save(self, path: _Path, *, compact: bool = False) -> None: ...
+
+def load(
+    path: _Path,
+    *,
+    compensate: bool = True,
+    alpha: float | Literal["auto"] | None = None,
+    axes: str = "z-up",
+    mapping: Literal["equirect", "equal-area"] = "equirect",
+    colorspace: str | None = None,
+    working_space: str = "lin_rec709",
+    bins: int = 0,
+    cell_columns: int = 0,
+) -> EnvMap | BinnedEnvMap: ...
+def load_table(path: _Path, *, mapped: bool = True) -> EnvMap | BinnedEnvMap: ...
+def uniform_points(n: int, seed: int) -> _F32: ...
+def _time_sample_many(map: EnvMap, u: _F32, repeats: int) -> float: ...

@@ -1,0 +1,63 @@
+#!/usr/bin/python3
+"""The cost of sampling from Python against the C++ batch call, in one process.
+
+For each map: ns/sample of EnvMap.sample(u) at N points (u from envmis.uniform_points,
+outputs (N, 3)/(N,)/(N, 2) arrays allocated by the call), and of the core's sample_many on
+the same map and points (one array per coordinate, outputs preallocated, image points
+included), timed inside C++ by envmis._maps._time_sample_many; medians over --repeats
+runs each, interleaved so that both see the same machine load. Run with the package on
+the path:
+
+    PYTHONPATH=build/python /usr/bin/python3 scripts/python_bench.py
+"""
+
+import argparse
+import os
+import pathlib
+import statistics
+import time
+
+import numpy as np
+
+import envmis
+
+
+def synthetic(width, height, seed=1):
+    """A sky with a sun: a few decades of dynamic range, one bright spot."""
+    rng = np.random.default_rng(seed)
+    radiance = rng.lognormal(0.0, 1.0, size=(height, width, 3)).astype(np.float32)
+    radiance[height // 5 : height // 5 + 4, width // 3 : width // 3 + 4] = 1e4
+    return envmis.EnvMap(radiance)
+
+
+def measure(env, n, repeats):
+    u = envmis.uniform_points(n, seed=1)
+    env.sample(u)  # warm: pages of the outputs and of the map
+    python, cpp = [], []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        env.sample(u)
+        python.append(time.perf_counter() - start)
+        cpp.append(envmis._maps._time_sample_many(env, u, 1))
+    return statistics.median(python) * 1e9 / n, statistics.median(cpp) * 1e9 / n
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("-n", type=int, default=1_000_000, help="points per call")
+    parser.add_argument("--repeats", type=int, default=15)
+    parser.add_argument("--large", action="store_true", help="also a 4096x2048 synthetic map")
+    args = parser.parse_args()
+    source = pathlib.Path(os.environ.get("ENVMIS_SOURCE_DIR", pathlib.Path(__file__).parents[1]))
+    maps = [("rooitou_park_1k.hdr", envmis.load(source / "data" / "envmaps" / "rooitou_park_1k.hdr"))]
+    if args.large:
+        maps.append(("synthetic 4096x2048", synthetic(4096, 2048)))
+    print(f"N = {args.n}, median of {args.repeats}")
+    print(f"{'map':24} {'Python ns/sample':>17} {'C++ ns/sample':>14} {'ratio':>6}")
+    for name, env in maps:
+        python, cpp = measure(env, args.n, args.repeats)
+        print(f"{name:24} {python:17.2f} {cpp:14.2f} {python / cpp:6.3f}")
+
+
+if __name__ == "__main__":
+    main()
