@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """The cost of sampling from Python against the C++ batch call, in one process.
 
-For each map: ns/sample of EnvMap.sample(u) at N points (u from envmis.uniform_points,
-outputs (N, 3)/(N,)/(N, 2) arrays allocated by the call), and of the core's sample_many on
+For each map: ns/sample of EnvMap.sample(u) at N points (u from envmis.uniform_points),
+with new output arrays each call and with out= an earlier call's, and of the core's sample_many on
 the same map and points (one array per coordinate, outputs preallocated, image points
 included), timed inside C++ by envmis._maps._time_sample_many; medians over --repeats
 runs each, interleaved so that both see the same machine load. Run with the package on
@@ -32,14 +32,17 @@ def synthetic(width, height, seed=1):
 
 def measure(env, n, repeats):
     u = envmis.uniform_points(n, seed=1)
-    env.sample(u)  # warm: pages of the outputs and of the map
-    python, cpp = [], []
+    out = env.sample(u)  # also warms the map's pages
+    fresh, reused, cpp = [], [], []
     for _ in range(repeats):
         start = time.perf_counter()
         env.sample(u)
-        python.append(time.perf_counter() - start)
+        fresh.append(time.perf_counter() - start)
+        start = time.perf_counter()
+        env.sample(u, out=out)
+        reused.append(time.perf_counter() - start)
         cpp.append(envmis._maps._time_sample_many(env, u, 1))
-    return statistics.median(python) * 1e9 / n, statistics.median(cpp) * 1e9 / n
+    return [statistics.median(t) * 1e9 / n for t in (fresh, reused, cpp)]
 
 
 def main():
@@ -53,10 +56,10 @@ def main():
     if args.large:
         maps.append(("synthetic 4096x2048", synthetic(4096, 2048)))
     print(f"N = {args.n}, median of {args.repeats}")
-    print(f"{'map':24} {'Python ns/sample':>17} {'C++ ns/sample':>14} {'ratio':>6}")
+    print(f"{'map':22} {'new outputs':>12} {'out= reused':>12} {'C++ batch':>10}  ns/sample; ratios to C++")
     for name, env in maps:
-        python, cpp = measure(env, args.n, args.repeats)
-        print(f"{name:24} {python:17.2f} {cpp:14.2f} {python / cpp:6.3f}")
+        fresh, reused, cpp = measure(env, args.n, args.repeats)
+        print(f"{name:22} {fresh:12.2f} {reused:12.2f} {cpp:10.2f}  {fresh / cpp:.3f} {reused / cpp:.3f}")
 
 
 if __name__ == "__main__":

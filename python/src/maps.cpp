@@ -143,14 +143,21 @@ std::shared_ptr<EnvMap> from_array(const py::object& radiance, const BuildOption
     return held(std::move(built.map), {std::move(built.source), false});
 }
 
-// The outputs of sample for n points, as the Samples named tuple.
+// The outputs of sample for n points, as the Samples named tuple: new arrays, or the
+// caller's `out` (a Samples of arrays of the right shapes) to write into.
 struct SampleOutputs {
     py::array_t<float> direction, pdf, radiance, uv;
-    explicit SampleOutputs(py::ssize_t n)
-        : direction(new_float_array({n, 3})),
-          pdf(new_float_array({n})),
-          radiance(new_float_array({n, 3})),
-          uv(new_float_array({n, 2})) {}
+    SampleOutputs(py::ssize_t n, const py::object& out, const char* where) {
+        if (out.is_none()) {
+            direction = new_float_array({n, 3}), pdf = new_float_array({n});
+            radiance = new_float_array({n, 3}), uv = new_float_array({n, 2});
+            return;
+        }
+        direction = float_array(out.attr("direction"), where, "out.direction", {n, 3});
+        pdf = float_array(out.attr("pdf"), where, "out.pdf", {n});
+        radiance = float_array(out.attr("radiance"), where, "out.radiance", {n, 3});
+        uv = float_array(out.attr("uv"), where, "out.uv", {n, 2});
+    }
     InterleavedSamples arrays() {
         return {direction.mutable_data(), pdf.mutable_data(), radiance.mutable_data(), uv.mutable_data()};
     }
@@ -159,9 +166,10 @@ struct SampleOutputs {
     }
 };
 
-py::object sample_plain(const EnvMap& map, const py::object& u_object) {
-    const auto u = float_array(u_object, "envmis.EnvMap.sample", "u", {-1, 2});
-    SampleOutputs out(u.shape(0));
+py::object sample_plain(const EnvMap& map, const py::object& u_object, const py::object& out_object) {
+    const char* where = "envmis.EnvMap.sample";
+    const auto u = float_array(u_object, where, "u", {-1, 2});
+    SampleOutputs out(u.shape(0), out_object, where);
     const InterleavedSamples arrays = out.arrays();
     {
         py::gil_scoped_release released;
@@ -203,12 +211,12 @@ uint32_t lobe_of(const BinnedEnvMap& map, uint32_t lobe, const char* where) {
 }
 
 py::object sample_binned(const BinnedEnvMap& map, const py::object& u_object, const py::object& normals_object,
-                         uint32_t lobe) {
+                         uint32_t lobe, const py::object& out_object) {
     const char* where = "envmis.BinnedEnvMap.sample";
     const auto u = float_array(u_object, where, "u", {-1, 2});
     const auto normals = normals_for(normals_object, where, u.shape(0), "u");
     lobe_of(map, lobe, where);
-    SampleOutputs out(u.shape(0));
+    SampleOutputs out(u.shape(0), out_object, where);
     const InterleavedSamples arrays = out.arrays();
     {
         py::gil_scoped_release released;
@@ -269,7 +277,7 @@ void bind_envmap(py::module_& m) {
             "mapped", [](const std::shared_ptr<EnvMap>& map) { return provenance_of(map).mapped; }, docs::kMapped)
         .def_property_readonly("radiance", &radiance_view, docs::kRadiance)
         .def_property_readonly("density", &density_view, docs::kDensity)
-        .def("sample", &sample_plain, py::arg("u"), docs::kSample)
+        .def("sample", &sample_plain, py::arg("u"), py::kw_only(), py::arg("out") = py::none(), docs::kSample)
         .def(
             "pdf", [](const EnvMap& map, const py::object& d) { return lookup_plain(map, d, true); },
             py::arg("directions"), docs::kPdf)
@@ -310,7 +318,8 @@ void bind_binned(py::module_& m) {
             docs::kSource)
         .def_property_readonly(
             "mapped", [](const std::shared_ptr<BinnedEnvMap>& map) { return provenance_of(map).mapped; }, docs::kMapped)
-        .def("sample", &sample_binned, py::arg("u"), py::arg("normals"), py::arg("lobe") = 0, docs::kBinnedSample)
+        .def("sample", &sample_binned, py::arg("u"), py::arg("normals"), py::arg("lobe") = 0, py::kw_only(),
+             py::arg("out") = py::none(), docs::kBinnedSample)
         .def("pdf", &pdf_binned, py::arg("directions"), py::arg("normals"), py::arg("lobe") = 0, docs::kBinnedPdf)
         .def(
             "eval", [](const BinnedEnvMap& map, const py::object& d) { return lookup_plain(map.plain(), d, false); },

@@ -1,6 +1,7 @@
 #include "maps_build.h"
 
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <utility>
 
@@ -71,8 +72,11 @@ Built build(RgbImage image, const BuildOptions& o, LumaCoefficients luma, const 
 
 void check(const BuildOptions& o) {
     check_bins(o.bins);
-    if (o.alpha && !(*o.alpha >= 0 && std::isfinite(*o.alpha)))
-        throw std::invalid_argument("alpha: '" + std::to_string(*o.alpha) + "': expected a number >= 0 or auto");
+    if (o.alpha && !(*o.alpha >= 0 && std::isfinite(*o.alpha))) {
+        std::ostringstream text;
+        text << *o.alpha;
+        throw std::invalid_argument("alpha: '" + text.str() + "': expected a number >= 0 or auto");
+    }
     if (o.cell_columns > 4096)
         throw std::invalid_argument("cell_columns: Value " + std::to_string(o.cell_columns) +
                                     " not in range 0 to 4096");

@@ -84,8 +84,11 @@ u: float32 (N, 2), points in [0, 1)^2 (a random or low-discrepancy sequence;
    envmis.uniform_points gives what `envmis sample` draws). Returns Samples (direction,
    pdf per steradian, radiance, uv), bit-identical to N calls of the C++ EnvMap::sample,
    through the core's batch call sample_many (SIMD with AVX2). Cost: O(N), about the C++
-   batch call's per sample (docs/performance.md), GIL released; allocates the four
-   output arrays (N x 36 bytes).)";
+   batch call's per sample (docs/performance.md), GIL released.
+out: None (new arrays, N x 36 bytes), or a Samples of float32 C-contiguous arrays of
+   these shapes (an earlier call's) to write into and return. Reusing them matters at
+   large N: writing fresh pages costs the kernel's page faults, which on a virtual machine
+   can cost more than the sampling (docs/performance.md, "Python").)";
 inline constexpr const char* kPdf = R"(The solid-angle pdf (per steradian) of sampling each direction.
 
 directions: float32 (N, 3), unit vectors in the map's world frame. They are not
@@ -123,7 +126,7 @@ inline constexpr const char* kBinnedSample = R"(Directions drawn for N (point, n
 u: float32 (N, 2) in [0, 1)^2; normals: float32 (N, 3), the shading normals in the world
 frame (their bin: the octahedral cell of the normalised vector); lobe: the lobe class (0
 to classes - 1). Returns Samples as EnvMap.sample does, bit-identical to N single calls
-of the C++ BinnedEnvMapView::sample. O(N), GIL released.)";
+of the C++ BinnedEnvMapView::sample; out as EnvMap.sample's. O(N), GIL released.)";
 inline constexpr const char* kBinnedPdf = R"(The solid-angle pdf (per steradian) of each direction under the bin
 its normal picks (lobe class `lobe`): what sample() with that normal would have drawn.
 

@@ -276,7 +276,7 @@ def test_a_bad_file_raises_the_message_the_command_prints(tmp_path, case):
     [
         ({"bins": 5}, "bins: 5: expected a square number of bins (g x g octahedral grid) from 1 to 4096"),
         ({"alpha": "fast"}, "alpha: 'fast': expected a number >= 0 or auto"),
-        ({"alpha": -1.0}, "alpha: '-1.000000': expected a number >= 0 or auto"),
+        ({"alpha": -1.5}, "alpha: '-1.5': expected a number >= 0 or auto"),
         ({"mapping": "equal-area"}, "an equal-area map must be square, this one is 1024x512"),
         ({"axes": "up"}, "up"),
     ],
@@ -300,3 +300,16 @@ def test_every_public_name_of_the_module_has_a_stub_and_a_docstring():
     for name in public:
         assert getattr(envmis._maps, name).__doc__, name
     assert "per steradian" in envmis.EnvMap.pdf.__doc__
+
+
+def test_sample_writes_into_the_arrays_of_out_and_checks_their_shapes(small_maps):
+    env = small_maps["compensated"]
+    u = envmis.uniform_points(100, seed=4)
+    out = env.sample(envmis.uniform_points(100, seed=5))
+    again = env.sample(u, out=out)
+    assert all(a is b for a, b in zip(again, out))
+    for a, b in zip(out, env.sample(u)):
+        assert np.array_equal(bits(a), bits(b))
+    short = out._replace(uv=np.zeros((99, 2), np.float32))
+    with pytest.raises(ValueError, match=r"out.uv must be a float32 array of shape \(100, 2\); got .* \(99, 2\)"):
+        env.sample(u, out=short)
