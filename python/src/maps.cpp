@@ -1,4 +1,402 @@
-// envmis._maps: maps, tables and sampling.
+// envmis._maps: maps, tables and sampling, with NumPy arrays in and out.
+//
+// envmis::EnvMap and envmis::BinnedEnvMap are bound as themselves, each held by a
+// std::shared_ptr (py::class_<EnvMap, std::shared_ptr<EnvMap>>), so that envmis._study,
+// which imports this module, takes them as arguments (const EnvMap&,
+// std::shared_ptr<const BinnedEnvMap>) through pybind11's shared type registry. A binned
+// map's `plain` is a shared_ptr aliasing the binned map, which it keeps alive.
+//
+// What a C++ map does not hold, where it came from (TableSource) and whether its
+// radiance maps a table file, rides in its shared_ptr's deleter (Provenance), so that it
+// follows the map into every Python object of it, a binned map's plain map included.
+// The density, which EnvMap does not keep (its buffer became the CDF), is computed on
+// first access and kept in the Python object's __dict__.
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
-PYBIND11_MODULE(_maps, m) { m.doc() = "envmis maps, tables and sampling"; }
+#include <cstring>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <utility>
+
+#include "envmis/io/image_io.h"
+#include "maps_batch.h"
+#include "maps_build.h"
+#include "maps_docs.h"
+#include "numpy_arrays.h"
+
+namespace envmis::python {
+namespace {
+
+struct Provenance {
+    TableSource source;
+    bool mapped = false;
+};
+
+template <class T>
+struct Deleter {
+    Provenance provenance;
+    void operator()(T* map) const noexcept { delete map; }
+};
+
+template <class T>
+std::shared_ptr<T> held(T map, Provenance provenance) {
+    return std::shared_ptr<T>(new T(std::move(map)), Deleter<T>{std::move(provenance)});
+}
+
+// Maps made elsewhere (by envmis._study, say) have none: an empty source.
+template <class T>
+Provenance provenance_of(const std::shared_ptr<T>& map) {
+    if (const auto* d = std::get_deleter<Deleter<EnvMap>>(map)) return d->provenance;
+    if (const auto* d = std::get_deleter<Deleter<BinnedEnvMap>>(map)) return d->provenance;
+    return {};
+}
+
+py::object to_python(Built built) {
+    const py::object warn = py::module_::import("warnings").attr("warn");
+    for (const std::string& notice : built.notices) warn(notice, py::arg("stacklevel") = 2);
+    Provenance provenance{std::move(built.source), built.mapped};
+    if (built.binned) return py::cast(held(std::move(*built.binned), std::move(provenance)));
+    return py::cast(held(std::move(built.map), std::move(provenance)));
+}
+
+// alpha: None (not given), a number, or "auto"; the messages are the command line's.
+BuildOptions build_options(bool compensate, const py::object& alpha, std::string axes, std::string mapping,
+                           const py::object& colorspace, std::string working_space) {
+    BuildOptions o;
+    o.compensate = compensate;
+    if (py::isinstance<py::str>(alpha)) {
+        const auto text = alpha.cast<std::string>();
+        if (text != "auto") throw std::invalid_argument("alpha: '" + text + "': expected a number >= 0 or auto");
+        o.alpha_auto = true;
+    } else if (!alpha.is_none()) {
+        o.alpha = alpha.cast<float>();
+    }
+    o.axes = std::move(axes);
+    o.mapping = std::move(mapping);
+    if (!colorspace.is_none()) o.colorspace = colorspace.cast<std::string>();
+    o.working_space = std::move(working_space);
+    return o;
+}
+
+py::dict source_dict(const TableSource& s) {
+    py::dict d;
+    d["name"] = s.name, d["content_hash"] = s.content_hash;
+    d["input_colorspace"] = s.input_colorspace, d["working_colorspace"] = s.working_colorspace;
+    return d;
+}
+
+py::dict stats_dict(const EnvMapStats& s) {
+    py::dict bad, d;
+    bad["nan"] = s.bad_pixels.nan, bad["infinite"] = s.bad_pixels.infinite, bad["negative"] = s.bad_pixels.negative;
+    d["bad_pixels"] = bad, d["mean_luminance"] = s.mean_luminance, d["threshold"] = s.threshold;
+    d["max_luminance"] = s.max_luminance, d["min_positive_luminance"] = s.min_positive_luminance;
+    d["zeroed_texels"] = s.zeroed_texels, d["fallback"] = std::string(to_string(s.fallback));
+    return d;
+}
+
+py::dict options_dict(const EnvMapOptions& o) {
+    py::dict d;
+    d["compensate"] = o.compensation.enabled, d["alpha"] = o.compensation.alpha;
+    d["axes"] = o.axes.to_string(), d["mapping"] = std::string(to_string(o.mapping));
+    d["luma"] = py::make_tuple(o.luma.r, o.luma.g, o.luma.b);
+    return d;
+}
+
+// The density, computed once per Python object (EnvMap::density(): O(w h)).
+py::object density_view(const py::object& self) {
+    const py::dict cache = self.attr("__dict__");
+    if (cache.contains("_density")) return cache["_density"];
+    const auto& map = self.cast<const EnvMap&>();
+    auto values = std::make_unique<std::vector<float>>();
+    {
+        py::gil_scoped_release released;
+        *values = map.density();
+    }
+    const float* data = values->data();
+    const py::capsule owner(values.release(), [](void* p) { delete static_cast<std::vector<float>*>(p); });
+    py::object view = read_only_view(data, {map.height(), map.width()}, owner);
+    cache["_density"] = view;
+    return view;
+}
+
+py::object radiance_view(const py::object& self) {
+    const auto& map = self.cast<const EnvMap&>();
+    return read_only_view(reinterpret_cast<const float*>(map.radiance().pixels.data()), {map.height(), map.width(), 3},
+                          self);
+}
+
+std::shared_ptr<EnvMap> from_array(const py::object& radiance, const BuildOptions& options) {
+    const auto array = float_array(radiance, "envmis.EnvMap", "radiance", {-1, -1, 3});
+    if (array.shape(0) > UINT32_MAX || array.shape(1) > UINT32_MAX)
+        throw std::invalid_argument("envmis.EnvMap: radiance: more than 2^32 - 1 rows or columns");
+    RgbImage image{static_cast<uint32_t>(array.shape(1)), static_cast<uint32_t>(array.shape(0)),
+                   std::vector<Rgb>(static_cast<size_t>(array.shape(0)) * array.shape(1))};
+    std::memcpy(static_cast<void*>(image.pixels.data()), array.data(), image.pixels.size() * sizeof(Rgb));
+    Built built;
+    {
+        py::gil_scoped_release released;
+        built = from_pixels(std::move(image), options);
+    }
+    return held(std::move(built.map), {std::move(built.source), false});
+}
+
+// The outputs of sample for n points, as the Samples named tuple.
+struct SampleOutputs {
+    py::array_t<float> direction, pdf, radiance, uv;
+    explicit SampleOutputs(py::ssize_t n)
+        : direction(new_float_array({n, 3})),
+          pdf(new_float_array({n})),
+          radiance(new_float_array({n, 3})),
+          uv(new_float_array({n, 2})) {}
+    InterleavedSamples arrays() {
+        return {direction.mutable_data(), pdf.mutable_data(), radiance.mutable_data(), uv.mutable_data()};
+    }
+    py::object to_python() const {
+        return py::module_::import("envmis._maps").attr("Samples")(direction, pdf, radiance, uv);
+    }
+};
+
+py::object sample_plain(const EnvMap& map, const py::object& u_object) {
+    const auto u = float_array(u_object, "envmis.EnvMap.sample", "u", {-1, 2});
+    SampleOutputs out(u.shape(0));
+    const InterleavedSamples arrays = out.arrays();
+    {
+        py::gil_scoped_release released;
+        sample(map.view(), u.data(), arrays, static_cast<size_t>(u.shape(0)));
+    }
+    return out.to_python();
+}
+
+py::array_t<float> lookup_plain(const EnvMap& map, const py::object& directions_object, bool pdf) {
+    const char* where = pdf ? "envmis.EnvMap.pdf" : "envmis.EnvMap.eval";
+    const auto directions = float_array(directions_object, where, "directions", {-1, 3});
+    const py::ssize_t n = directions.shape(0);
+    py::array_t<float> out = pdf ? new_float_array({n}) : new_float_array({n, 3});
+    float* data = out.mutable_data();
+    {
+        py::gil_scoped_release released;
+        lookup(map.view(), directions.data(), {pdf ? data : nullptr, pdf ? nullptr : data}, static_cast<size_t>(n));
+    }
+    return out;
+}
+
+// Normals for n points: float32 (n, 3), n the length of the other argument.
+py::array_t<float, py::array::c_style> normals_for(const py::object& normals, const char* where, py::ssize_t n,
+                                                   const char* other) {
+    auto array = float_array(normals, where, "normals", {-1, 3});
+    if (array.shape(0) != n)
+        throw std::invalid_argument(
+            std::string(where) + ": normals must be a float32 array of shape (N, 3) with N = " + std::to_string(n) +
+            ", the length of " + other + "; got " + std::to_string(array.shape(0)) + " normals");
+    return array;
+}
+
+uint32_t lobe_of(const BinnedEnvMap& map, uint32_t lobe, const char* where) {
+    if (lobe >= map.classes())
+        throw std::invalid_argument(std::string(where) + ": lobe " + std::to_string(lobe) +
+                                    " is not a lobe class of this map (0 to " + std::to_string(map.classes() - 1) +
+                                    ")");
+    return lobe;
+}
+
+py::object sample_binned(const BinnedEnvMap& map, const py::object& u_object, const py::object& normals_object,
+                         uint32_t lobe) {
+    const char* where = "envmis.BinnedEnvMap.sample";
+    const auto u = float_array(u_object, where, "u", {-1, 2});
+    const auto normals = normals_for(normals_object, where, u.shape(0), "u");
+    lobe_of(map, lobe, where);
+    SampleOutputs out(u.shape(0));
+    const InterleavedSamples arrays = out.arrays();
+    {
+        py::gil_scoped_release released;
+        sample(map.view(), lobe, normals.data(), u.data(), arrays, static_cast<size_t>(u.shape(0)));
+    }
+    return out.to_python();
+}
+
+py::array_t<float> pdf_binned(const BinnedEnvMap& map, const py::object& directions_object,
+                              const py::object& normals_object, uint32_t lobe) {
+    const char* where = "envmis.BinnedEnvMap.pdf";
+    const auto directions = float_array(directions_object, where, "directions", {-1, 3});
+    const py::ssize_t n = directions.shape(0);
+    const auto normals = normals_for(normals_object, where, n, "directions");
+    lobe_of(map, lobe, where);
+    py::array_t<float> out = new_float_array({n});
+    float* data = out.mutable_data();
+    {
+        py::gil_scoped_release released;
+        lookup(map.view(), lobe, normals.data(), directions.data(), {data, nullptr}, static_cast<size_t>(n));
+    }
+    return out;
+}
+
+std::string describe(const EnvMap& map, const TableSource& source) {
+    std::ostringstream text;
+    text << map.width() << "x" << map.height() << " " << to_string(map.options().mapping) << ", ";
+    if (map.compensated())
+        text << "compensated (alpha " << map.options().compensation.alpha << ")";
+    else
+        text << "uncompensated";
+    if (!source.name.empty()) text << ", from " << source.name;
+    return text.str();
+}
+
+void bind_envmap(py::module_& m) {
+    py::class_<EnvMap, std::shared_ptr<EnvMap>>(m, "EnvMap", py::dynamic_attr(), docs::kEnvMap)
+        .def(py::init([](const py::object& radiance, bool compensate, const py::object& alpha, std::string axes,
+                         std::string mapping, const py::object& colorspace, std::string working_space) {
+                 return from_array(radiance, build_options(compensate, alpha, std::move(axes), std::move(mapping),
+                                                           colorspace, std::move(working_space)));
+             }),
+             py::arg("radiance"), py::kw_only(), py::arg("compensate") = true, py::arg("alpha") = 1.0f,
+             py::arg("axes") = "z-up", py::arg("mapping") = "equirect", py::arg("colorspace") = py::none(),
+             py::arg("working_space") = "lin_rec709", docs::kEnvMapInit)
+        .def_property_readonly("width", &EnvMap::width, "Columns of the image (texels).")
+        .def_property_readonly("height", &EnvMap::height, "Rows of the image (texels).")
+        .def_property_readonly("compensated", &EnvMap::compensated, docs::kCompensated)
+        .def_property_readonly("complete", &EnvMap::complete, docs::kComplete)
+        .def_property_readonly(
+            "options", [](const EnvMap& map) { return options_dict(map.options()); }, docs::kOptions)
+        .def_property_readonly(
+            "stats", [](const EnvMap& map) { return stats_dict(map.stats()); }, docs::kStats)
+        .def_property_readonly(
+            "source", [](const std::shared_ptr<EnvMap>& map) { return source_dict(provenance_of(map).source); },
+            docs::kSource)
+        .def_property_readonly(
+            "mapped", [](const std::shared_ptr<EnvMap>& map) { return provenance_of(map).mapped; }, docs::kMapped)
+        .def_property_readonly("radiance", &radiance_view, docs::kRadiance)
+        .def_property_readonly("density", &density_view, docs::kDensity)
+        .def("sample", &sample_plain, py::arg("u"), docs::kSample)
+        .def(
+            "pdf", [](const EnvMap& map, const py::object& d) { return lookup_plain(map, d, true); },
+            py::arg("directions"), docs::kPdf)
+        .def(
+            "eval", [](const EnvMap& map, const py::object& d) { return lookup_plain(map, d, false); },
+            py::arg("directions"), docs::kEval)
+        .def(
+            "save",
+            [](const std::shared_ptr<EnvMap>& map, const std::filesystem::path& path, bool compact) {
+                const TableSource source = provenance_of(map).source;
+                py::gil_scoped_release released;
+                write_table(path, *map, source, compact ? TableEncoding::compact : TableEncoding::full);
+            },
+            py::arg("path"), py::kw_only(), py::arg("compact") = false, docs::kSave)
+        .def("__repr__", [](const std::shared_ptr<EnvMap>& map) {
+            return "<envmis.EnvMap " + describe(*map, provenance_of(map).source) + ">";
+        });
+}
+
+void bind_binned(py::module_& m) {
+    py::class_<BinnedEnvMap, std::shared_ptr<BinnedEnvMap>>(m, "BinnedEnvMap", py::dynamic_attr(), docs::kBinned)
+        .def_property_readonly(
+            "plain",
+            [](const std::shared_ptr<BinnedEnvMap>& map) {
+                return std::shared_ptr<EnvMap>(map, const_cast<EnvMap*>(&map->plain()));
+            },
+            docs::kPlain)
+        .def_property_readonly("width", [](const BinnedEnvMap& map) { return map.plain().width(); })
+        .def_property_readonly("height", [](const BinnedEnvMap& map) { return map.plain().height(); })
+        .def_property_readonly("bins", &BinnedEnvMap::bins, "K = g^2, the bins of normals (a g x g octahedral grid).")
+        .def_property_readonly("classes", &BinnedEnvMap::classes, "The lobe classes (lobe arguments 0 to classes - 1).")
+        .def_property_readonly(
+            "lobe_exponents", [](const BinnedEnvMap& map) { return map.layout().lobe_exponents; }, docs::kExponents)
+        .def("lobe_class", &BinnedEnvMap::lobe_class, py::arg("phong_exponent"), docs::kLobeClass)
+        .def("complete", &BinnedEnvMap::complete, py::arg("lobe"), docs::kBinnedComplete)
+        .def_property_readonly(
+            "source", [](const std::shared_ptr<BinnedEnvMap>& map) { return source_dict(provenance_of(map).source); },
+            docs::kSource)
+        .def_property_readonly(
+            "mapped", [](const std::shared_ptr<BinnedEnvMap>& map) { return provenance_of(map).mapped; }, docs::kMapped)
+        .def("sample", &sample_binned, py::arg("u"), py::arg("normals"), py::arg("lobe") = 0, docs::kBinnedSample)
+        .def("pdf", &pdf_binned, py::arg("directions"), py::arg("normals"), py::arg("lobe") = 0, docs::kBinnedPdf)
+        .def(
+            "eval", [](const BinnedEnvMap& map, const py::object& d) { return lookup_plain(map.plain(), d, false); },
+            py::arg("directions"), docs::kEval)
+        .def(
+            "save",
+            [](const std::shared_ptr<BinnedEnvMap>& map, const std::filesystem::path& path, bool compact) {
+                const TableSource source = provenance_of(map).source;
+                py::gil_scoped_release released;
+                write_table(path, *map, source, compact ? TableEncoding::compact : TableEncoding::full);
+            },
+            py::arg("path"), py::kw_only(), py::arg("compact") = false, docs::kSave)
+        .def("__repr__", [](const std::shared_ptr<BinnedEnvMap>& map) {
+            return "<envmis.BinnedEnvMap " + std::to_string(map->bins()) + " bins over " +
+                   describe(map->plain(), provenance_of(map).source) + ">";
+        });
+}
+
+// The u that `envmis sample` draws for a seed (cmd_sample.cpp): mt19937_64, 24 bits a
+// coordinate, u.x then u.y.
+py::array_t<float> uniform_points(py::ssize_t n, uint64_t seed) {
+    if (n < 0) throw std::invalid_argument("envmis.uniform_points: n must be >= 0; got " + std::to_string(n));
+    py::array_t<float> out = new_float_array({n, 2});
+    float* data = out.mutable_data();
+    py::gil_scoped_release released;
+    std::mt19937_64 rng(seed);
+    for (py::ssize_t i = 0; i < 2 * n; ++i) data[i] = static_cast<float>(rng() >> 40) * 0x1p-24f;
+    return out;
+}
+
+void bind_functions(py::module_& m) {
+    m.def(
+        "load",
+        [](const std::filesystem::path& path, bool compensate, const py::object& alpha, std::string axes,
+           std::string mapping, const py::object& colorspace, std::string working_space, uint32_t bins,
+           uint32_t cell_columns) {
+            BuildOptions o = build_options(compensate, alpha, std::move(axes), std::move(mapping), colorspace,
+                                           std::move(working_space));
+            o.bins = bins, o.cell_columns = cell_columns;
+            Built built;
+            {
+                py::gil_scoped_release released;
+                built = load(path, o);
+            }
+            return to_python(std::move(built));
+        },
+        py::arg("path"), py::kw_only(), py::arg("compensate") = true, py::arg("alpha") = py::none(),
+        py::arg("axes") = "z-up", py::arg("mapping") = "equirect", py::arg("colorspace") = py::none(),
+        py::arg("working_space") = "lin_rec709", py::arg("bins") = 0, py::arg("cell_columns") = 0, docs::kLoad);
+    m.def(
+        "load_table",
+        [](const std::filesystem::path& path, bool mapped) {
+            Built built;
+            {
+                py::gil_scoped_release released;
+                built = load_table(path, mapped);
+            }
+            return to_python(std::move(built));
+        },
+        py::arg("path"), py::kw_only(), py::arg("mapped") = true, docs::kLoadTable);
+    m.def("uniform_points", &uniform_points, py::arg("n"), py::arg("seed"), docs::kUniformPoints);
+    m.def(
+        "_time_sample_many",
+        [](const EnvMap& map, const py::object& u_object, int repeats) {
+            const auto u = float_array(u_object, "envmis._time_sample_many", "u", {-1, 2});
+            if (repeats < 1) throw std::invalid_argument("envmis._time_sample_many: repeats must be >= 1");
+            py::gil_scoped_release released;
+            return time_sample_many(map.view(), u.data(), static_cast<size_t>(u.shape(0)), repeats);
+        },
+        py::arg("map"), py::arg("u"), py::arg("repeats"), docs::kTimeSampleMany);
+}
+
+}  // namespace
+}  // namespace envmis::python
+
+PYBIND11_MODULE(_maps, m) {
+    using namespace envmis::python;
+    m.doc() = docs::kModule;
+    py::register_exception<envmis::io::ImageError>(m, "ImageError", PyExc_OSError).doc() = docs::kImageError;
+    py::register_exception<envmis::TableError>(m, "TableError", PyExc_OSError).doc() = docs::kTableError;
+    const py::object samples = py::module_::import("collections")
+                                   .attr("namedtuple")("Samples", py::make_tuple("direction", "pdf", "radiance", "uv"),
+                                                       py::arg("module") = "envmis._maps");
+    samples.attr("__doc__") = docs::kSamples;
+    m.attr("Samples") = samples;
+    bind_envmap(m);
+    bind_binned(m);
+    bind_functions(m);
+}

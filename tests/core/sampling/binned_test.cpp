@@ -109,14 +109,16 @@ TEST(Binned, BatchCallsAreBitIdenticalToSingleCalls) {
         const Vec3 d = equirect_direction(rng.uniform2());
         dx[i] = d.x, dy[i] = d.y, dz[i] = d.z;
     }
-    float x[n], y[n], z[n], pdf[n], r[n], g[n], b[n];
-    sample_many(view, 1, {nx, ny, nz}, {ux, uy}, {x, y, z, pdf, r, g, b}, n);
+    float x[n], y[n], z[n], pdf[n], r[n], g[n], b[n], u[n], v[n];
+    sample_many(view, 1, {nx, ny, nz}, {ux, uy}, {x, y, z, pdf, r, g, b, u, v}, n);
     for (uint32_t i = 0; i < n; ++i) {
         const EnvSample s = view.sample({nx[i], ny[i], nz[i]}, 1, {ux[i], uy[i]});
         ASSERT_EQ(s.direction.x, x[i]);
         ASSERT_EQ(s.direction.z, z[i]);
         ASSERT_EQ(s.pdf, pdf[i]);
         ASSERT_EQ(s.radiance.g, g[i]);
+        ASSERT_EQ(s.uv.x, u[i]);
+        ASSERT_EQ(s.uv.y, v[i]);
     }
     lookup_many(view, 1, {nx, ny, nz}, {dx, dy, dz}, {r, g, b, pdf}, n);
     for (uint32_t i = 0; i < n; ++i) {

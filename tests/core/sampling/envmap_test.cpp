@@ -395,7 +395,7 @@ TEST(EnvMap, LookupManyIsBitIdenticalToLookup) {
 }
 
 // sample_many's SIMD path repeats sample's search and arithmetic likewise, for points
-// at the ends of [0,1), on the random generator's grid and off it.
+// at the ends of [0,1), on the random generator's grid and off it; the image points too.
 TEST(EnvMap, SampleManyIsBitIdenticalToSample) {
     const float edges[] = {0.0f, 0x1p-24f, 0.5f, 0.25f, 1 - 0x1p-24f, kOneMinusEpsilon};
     std::vector<Vec2> points;
@@ -411,16 +411,17 @@ TEST(EnvMap, SampleManyIsBitIdenticalToSample) {
     for (const Vec2 p : points) ux.push_back(p.x), uy.push_back(p.y);
     for (const EnvMap& map : batch_maps()) {
         const size_t n = points.size();
-        std::vector<float> x(n), y(n), z(n), pdf(n), r(n), g(n), b(n);
+        std::vector<float> x(n), y(n), z(n), pdf(n), r(n), g(n), b(n), u(n), v(n);
         const EnvMapView view = map.view();
         sample_many(view, {ux.data(), uy.data()},
-                    {x.data(), y.data(), z.data(), pdf.data(), r.data(), g.data(), b.data()}, static_cast<uint32_t>(n));
+                    {x.data(), y.data(), z.data(), pdf.data(), r.data(), g.data(), b.data(), u.data(), v.data()},
+                    static_cast<uint32_t>(n));
         for (size_t i = 0; i < n; ++i) {
             const EnvSample e = view.sample(points[i]);
-            const float expected[] = {e.direction.x, e.direction.y, e.direction.z, e.pdf,
-                                      e.radiance.r,  e.radiance.g,  e.radiance.b};
-            const float got[] = {x[i], y[i], z[i], pdf[i], r[i], g[i], b[i]};
-            for (int k = 0; k < 7; ++k)
+            const float expected[] = {e.direction.x, e.direction.y, e.direction.z, e.pdf, e.radiance.r,
+                                      e.radiance.g,  e.radiance.b,  e.uv.x,        e.uv.y};
+            const float got[] = {x[i], y[i], z[i], pdf[i], r[i], g[i], b[i], u[i], v[i]};
+            for (int k = 0; k < 9; ++k)
                 ASSERT_EQ(bits(got[k]), bits(expected[k]))
                     << map.width() << "x" << map.height() << " point " << i << " (" << points[i].x << ", "
                     << points[i].y << ") output " << k;

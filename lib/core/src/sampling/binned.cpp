@@ -307,6 +307,8 @@ void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays nor
             const EnvSample s = bins[j].sample_at(cells[j], rows[j], texels[j]);
             out.x[i] = s.direction.x, out.y[i] = s.direction.y, out.z[i] = s.direction.z, out.pdf[i] = s.pdf;
             out.r[i] = s.radiance.r, out.g[i] = s.radiance.g, out.b[i] = s.radiance.b;
+            if (out.u) out.u[i] = s.uv.x;
+            if (out.v) out.v[i] = s.uv.y;
         }
     }
 }

@@ -311,8 +311,10 @@ ENVMIS_AVX2 void sample8(const EnvMapView& env, const Rows8& rows, SampleArrays 
     const Hit8& r = rows.r;
     const I8 row = rows.row;
     const Hit8 c = search8(d.start, d.guide, row, d.w, rows.column);
-    const SinCos8 theta = sincos_half_turns8(env.turns, point_in_cell8(r.index, r.offset, d.h));
-    const SinCos8 phi = sincos_turns8(env.turns, point_in_cell8(c.index, c.offset, d.w));
+    const F8 u = point_in_cell8(c.index, c.offset, d.w), v = point_in_cell8(r.index, r.offset, d.h);
+    const SinCos8 theta = sincos_half_turns8(env.turns, v), phi = sincos_turns8(env.turns, u);
+    if (out.u) _mm256_storeu_ps(out.u + l, u);
+    if (out.v) _mm256_storeu_ps(out.v + l, v);
     _mm256_storeu_ps(out.x + l, _mm256_mul_ps(theta.sin, phi.cos));
     _mm256_storeu_ps(out.y + l, _mm256_mul_ps(theta.sin, phi.sin));
     _mm256_storeu_ps(out.z + l, theta.cos);
@@ -350,6 +352,8 @@ void sample_many(const EnvMapView& env, PointArrays in, SampleArrays out, uint32
         const EnvSample e = env.sample({in.x[l], in.y[l]});
         out.x[l] = e.direction.x, out.y[l] = e.direction.y, out.z[l] = e.direction.z, out.pdf[l] = e.pdf;
         out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b;
+        if (out.u) out.u[l] = e.uv.x;
+        if (out.v) out.v[l] = e.uv.y;
     }
 }
 

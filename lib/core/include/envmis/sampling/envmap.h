@@ -162,14 +162,16 @@ struct LookupArrays {
 void lookup_many(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept;
 
 // EnvMapView::sample for n random points at once, likewise: the points' two coordinates
-// in [0,1) in, one array each; direction, solid-angle pdf and radiance out (not the
-// image point). Bit-identical to n calls of sample; SIMD on the same maps and CPUs as
-// lookup_many, when the map is at least 2x2.
+// in [0,1) in, one array each; direction, solid-angle pdf and radiance out, and the
+// image point (EnvSample::uv) where u and v are given (null: not written). Bit-identical
+// to n calls of sample; SIMD on the same maps and CPUs as lookup_many, when the map is
+// at least 2x2.
 struct PointArrays {
     const float *x, *y;
 };
 struct SampleArrays {
     float *x, *y, *z, *pdf, *r, *g, *b;
+    float *u = nullptr, *v = nullptr;  // optional: the image point's two coordinates
 };
 void sample_many(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t n) noexcept;
 

@@ -1,0 +1,110 @@
+#include "maps_batch.h"
+
+#include <algorithm>
+#include <chrono>
+#include <vector>
+
+namespace envmis::python {
+namespace {
+
+// The columns of rows first .. first + m of an interleaved n x k array.
+template <size_t K>
+void deinterleave(const float* in, size_t first, uint32_t m, float (*out)[kChunk]) noexcept {
+    const float* row = in + first * K;
+    for (uint32_t i = 0; i < m; ++i, row += K)
+        for (size_t k = 0; k < K; ++k) out[k][i] = row[k];
+}
+
+template <size_t K>
+void interleave(float (*in)[kChunk], uint32_t m, float* out, size_t first) noexcept {
+    float* row = out + first * K;
+    for (uint32_t i = 0; i < m; ++i, row += K)
+        for (size_t k = 0; k < K; ++k) row[k] = in[k][i];
+}
+
+// Runs `batch(first, m, points, normals, outputs)` chunk by chunk over n points with the
+// chunk's inputs deinterleaved (normals only when given) and stores its outputs.
+template <class Batch>
+void sample_chunks(const float* u, const float* normals, InterleavedSamples out, size_t n, Batch&& batch) noexcept {
+    alignas(32) float points[2][kChunk], normal[3][kChunk], direction[3][kChunk], radiance[3][kChunk], uv[2][kChunk];
+    for (size_t first = 0; first < n; first += kChunk) {
+        const auto m = static_cast<uint32_t>(std::min<size_t>(kChunk, n - first));
+        deinterleave<2>(u, first, m, points);
+        if (normals) deinterleave<3>(normals, first, m, normal);
+        batch({points[0], points[1]}, DirectionArrays{normal[0], normal[1], normal[2]},
+              SampleArrays{direction[0], direction[1], direction[2], out.pdf + first, radiance[0], radiance[1],
+                           radiance[2], uv[0], uv[1]},
+              m);
+        interleave<3>(direction, m, out.direction, first);
+        interleave<3>(radiance, m, out.radiance, first);
+        interleave<2>(uv, m, out.uv, first);
+    }
+}
+
+template <class Batch>
+void lookup_chunks(const float* directions, const float* normals, InterleavedLookups out, size_t n,
+                   Batch&& batch) noexcept {
+    alignas(32) float direction[3][kChunk], normal[3][kChunk], radiance[3][kChunk], pdf[kChunk];
+    for (size_t first = 0; first < n; first += kChunk) {
+        const auto m = static_cast<uint32_t>(std::min<size_t>(kChunk, n - first));
+        deinterleave<3>(directions, first, m, direction);
+        if (normals) deinterleave<3>(normals, first, m, normal);
+        batch(DirectionArrays{direction[0], direction[1], direction[2]},
+              DirectionArrays{normal[0], normal[1], normal[2]},
+              LookupArrays{radiance[0], radiance[1], radiance[2], out.pdf ? out.pdf + first : pdf}, m);
+        if (out.radiance) interleave<3>(radiance, m, out.radiance, first);
+    }
+}
+
+}  // namespace
+
+void sample(const EnvMapView& env, const float* u, InterleavedSamples out, size_t n) noexcept {
+    sample_chunks(u, nullptr, out, n,
+                  [&](PointArrays in, DirectionArrays, SampleArrays o, uint32_t m) { sample_many(env, in, o, m); });
+}
+
+void sample(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* u, InterleavedSamples out,
+            size_t n) noexcept {
+    sample_chunks(u, normals, out, n, [&](PointArrays in, DirectionArrays normal, SampleArrays o, uint32_t m) {
+        sample_many(env, lobe, normal, in, o, m);
+    });
+}
+
+void lookup(const EnvMapView& env, const float* directions, InterleavedLookups out, size_t n) noexcept {
+    lookup_chunks(directions, nullptr, out, n,
+                  [&](DirectionArrays in, DirectionArrays, LookupArrays o, uint32_t m) { lookup_many(env, in, o, m); });
+}
+
+void lookup(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* directions,
+            InterleavedLookups out, size_t n) noexcept {
+    lookup_chunks(directions, normals, out, n,
+                  [&](DirectionArrays in, DirectionArrays normal, LookupArrays o, uint32_t m) {
+                      lookup_many(env, lobe, normal, in, o, m);
+                  });
+}
+
+double time_sample_many(const EnvMapView& env, const float* u, size_t n, int repeats) {
+    std::vector<float> ux(n), uy(n);
+    for (size_t i = 0; i < n; ++i) ux[i] = u[2 * i], uy[i] = u[2 * i + 1];
+    std::vector<std::vector<float>> outputs(9, std::vector<float>(n));
+    const SampleArrays out{outputs[0].data(), outputs[1].data(), outputs[2].data(),
+                           outputs[3].data(), outputs[4].data(), outputs[5].data(),
+                           outputs[6].data(), outputs[7].data(), outputs[8].data()};
+    std::vector<double> seconds;
+    for (int r = 0; r < repeats; ++r) {
+        const auto start = std::chrono::steady_clock::now();
+        // The core's call takes at most 2^32 - 1 points.
+        for (size_t first = 0; first < n; first += UINT32_MAX) {
+            const auto m = static_cast<uint32_t>(std::min<size_t>(UINT32_MAX, n - first));
+            sample_many(env, {ux.data() + first, uy.data() + first},
+                        {out.x + first, out.y + first, out.z + first, out.pdf + first, out.r + first, out.g + first,
+                         out.b + first, out.u + first, out.v + first},
+                        m);
+        }
+        seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
+    std::nth_element(seconds.begin(), seconds.begin() + seconds.size() / 2, seconds.end());
+    return seconds[seconds.size() / 2];
+}
+
+}  // namespace envmis::python

@@ -1,0 +1,167 @@
+// The docstrings of envmis._maps (python/envmis/_maps.pyi repeats the signatures).
+// Measures and units are those of the C++ headers (envmap.h, binned.h, table.h).
+#pragma once
+
+namespace envmis::python::docs {
+
+inline constexpr const char* kModule = R"(envmis maps, tables and sampling.
+
+Units and measures throughout: directions are unit vectors (float32, x, y, z) in the
+map's world frame (its `axes`, z up by default); pdfs are densities per steradian of
+solid angle; radiance is linear RGB in the map's working colour space; image points uv
+are in [0, 1)^2 with u along the columns (azimuth for equirect) and v down the rows
+(v = 0 at the top, the +up pole). Every array in is float32 and C-contiguous; other
+dtypes are refused, never converted (a float64 direction rounded to float32 is another
+direction).)";
+
+inline constexpr const char* kImageError =
+    "An image that cannot be read (missing, not an image, truncated, unknown colour space); "
+    "the message names the file, as `envmis` prints it after 'envmis: '. An OSError.";
+inline constexpr const char* kTableError =
+    "A table file that cannot be read or written (missing, truncated, corrupted, another format or version); "
+    "the message names the file. An OSError.";
+
+inline constexpr const char* kSamples = R"(Samples(direction, pdf, radiance, uv): the result of sample() for N points.
+
+direction: float32 (N, 3), unit vectors in the map's world frame.
+pdf:       float32 (N,), the solid-angle density (per steradian) of drawing each direction;
+           0 only at the poles of an equirect map, where the mapping degenerates.
+radiance:  float32 (N, 3), linear RGB in the working space arriving from each direction
+           (the texel's value: nearest, constant over the texel).
+uv:        float32 (N, 2), the image points in [0, 1)^2 that the directions map from.
+All are new C-contiguous arrays, bit-identical to the C++ single call EnvMap::sample.)";
+
+inline constexpr const char* kEnvMap = R"(An importance-sampled environment map (envmis::EnvMap).
+
+Samples directions with a density proportional to the texel's luminance L, or, when
+compensated, to max(L - alpha Lbar, 0) (Lbar the solid-angle mean luminance), times the
+texel's solid angle. Made by envmis.load() (an image or a table file), envmis.load_table()
+or EnvMap(array). Immutable; sample, pdf and eval are vectorised over NumPy arrays and
+release the GIL. Memory: 6 bytes a texel for the distribution plus 12 for the radiance
+(none of its own where it maps a table file).)";
+
+inline constexpr const char* kEnvMapInit = R"(A map of an array of pixels.
+
+radiance: float32 (H, W, 3), linear RGB in `colorspace` (default: the working space),
+    row 0 at the top (the +up pole for equirect). Copied into the map (H W 12 bytes),
+    converted to `working_space` when `colorspace` differs (OpenColorIO); NaN, infinite
+    and negative channel values are replaced by 0 and counted in stats["bad_pixels"].
+compensate, alpha, axes, mapping, working_space: as envmis.load(); alpha defaults to 1.
+The map's source is {"name": "array", "content_hash": hash64 of the array's bytes, ...}.
+Raises ValueError for an array of another dtype or shape, an empty one, invalid options,
+or pixels whose power overflows float32 (the message says by how much to scale them).
+Cost: O(H W), parallel over rows.)";
+
+inline constexpr const char* kCompensated = "True if the density is compensated (and no fallback replaced it).";
+inline constexpr const char* kComplete =
+    "True if pdf > 0 wherever the radiance is non-zero, so that the map alone estimates without bias. A "
+    "compensated map is usually incomplete: combine it with BSDF sampling through MIS.";
+inline constexpr const char* kOptions =
+    "How the map was built: {'compensate': bool, 'alpha': float (the strength used, after 'auto'), 'axes': str "
+    "('x,y,z' form), 'mapping': 'equirect' | 'equal-area', 'luma': (r, g, b) luminance weights of the working space}.";
+inline constexpr const char* kStats =
+    "What the build measured: {'bad_pixels': {'nan', 'infinite', 'negative'}: channel values replaced by 0, "
+    "'mean_luminance': Lbar (solid-angle weighted), 'threshold': alpha Lbar if compensated else 0, "
+    "'max_luminance', 'min_positive_luminance' (0 for a black map), 'zeroed_texels': texels with L > 0 that "
+    "compensation set to density 0, 'fallback': 'none' | 'uncompensated' | 'uniform'}.";
+inline constexpr const char* kSource =
+    "Where the map came from, as its table file records it: {'name': the source image's file name (no folders), "
+    "'content_hash': hash64 of its bytes (int), 'input_colorspace', 'working_colorspace'}; empty strings and 0 for a "
+    "map made outside this module.";
+inline constexpr const char* kMapped =
+    "True if the radiance is borrowed from a read-only memory mapping of a table file (load_table(mapped=True)).";
+inline constexpr const char* kRadiance =
+    "The repaired radiance, float32 (H, W, 3), linear RGB in the working space: a read-only view of the map's own "
+    "pixels (or of its table file's mapping), no copy; its base keeps the map alive.";
+inline constexpr const char* kDensity =
+    "The image-space sampling density q(x, y) w_y (w_y = sin theta at the row's centre for equirect, 1 for "
+    "equal-area), float32 (H, W), unnormalised, as the table file stores it. The map does not keep it (its buffer "
+    "became the CDF): it is recomputed from the radiance on this Python object's first access (O(H W), 4 bytes a "
+    "texel), then kept with the object; every access is a read-only view of that one array.";
+inline constexpr const char* kSample = R"(Directions drawn from the map for N points.
+
+u: float32 (N, 2), points in [0, 1)^2 (a random or low-discrepancy sequence;
+   envmis.uniform_points gives what `envmis sample` draws). Returns Samples (direction,
+   pdf per steradian, radiance, uv), bit-identical to N calls of the C++ EnvMap::sample,
+   through the core's batch call sample_many (SIMD with AVX2). Cost: O(N), about the C++
+   batch call's per sample (docs/performance.md), GIL released; allocates the four
+   output arrays (N x 36 bytes).)";
+inline constexpr const char* kPdf = R"(The solid-angle pdf (per steradian) of sampling each direction.
+
+directions: float32 (N, 3), unit vectors in the map's world frame. They are not
+   normalised here (nor in C++): a vector of another length reads as another direction
+   (its azimuth kept, its z taken as the cosine). Returns float32 (N,), bit-identical to
+   Samples.pdf for the samples' own directions up to their float rounding; O(N), GIL
+   released.)";
+inline constexpr const char* kEval =
+    "The radiance arriving from each direction, float32 (N, 3) linear RGB in the working space (the nearest "
+    "texel's). directions: float32 (N, 3) unit vectors in the world frame (not normalised). O(N), GIL released.";
+inline constexpr const char* kSave = R"(Writes the map as a table file (envmis::write_table).
+
+compact=False stores the float32 density and radiance (16 bytes a texel; loads
+bit-identical); compact=True the radiance in RGBE (4 bytes a texel; loads as the map of
+the RGBE-rounded pixels). Written to a temporary file in the same folder and renamed
+when complete: a failure leaves no partial table. Records the map's source. Raises
+TableError on I/O failure or a destination that is not a regular file.)";
+
+inline constexpr const char* kBinned = R"(A normal-aware map (envmis::BinnedEnvMap): K bins of normals,
+each with its own compensated density per lobe class, over a plain (uncompensated) map.
+
+A shading point picks its bin by its normal (world frame); a lobe class by its BSDF's
+sharpness (lobe_class). Made by envmis.load(..., bins=K) or from a binned table. pdf and
+sample speak solid angle (per steradian) over world directions, as EnvMap's.)";
+inline constexpr const char* kPlain =
+    "The plain map the bins are built over (an EnvMap sharing this map's memory; it keeps this map alive).";
+inline constexpr const char* kExponents = "The lobe classes' Phong exponents, ascending; 0 is diffuse (Lambert).";
+inline constexpr const char* kLobeClass =
+    "The lobe class of a BSDF with this Phong exponent (0 for Lambert): the nearest class on the scale "
+    "log(1 + exponent).";
+inline constexpr const char* kBinnedComplete =
+    "True if every bin of lobe class `lobe` samples wherever its normals see light (no texel zeroed by compensation).";
+inline constexpr const char* kBinnedSample = R"(Directions drawn for N (point, normal) pairs.
+
+u: float32 (N, 2) in [0, 1)^2; normals: float32 (N, 3), the shading normals in the world
+frame (their bin: the octahedral cell of the normalised vector); lobe: the lobe class (0
+to classes - 1). Returns Samples as EnvMap.sample does, bit-identical to N single calls
+of the C++ BinnedEnvMapView::sample. O(N), GIL released.)";
+inline constexpr const char* kBinnedPdf = R"(The solid-angle pdf (per steradian) of each direction under the bin
+its normal picks (lobe class `lobe`): what sample() with that normal would have drawn.
+
+directions, normals: float32 (N, 3), world frame; directions unit length (not
+normalised). Returns float32 (N,). O(N), GIL released.)";
+
+inline constexpr const char* kLoad = R"(Loads an HDR image (or a table file) as `envmis precompute` builds it.
+
+path: an image that OpenImageIO reads (EXR, .hdr, .pfm, TIFF...), converted with
+   OpenColorIO from `colorspace` (default: the file's metadata) to `working_space`; or a
+   table file (recognised by its magic), whose own recorded options are used: the keywords
+   are then ignored, as the command ignores its flags for a table.
+compensate: compensate the density for MIS (False: luminance times solid angle).
+alpha: compensation strength >= 0, or "auto" (choose_alpha: the candidate with the lowest
+   exact variance of balance MIS). Default: 1, or with bins auto per bin and lobe class.
+axes: the world frame of directions: "z-up", "y-up" or a signed permutation like "x,z,-y".
+mapping: "equirect" (latitude-longitude) or "equal-area" (octahedral, a square image).
+bins: K = g^2 (g 1 to 64) gives a BinnedEnvMap as `precompute --bins K` builds it;
+   cell_columns its cell grid's columns (0: width / 32).
+Returns EnvMap or BinnedEnvMap. The loader's notes (a square equirect image, an OpenEXR
+data window) are issued as UserWarning. Raises ImageError (the file), TableError (a
+corrupt table), ValueError (invalid options; a map whose power overflows float32), with
+the messages `envmis` prints. GIL released while loading and building (O(W H)).)";
+inline constexpr const char* kLoadTable = R"(Reads a table file written by EnvMap.save or `envmis precompute`.
+
+mapped=True borrows a full table's radiance from a read-only memory mapping of the file
+(no copy, pages shared with other processes; EnvMap.mapped says whether it did);
+mapped=False reads it into memory. Either way the map samples bit-identically to the one
+saved. Returns EnvMap, or BinnedEnvMap for a binned table. Raises TableError naming the
+file if it is missing, truncated, corrupted, of another format or version.)";
+inline constexpr const char* kUniformPoints = R"(The n points in [0, 1)^2 that `envmis sample -n n --seed seed` draws.
+
+float32 (n, 2): a mt19937_64 seeded with `seed`, 24 random bits per coordinate (the float
+grid k / 2^24), u then v per point; so map.sample(uniform_points(n, seed)) equals the
+command's CSV bit for bit. O(n).)";
+inline constexpr const char* kTimeSampleMany = R"(Benchmark helper: the median wall time in seconds over `repeats`
+runs of the C++ batch call sample_many on u (its columns as separate arrays, outputs
+preallocated, image points included), measured inside C++: the reference for
+EnvMap.sample's cost (scripts/python_bench.py).)";
+
+}  // namespace envmis::python::docs
