@@ -13,6 +13,7 @@ and their ratio, and prints a chi-square goodness-of-fit statistic per degree of
 """
 
 import argparse
+import os
 import sys
 
 import numpy as np
@@ -82,14 +83,19 @@ def plot(path, title, observed_fraction, expected, ratio):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from matplotlib.colors import LogNorm
+
     figure, axes = plt.subplots(1, 3, figsize=(15, 3.6), constrained_layout=True)
+    # A log scale: a sun holds most of the probability, the sky the rest.
     top = max(observed_fraction.max(), expected.max())
+    norm = LogNorm(vmin=top * 1e-6, vmax=top)
+    extent = (0, 1, 1, 0)
     for ax, image, name in ((axes[0], observed_fraction, "samples (fraction per bin)"),
                             (axes[1], expected, "pdf integrated over each bin")):
-        shown = ax.imshow(image, vmin=0, vmax=top, cmap="magma", aspect="auto")
+        shown = ax.imshow(np.maximum(image, top * 1e-6), norm=norm, cmap="magma", aspect="auto", extent=extent)
         ax.set_title(name)
         figure.colorbar(shown, ax=ax)
-    shown = axes[2].imshow(ratio, vmin=0.8, vmax=1.2, cmap="coolwarm", aspect="auto")
+    shown = axes[2].imshow(ratio, vmin=0.8, vmax=1.2, cmap="coolwarm", aspect="auto", extent=extent)
     axes[2].set_title("samples / pdf (bins expecting >= 100 samples)")
     figure.colorbar(shown, ax=axes[2])
     for ax in axes:
@@ -122,7 +128,8 @@ def main(argv):
     print(f"{arguments.map}: {n} samples in {columns}x{rows} bins; chi-square {statistic:.1f} over {dof} "
           f"degrees of freedom: {statistic / max(dof, 1):.3f} per degree (1 expected, +-{np.sqrt(2 / max(dof, 1)):.3f}); "
           f"samples / pdf in [{np.nanmin(ratio):.3f}, {np.nanmax(ratio):.3f}] over the bins expecting >= 100")
-    plot(arguments.output, f"{arguments.map}: {n} samples against the pdf", observed / n, expected, ratio)
+    name = os.path.basename(arguments.map)
+    plot(arguments.output, f"{name}: {n} samples against the pdf", observed / n, expected, ratio)
     print(f"wrote {arguments.output}")
 
 

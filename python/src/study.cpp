@@ -14,6 +14,7 @@
 #include "envmis/study/techniques/estimator.h"
 #include "numpy_arrays.h"
 #include "study_alpha.h"
+#include "study_arguments.h"
 #include "study_compare.h"
 
 namespace py = pybind11;
@@ -24,9 +25,9 @@ namespace {
 // Each grey reflectance or parameter a factory takes, in the range parse() accepts.
 float checked(double value, double low, double high, const char* where, const char* name) {
     if (!(value >= low && value <= high))
-        throw std::invalid_argument(std::string(where) + ": " + name + " must be in [" + py::str(py::float_(low)).cast<std::string>() +
-                                    ", " + py::str(py::float_(high)).cast<std::string>() + "]; got " +
-                                    std::to_string(value));
+        throw std::invalid_argument(std::string(where) + ": " + name + " must be in [" +
+                                    py::str(py::float_(low)).cast<std::string>() + ", " +
+                                    py::str(py::float_(high)).cast<std::string>() + "]; got " + std::to_string(value));
     return static_cast<float>(value);
 }
 
@@ -141,10 +142,13 @@ pdf the solid-angle density (per steradian) of sample over the whole sphere.)")
             "0.95/0.64/0.54, copper-like).")
         .def_property_readonly("name", &Bsdf::name, "The name parse() reads back: 'lambert', 'phong:50', 'ggx:0.1'.")
         .def_property_readonly("kind", [](const Bsdf& b) { return kind_name(b.kind); })
-        .def_property_readonly("albedo", [](const Bsdf& b) { return py::make_tuple(b.reflectance.r, b.reflectance.g, b.reflectance.b); },
-                               "The reflectance (r, g, b): Lambert's albedo, Phong's specular albedo, GGX's F0.")
-        .def_property_readonly("exponent", [](const Bsdf& b) { return b.exponent; }, "Phong's n (0 otherwise).")
-        .def_property_readonly("alpha", [](const Bsdf& b) { return b.alpha; }, "GGX's roughness (0 otherwise).")
+        .def_property_readonly(
+            "albedo", [](const Bsdf& b) { return py::make_tuple(b.reflectance.r, b.reflectance.g, b.reflectance.b); },
+            "The reflectance (r, g, b): Lambert's albedo, Phong's specular albedo, GGX's F0.")
+        .def_property_readonly(
+            "exponent", [](const Bsdf& b) { return b.exponent; }, "Phong's n (0 otherwise).")
+        .def_property_readonly(
+            "alpha", [](const Bsdf& b) { return b.alpha; }, "GGX's roughness (0 otherwise).")
         .def("eval", &bsdf_eval, py::arg("wo"), py::arg("wi"),
              "float32 (N, 3) RGB f(wo, wi) cos(theta_i) for wo, wi float32 (N, 3) local unit vectors. GIL released.")
         .def("pdf", &bsdf_pdf, py::arg("wo"), py::arg("wi"),
@@ -164,7 +168,8 @@ void bind_technique(py::module_& m) {
 with -comp (sampling the compensated density), 'mis-balance-all' and 'mis-optimal-all'
 (the mixture), 'mis-balance-bins', 'mis-power-bins', 'mis-optimal-bins',
 'one-sample' and 'one-sample-comp'; envmis.techniques() lists them.)")
-        .def_static("parse", &Technique::parse, py::arg("name"), "ValueError with the command's message for another name.")
+        .def_static("parse", &Technique::parse, py::arg("name"),
+                    "ValueError with the command's message for another name.")
         .def_property_readonly("name", &Technique::name)
         .def_property_readonly("adaptive", &Technique::adaptive,
                                "Learns at each shading point (mis-optimal, mis-var): no exact variance.")
@@ -174,9 +179,11 @@ with -comp (sampling the compensated density), 'mis-balance-all' and 'mis-optima
         .def("__eq__", [](const Technique& a, const Technique& b) { return a == b; })
         .def("__hash__", [](const Technique& t) { return py::hash(py::str(t.name())); })
         .def("__repr__", [](const Technique& t) { return "envmis.Technique.parse('" + t.name() + "')"; });
-    m.def("techniques", [] { return names_of(Technique::all()); }, "The names of every technique.");
-    m.def("default_techniques", [] { return names_of(ComparisonOptions::default_techniques()); },
-          "The techniques compare runs when none are named, in its order.");
+    m.def(
+        "techniques", [] { return names_of(Technique::all()); }, "The names of every technique.");
+    m.def(
+        "default_techniques", [] { return names_of(ComparisonOptions::default_techniques()); },
+        "The techniques compare runs when none are named, in its order.");
 }
 
 py::array_t<float> sphere_normals(const py::handle& k) {

@@ -46,9 +46,9 @@ RadianceInput radiance_of(const py::handle& source, const char* where) {
     return {{width, height, {pixels, static_cast<size_t>(width) * height}}, {}};
 }
 
-py::dict choose(const py::handle& source, const py::handle& bsdfs, const py::handle& points,
-                const py::handle& normals, const py::handle& views, const py::handle& candidates,
-                const py::handle& env_samples, const py::handle& bsdf_samples, const py::handle& max_width) {
+py::dict choose(const py::handle& source, const py::handle& bsdfs, const py::handle& points, const py::handle& normals,
+                const py::handle& views, const py::handle& candidates, const py::handle& env_samples,
+                const py::handle& bsdf_samples, const py::handle& max_width) {
     constexpr const char* where = "envmis.choose_alpha";
     AlphaOptions options;
     options.bsdfs = bsdf_list(bsdfs, where);
@@ -102,8 +102,8 @@ py::dict alpha_choice_dict(const AlphaChoice& choice, std::span<const Bsdf> bsdf
     for (const AlphaCandidate& c : choice.candidates) {
         py::dict per_bsdf;
         for (size_t b = 0; b < bsdfs.size(); ++b) per_bsdf[py::str(bsdfs[b].name())] = c.per_bsdf[b];
-        candidates.append(py::dict(py::arg("alpha") = c.alpha, py::arg("criterion") = c.criterion,
-                                   py::arg("per_bsdf") = per_bsdf));
+        candidates.append(
+            py::dict(py::arg("alpha") = c.alpha, py::arg("criterion") = c.criterion, py::arg("per_bsdf") = per_bsdf));
     }
     return py::dict(py::arg("alpha") = choice.alpha, py::arg("bsdf_alphas") = bsdf_alphas,
                     py::arg("candidates") = candidates, py::arg("width") = choice.width,

@@ -40,9 +40,7 @@ std::vector<T> list_of(const py::handle& items, const char* where, const char* n
 
 // The length of a float32 (N, 3) row, in double so that rounding does not hide a
 // non-unit vector.
-double length(const float* v) {
-    return std::sqrt(double(v[0]) * v[0] + double(v[1]) * v[1] + double(v[2]) * v[2]);
-}
+double length(const float* v) { return std::sqrt(double(v[0]) * v[0] + double(v[1]) * v[1] + double(v[2]) * v[2]); }
 
 std::vector<Vec3> unit_rows(const py::array_t<float, py::array::c_style>& rows, const char* where, const char* name) {
     std::vector<Vec3> result(static_cast<size_t>(rows.shape(0)));

@@ -197,7 +197,7 @@ ComparisonResult run_compare(const EnvMap& map, const CompareArguments& args) {
             return r;
         },
         watch);
-    ComparisonResult result{std::move(run.comparison), {}, {}, py::none()};
+    ComparisonResult result{std::move(run.comparison), py::list(), py::dict(), py::none()};
     result.records = to_python(run.records).cast<py::list>();
     result.inputs = inputs_dict(s, args.name, result.comparison.points_done);
     if (run.exact) result.exact = to_python(*run.exact);

@@ -27,12 +27,12 @@ inline py::object to_python(const nlohmann::json& j) {
         case nlohmann::json::value_t::array: {
             py::list list;
             for (const nlohmann::json& item : j) list.append(to_python(item));
-            return std::move(list);
+            return list;
         }
         case nlohmann::json::value_t::object: {
             py::dict dict;
             for (const auto& [key, value] : j.items()) dict[py::str(key)] = to_python(value);
-            return std::move(dict);
+            return dict;
         }
         default: return py::none();
     }

@@ -41,25 +41,33 @@ struct Watch {
 
 // Runs `work()` (which must honour watch.stop where it can) and returns its result or
 // rethrows its exception; raises the Python error of a signal handler or of the
-// progress callback once the work has stopped. Call with the GIL held.
+// progress callback once the work has stopped. The callback sees each poll's latest
+// progress and the final one. Call with the GIL held.
 template <class Work>
 auto run_watched(Work&& work, Watch& watch) -> decltype(work()) {
     auto future = std::async(std::launch::async, std::forward<Work>(work));
     size_t reported = static_cast<size_t>(-1);
+    auto report = [&] {
+        const size_t done = watch.done.load();
+        if (!watch.progress.is_none() && done != reported && watch.total.load() > 0) {
+            reported = done;
+            watch.progress(done, watch.total.load());
+        }
+    };
     for (;;) {
         bool ready = false;
         {
             py::gil_scoped_release release;
             ready = future.wait_for(kPollInterval) == std::future_status::ready;
         }
-        if (ready) return future.get();
+        if (ready) {
+            auto result = future.get();
+            report();  // the end, which a short run reaches before any poll
+            return result;
+        }
         try {
             if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-            const size_t done = watch.done.load();
-            if (!watch.progress.is_none() && done != reported && watch.total.load() > 0) {
-                reported = done;
-                watch.progress(done, watch.total.load());
-            }
+            report();
         } catch (...) {
             watch.stop = true;
             {
