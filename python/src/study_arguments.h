@@ -1,0 +1,56 @@
+// The study's arguments as Python gives them, checked and converted once: BSDFs and
+// techniques by name or object, shading points as NumPy arrays or a count, sample
+// counts and seeds as Python ints. Every refusal is a ValueError (std::invalid_argument)
+// or a TypeError (py::type_error) whose message starts with the function's name.
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "envmis/study/comparison/comparison.h"
+#include "envmis/study/shading/bsdf.h"
+#include "envmis/study/techniques/estimator.h"
+
+namespace envmis::python {
+
+namespace py = pybind11;
+
+// The limits of compare's flags, so that Python refuses what the command refuses.
+inline constexpr uint32_t kMaxSamples = 65536;  // per estimate, of each kind
+inline constexpr uint32_t kMaxPoints = 1000000;
+inline constexpr uint32_t kMaxThreads = 1024;
+inline constexpr uint32_t kThreadsPerCore = 4;  // more workers than this per hardware thread only contend
+inline constexpr uint32_t kDefaultBins = 121;   // BinnedOptions{}.bins_per_side squared
+
+// A str of comma-separated names (as `--bsdf lambert,phong:50`), or an iterable of
+// names and envmis.Bsdf objects. Bsdf::parse's message for a bad name.
+std::vector<Bsdf> bsdf_list(const py::handle& bsdfs, const char* where);
+// The same for techniques (Technique::parse); None gives `fallback`.
+std::vector<Technique> technique_list(const py::handle& techniques, const char* where,
+                                      const std::vector<Technique>& fallback);
+// One BSDF or technique, by name or object.
+Bsdf bsdf_of(const py::handle& bsdf, const char* where);
+Technique technique_of(const py::handle& technique, const char* where);
+
+// An integer argument in [low, high]: "envmis.compare: spp must be 1 to 4294967295; got 0".
+uint64_t count_in_range(const py::handle& value, const char* where, const char* name, uint64_t low, uint64_t high);
+
+// The shading points: `count` spread over the sphere (sphere_points) when `normals` is
+// None, else one per row of normals (N, 3) float32, viewed from `views` (N, 3) float32
+// or head-on. Every row must be a unit vector to within 1e-3 (they are used as given,
+// not renormalised, so that sphere_points' own normals give the same estimates here as
+// in the command).
+std::vector<ShadingPoint> shading_points(const py::handle& count, const py::handle& normals, const py::handle& views,
+                                         const char* where);
+
+// env_samples and bsdf_samples, each 0 to kMaxSamples.
+Allocation allocation_of(const py::handle& env_samples, const py::handle& bsdf_samples, const char* where);
+
+// --threads' rule: 0 is every hardware thread; more than kThreadsPerCore per hardware
+// thread is reduced to that, with a Python warning saying so.
+uint32_t worker_threads(const py::handle& threads, const char* where);
+
+}  // namespace envmis::python

@@ -1,0 +1,343 @@
+#include "study_compare.h"
+
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+
+#include "envmis/report/results.h"
+#include "envmis/study/comparison/alpha.h"
+#include "study_alpha.h"
+#include "study_arguments.h"
+#include "study_json.h"
+#include "study_watch.h"
+
+namespace envmis::python {
+namespace {
+
+constexpr const char* kWhere = "envmis.compare";
+
+// Everything a run is set up with, as cmd_compare.cpp's Setup.
+struct Setup {
+    const EnvMap* given = nullptr;    // the caller's map
+    std::optional<EnvMap> own_plain;  // it rebuilt without compensation, when it had some
+    std::vector<ShadingPoint> points;
+    ComparisonOptions options;
+    std::optional<AlphaChoice> choice;
+    float map_alpha = 0;
+    std::vector<float> bsdf_alphas;
+    CompensatedMaps compensated;
+    std::shared_ptr<const BinnedEnvMap> binned;
+    bool bins_auto = false;
+
+    const EnvMap& plain() const { return own_plain ? *own_plain : *given; }
+    StudyInputs inputs() const { return {plain(), compensated, points, options, binned.get()}; }
+    float alpha_of(const Bsdf& bsdf) const {
+        for (size_t b = 0; b < options.bsdfs.size(); ++b)
+            if (options.bsdfs[b].name() == bsdf.name()) return bsdf_alphas[b];
+        return map_alpha;
+    }
+};
+
+ComparisonOptions comparison_options(const CompareArguments& args) {
+    ComparisonOptions options;
+    options.bsdfs = bsdf_list(args.bsdfs, kWhere);
+    options.techniques = technique_list(args.techniques, kWhere, ComparisonOptions::default_techniques());
+    options.spp = static_cast<uint32_t>(count_in_range(args.spp, kWhere, "spp", 1, UINT32_MAX));
+    options.seed = count_in_range(args.seed, kWhere, "seed", 0, UINT64_MAX);
+    options.allocation = allocation_of(args.env_samples, args.bsdf_samples, kWhere);
+    options.threads = worker_threads(args.threads, kWhere);
+    return options;
+}
+
+// g of bins K = g * g; 0 without a -bins technique (the command's --bins rule).
+uint32_t bins_per_side(const CompareArguments& args, std::span<const Technique> techniques) {
+    const auto asked = static_cast<uint32_t>(count_in_range(args.bins, kWhere, "bins", 0, 4096));
+    const uint32_t k = asked ? asked : (uses_bins(techniques) ? kDefaultBins : 0);
+    const auto g = static_cast<uint32_t>(std::lround(std::sqrt(static_cast<double>(k))));
+    if (g * g != k || (k && g > 64))
+        throw std::invalid_argument(std::string(kWhere) + ": bins " + std::to_string(k) +
+                                    ": expected a square number g*g of normal bins, g 1 to 64 (e.g. 64, 100, 144)");
+    return uses_bins(techniques) ? g : 0;
+}
+
+// alpha: None (the map's own strength if it is compensated, else the command's 1),
+// "auto" or a finite number >= 0.
+std::optional<float> fixed_alpha(const py::object& alpha, const EnvMap& map) {
+    if (alpha.is_none()) return map.compensated() ? map.options().compensation.alpha : 1.0f;
+    if (py::isinstance<py::str>(alpha)) {
+        if (alpha.cast<std::string>() == "auto") return std::nullopt;
+    } else if (py::isinstance<py::float_>(alpha) || py::isinstance<py::int_>(alpha)) {
+        const double a = alpha.cast<double>();
+        if (std::isfinite(a) && a >= 0 && a <= std::numeric_limits<float>::max()) return static_cast<float>(a);
+    }
+    throw std::invalid_argument(std::string(kWhere) + ": alpha must be a finite number >= 0 or 'auto'; got " +
+                                py::repr(alpha).cast<std::string>());
+}
+
+Setup prepare(const EnvMap& map, const CompareArguments& args) {
+    Setup s;
+    s.given = &map;
+    s.options = comparison_options(args);
+    const uint32_t g = bins_per_side(args, s.options.techniques);
+    s.points = shading_points(args.points, args.normals, args.views, kWhere);
+    const std::optional<float> fixed = fixed_alpha(args.alpha, map);
+    s.bins_auto = !fixed || args.alpha.is_none();
+    py::gil_scoped_release release;
+    if (map.options().compensation.enabled) {
+        EnvMapOptions plain_options = map.options();
+        plain_options.compensation.enabled = false;
+        s.own_plain.emplace(to_image(map.radiance()), plain_options);
+    }
+    if (!fixed) {
+        AlphaOptions search;
+        search.bsdfs = s.options.bsdfs;
+        search.points = s.points;
+        search.allocation = s.options.allocation;
+        s.choice = choose_alpha(s.plain().radiance(), s.plain().options(), search);
+    }
+    s.map_alpha = s.choice ? s.choice->alpha : *fixed;
+    s.bsdf_alphas = s.choice ? s.choice->bsdf_alphas : std::vector<float>(s.options.bsdfs.size(), s.map_alpha);
+    s.compensated = compensated_maps(s.plain(), s.bsdf_alphas);
+    if (g) {
+        BinnedOptions options;
+        options.bins_per_side = g;
+        options.auto_alpha = s.bins_auto;
+        options.alpha = fixed.value_or(1.0f);
+        s.binned = std::make_shared<const BinnedEnvMap>(EnvMap(s.plain()), options);
+    }
+    return s;
+}
+
+// Each BSDF's reflectance as the command writes it: [r, g, b] by name, each "%g".
+nlohmann::json albedo_json(std::span<const Bsdf> bsdfs) {
+    nlohmann::json albedo = nlohmann::json::object();
+    auto value = [](float v) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%g", v);
+        return std::stod(text);
+    };
+    for (const Bsdf& b : bsdfs)
+        albedo[b.name()] = {value(b.reflectance.r), value(b.reflectance.g), value(b.reflectance.b)};
+    return albedo;
+}
+
+// compare --json's "inputs", but alpha_choice in envmis.choose_alpha's form.
+py::dict inputs_dict(const Setup& s, const std::string& name, size_t points_done) {
+    const ComparisonOptions& o = s.options;
+    nlohmann::json inputs = {{"map", name},
+                             {"width", s.plain().width()},
+                             {"height", s.plain().height()},
+                             {"alpha", s.map_alpha},
+                             {"alpha_auto", s.choice.has_value()},
+                             {"spp", o.spp},
+                             {"seed", o.seed},
+                             {"threads", o.threads},
+                             {"env_samples", o.allocation.env},
+                             {"bsdf_samples", o.allocation.bsdf},
+                             {"points_done", points_done},
+                             {"albedo", albedo_json(o.bsdfs)}};
+    for (size_t b = 0; b < o.bsdfs.size(); ++b) inputs["bsdf_alpha"][o.bsdfs[b].name()] = s.bsdf_alphas[b];
+    if (s.binned) inputs["bins"] = {{"count", s.binned->bins()}, {"alpha_auto", s.bins_auto}};
+    for (size_t i = 0; i < points_done; ++i) {
+        const ShadingPoint& p = s.points[i];
+        inputs["points"].push_back(
+            {{"normal", {p.normal.x, p.normal.y, p.normal.z}}, {"view", {p.wo.x, p.wo.y, p.wo.z}}});
+    }
+    py::dict dict = to_python(inputs).cast<py::dict>();
+    if (s.choice) dict["alpha_choice"] = alpha_choice_dict(*s.choice, o.bsdfs);
+    return dict;
+}
+
+// compare --exact's figures: per BSDF, each fixed-weight technique's exact variance
+// (quadrature, one subdivision) over mis-balance's, the geometric mean over points and
+// the worst point. Stops between techniques once `stop` is set (the result then unused).
+nlohmann::json exact_json(const Setup& s, const std::atomic<bool>& stop) {
+    const StudyInputs inputs = s.inputs();
+    const Technique balance = Technique::parse("mis-balance");
+    nlohmann::json exact = nlohmann::json::object();
+    for (size_t b = 0; b < s.options.bsdfs.size(); ++b) {
+        const std::vector<double> baseline = exact_point_variances(inputs, balance, b, 1);
+        for (const Technique& t : s.options.techniques) {
+            if (t.adaptive() || t.mixture) continue;
+            if (stop) return exact;
+            const std::vector<double> v = exact_point_variances(inputs, t, b, 1);
+            double worst = 0;
+            for (size_t p = 0; p < v.size(); ++p)
+                if (v[p] > 0 && baseline[p] > 0) worst = std::max(worst, v[p] / baseline[p]);
+            const double mean = geometric_mean_ratios(v, baseline, 1).front();
+            exact[s.options.bsdfs[b].name()][t.name()] = {{"ratio", mean}, {"worst", worst}};
+        }
+    }
+    return exact;
+}
+
+}  // namespace
+
+ComparisonResult run_compare(const EnvMap& map, const CompareArguments& args) {
+    const Setup s = prepare(map, args);
+    Watch watch;
+    watch.progress = args.progress;
+    struct Run {
+        Comparison comparison;
+        std::optional<nlohmann::json> exact;
+        nlohmann::json records;
+    };
+    Run run = run_watched(
+        [&] {
+            Run r{compare(s.inputs(), watch.control()), std::nullopt, {}};
+            if (args.exact && !watch.stop) r.exact = exact_json(s, watch.stop);
+            r.records = stats_results_json(r.comparison, [&s](const Bsdf& b) { return s.alpha_of(b); });
+            return r;
+        },
+        watch);
+    ComparisonResult result{std::move(run.comparison), py::list(), py::dict(), py::none()};
+    result.records = to_python(run.records).cast<py::list>();
+    result.inputs = inputs_dict(s, args.name, result.comparison.points_done);
+    if (run.exact) result.exact = to_python(*run.exact);
+    return result;
+}
+
+}  // namespace envmis::python
+
+namespace envmis::python {
+namespace {
+
+const TechniqueStats& stats_of(const ComparisonResult& result, const py::handle& bsdf, const py::handle& technique) {
+    constexpr const char* where = "envmis.Comparison";
+    const std::string b = bsdf_of(bsdf, where).name(), t = technique_of(technique, where).name();
+    std::string names;
+    for (const BsdfComparison& bc : result.comparison.bsdfs) {
+        if (bc.bsdf.name() != b) {
+            names += (names.empty() ? "" : ", ") + bc.bsdf.name();
+            continue;
+        }
+        if (const TechniqueStats* stats = bc.find(t)) return *stats;
+        throw py::key_error(std::string(where) + ": no technique " + t + " in this comparison");
+    }
+    throw py::key_error(std::string(where) + ": no BSDF " + b + " in this comparison (it has " + names + ")");
+}
+
+// The map's name in inputs: `name`, or where None the source file's name that
+// envmis.load recorded (EnvMap.source["name"]; empty for a map made from an array).
+std::string name_of(const py::object& map, const py::object& name) {
+    if (!name.is_none()) return name.cast<std::string>();
+    if (!py::hasattr(map, "source")) return "";
+    const py::object source = map.attr("source");
+    return py::isinstance<py::dict>(source) && source.contains("name") ? source["name"].cast<std::string>() : "";
+}
+
+py::array_t<double> copy_of(const std::vector<double>& values) {
+    return py::array_t<double>(static_cast<py::ssize_t>(values.size()), values.data());
+}
+
+constexpr const char* kCompareDoc = R"(The variance study of `envmis compare`, on one map.
+
+Every technique estimates direct lighting L_o (the luminance of reflected radiance, in
+the map's radiance units) on every BSDF at every shading point, spp estimates each,
+every technique spending env_samples + bsdf_samples samples per estimate (equal sample
+count). Each BSDF samples its own compensated map (alpha). The same arguments and seed
+give the same records as `envmis compare MAP --json` (every key but the measured
+timings ns_per_estimate and efficiency), whatever the number of threads.
+
+map: an envmis.EnvMap; its radiance is studied (rebuilt without compensation where it
+  has some); its own compensation strength is only the default of alpha.
+bsdfs: names ('lambert', 'phong:50', 'ggx:0.1', as --bsdf; also one comma-separated
+  str) or envmis.Bsdf objects.
+techniques: names or envmis.Technique objects; None: envmis.default_techniques().
+spp: estimates per point, BSDF and technique, 1 to 2^32-1.
+points: K normals spread evenly over the sphere (1 to 10^6), each viewed head-on;
+  or normals: float32 (N, 3) unit vectors, world frame, with views (N, 3) (towards
+  the viewer; default the normal).
+seed: 0 to 2^64-1. threads: workers (0: every hardware thread).
+alpha: the compensation strength, >= 0; 'auto' chooses it per BSDF (envmis.choose_alpha
+  over these BSDFs and points); None: the map's own if compensated, else 1. The -bins
+  techniques choose theirs per bin unless alpha is a number.
+env_samples, bsdf_samples: samples per MIS estimate, 0 to 65536.
+bins: normal bins K = g*g (1 <= g <= 64) of the -bins techniques; 0: 121 where one runs.
+exact: also the exact, noise-free variance ratios of compare --exact (.exact).
+name: the map's name in .inputs (None: the file name envmis.load recorded). progress: None or a callable (done, total) called on
+  this thread as points complete.
+
+Cost: points x BSDFs x techniques x spp estimates (tens of ns each) plus a quadrature
+reference per point and BSDF. The GIL is released; Ctrl-C stops the run between points
+(or every few thousand estimates) and raises KeyboardInterrupt, as does an exception
+from progress. Raises ValueError with the command's messages.)";
+
+}  // namespace
+
+void bind_compare(py::module_& m) {
+    py::class_<ComparisonResult>(m, "Comparison", R"(The result of envmis.compare.
+
+records: compare --json's "results": a dict per BSDF and technique (in that order) with
+  bsdf, technique, alpha, estimates, mean, reference (luminance of L_o, the map's
+  radiance units), variance (of ONE estimate, radiance units squared, mean over
+  points), std_error, rel_mse, ns_per_estimate, efficiency, variance_ratio_vs_mis
+  (geometric mean over points of variance / that of mis-balance),
+  variance_ratio_log_std_error, ill_conditioned_points, point_variances and
+  point_variance_rel_se (per point, in point order). A non-finite value is None, as in
+  the JSON file.
+inputs: compare --json's "inputs" (map, width, height, alpha, alpha_auto, bsdf_alpha,
+  spp, seed, threads, env_samples, bsdf_samples, points_done, albedo, points, bins),
+  with alpha_choice as envmis.choose_alpha returns it.
+exact: with exact=True, {bsdf: {technique: {"ratio", "worst"}}}: exact variance over
+  that of mis-balance, geometric mean over points and the worst point; else None.)")
+        .def_readonly("records", &ComparisonResult::records)
+        .def_readonly("inputs", &ComparisonResult::inputs)
+        .def_readonly("exact", &ComparisonResult::exact)
+        .def_property_readonly("points_done", [](const ComparisonResult& r) { return r.comparison.points_done; })
+        .def_property_readonly("points_total", [](const ComparisonResult& r) { return r.comparison.points_total; })
+        .def_property_readonly("bsdfs",
+                               [](const ComparisonResult& r) {
+                                   std::vector<std::string> names;
+                                   for (const BsdfComparison& b : r.comparison.bsdfs) names.push_back(b.bsdf.name());
+                                   return names;
+                               })
+        .def(
+            "point_variances",
+            [](const ComparisonResult& r, const py::handle& bsdf, const py::handle& technique) {
+                return copy_of(stats_of(r, bsdf, technique).point_variances);
+            },
+            py::arg("bsdf"), py::arg("technique"),
+            "float64 (points_done,): the variance of ONE estimate at each shading point, in point order (radiance "
+            "units squared); a copy. KeyError for a BSDF or technique not in the study.")
+        .def(
+            "point_variance_rel_se",
+            [](const ComparisonResult& r, const py::handle& bsdf, const py::handle& technique) {
+                return copy_of(stats_of(r, bsdf, technique).point_variance_rel_se);
+            },
+            py::arg("bsdf"), py::arg("technique"),
+            "float64 (points_done,): the relative standard error of each point's variance estimate; a copy.")
+        .def("__repr__", [](const ComparisonResult& r) {
+            return "<envmis.Comparison: " + std::to_string(r.comparison.bsdfs.size()) + " BSDFs, " +
+                   std::to_string(py::len(r.records)) + " records, " + std::to_string(r.comparison.points_done) +
+                   " of " + std::to_string(r.comparison.points_total) + " points>";
+        });
+
+    m.def(
+        "compare",
+        [](const py::object& map, py::object bsdfs, py::object techniques, py::object spp, py::object points,
+           py::object normals, py::object views, py::object seed, py::object threads, py::object alpha,
+           py::object env_samples, py::object bsdf_samples, py::object bins, bool exact, py::object name,
+           py::object progress) {
+            if (!py::isinstance<EnvMap>(map))
+                throw py::type_error(std::string(kWhere) + ": map must be an envmis.EnvMap; got " +
+                                     py::str(py::type::of(map).attr("__name__")).cast<std::string>());
+            return run_compare(map.cast<const EnvMap&>(),
+                               {bsdfs, techniques, spp, points, normals, views, seed, threads, alpha, env_samples,
+                                bsdf_samples, bins, exact, name_of(map, name), progress});
+        },
+        py::arg("map"), py::kw_only(), py::arg("bsdfs") = py::make_tuple("lambert", "phong:50", "ggx:0.1"),
+        py::arg("techniques") = py::none(), py::arg("spp") = 1024, py::arg("points") = 16,
+        py::arg("normals") = py::none(), py::arg("views") = py::none(), py::arg("seed") = 1, py::arg("threads") = 0,
+        py::arg("alpha") = py::none(), py::arg("env_samples") = 1, py::arg("bsdf_samples") = 1, py::arg("bins") = 0,
+        py::arg("exact") = false, py::arg("name") = py::none(), py::arg("progress") = py::none(), kCompareDoc);
+}
+
+}  // namespace envmis::python
