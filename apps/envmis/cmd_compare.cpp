@@ -647,8 +647,13 @@ bool results_up_to_date(const std::filesystem::path& json, uint64_t hash, const 
 // Several inputs or a folder: each map's study to DIR/<stem>.json, on the pool of --jobs;
 // each map's --threads defaults to its share of the cores.
 void run_library_compare(const CompareArgs& args) {
-    if (args.out_dir.empty())
-        throw std::runtime_error("--out-dir: required with several inputs or a folder (library mode)");
+    if (args.out_dir.empty()) {
+        std::error_code ec;
+        for (const std::string& input : args.inputs)
+            if (std::filesystem::is_directory(input, ec))
+                throw std::runtime_error(input + ": a directory; a folder of maps needs --out-dir DIR (library mode)");
+        throw std::runtime_error("--out-dir: required with several inputs, or with --summary (library mode)");
+    }
     if (!args.json.empty())
         throw std::runtime_error("--json: not in library mode; each map's JSON goes to --out-dir/<stem>.json");
     const std::filesystem::path dir = args.out_dir;
@@ -701,7 +706,7 @@ Subcommand add_compare(CLI::App& app) {
     args->threads_flag = sub->get_option("--threads");
     return {sub, [args] {
                 std::error_code ec;
-                if (args->inputs.size() > 1 || !args->out_dir.empty() ||
+                if (args->inputs.size() > 1 || !args->out_dir.empty() || !args->summary.empty() ||
                     std::filesystem::is_directory(args->inputs.front(), ec))
                     return run_library_compare(*args);
                 args->input = args->inputs.front();

@@ -56,7 +56,10 @@ std::vector<fs::path> folder_files(const fs::path& folder, bool recursive, const
         for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) keep(*it);
     }
     if (ec) throw std::runtime_error(folder.string() + ": cannot read the folder: " + ec.message());
-    if (files.empty()) throw std::runtime_error(folder.string() + ": no image files in the folder");
+    if (files.empty())
+        throw std::runtime_error(folder.string() +
+                                 ": a directory without image files (a folder input gives every file in it that "
+                                 "OpenImageIO reads)");
     std::sort(files.begin(), files.end());
     return files;
 }

@@ -34,9 +34,10 @@ public:
         fs::create_directories(small_);
         for (const char* name : {"city.exr", "rooitou_park_1k.hdr", "studio.exr"}) {
             const fs::path out = small_ / (fs::path(name).stem().string() + ".exr");
-            const Result r = envmis::test::run_envmis(small_, {"convert", (kBundled / name).string(), "-o",
-                                                               out.string(), "--to", "equirect", "--size", "32x16"},
-                                                      small_ / "..stdout", small_ / "..stderr");
+            const Result r = envmis::test::run_envmis(
+                small_,
+                {"convert", (kBundled / name).string(), "-o", out.string(), "--to", "equirect", "--size", "32x16"},
+                small_ / "..stdout", small_ / "..stderr");
             ASSERT_EQ(r.exit_code, 0) << r;
         }
     }
@@ -76,8 +77,8 @@ public:
     static inline fs::path small_;
 };
 
-const std::vector<std::string> kStudy = {"--spp",        "16",        "--points", "2", "--bsdf", "lambert",
-                                         "--techniques", "mis-balance,mis-balance-comp"};
+const std::vector<std::string> kStudy = {"--spp",  "16",      "--points",     "2",
+                                         "--bsdf", "lambert", "--techniques", "mis-balance,mis-balance-comp"};
 
 std::vector<std::string> with(std::vector<std::string> args, const std::vector<std::string>& more) {
     args.insert(args.end(), more.begin(), more.end());
