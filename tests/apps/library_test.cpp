@@ -177,8 +177,11 @@ TEST_F(Library, CompareWritesEachMapsJsonAndASummaryAndSkipsThemOnTheSecondRun) 
         EXPECT_FALSE(run["results"].empty());
     }
     expect_all("out/summary.json", "written");
-    // The tables print whole, one map after the other.
-    EXPECT_EQ(r.out.find("envmis compare: city.exr"), 0u) << r;
+    // The tables print whole, one map after the other (in the order they finish): each
+    // header line is followed by its own table's.
+    for (const std::string& stem : kStems)
+        EXPECT_TRUE(envmis::test::contains(r.out, "(^|\n)envmis compare: " + stem + "\\.exr [^\n]*\nbsdf +technique"))
+            << stem << r;
     const Result again = envmis(with({"compare", "maps", "--out-dir", "out"}, kStudy));
     EXPECT_EQ(again.exit_code, 0) << again;
     expect_all("out/summary.json", "up-to-date");
