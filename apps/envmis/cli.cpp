@@ -287,8 +287,11 @@ LoadedMap load_map(const std::string& path, const MapFlags& flags) {
     } catch (const std::invalid_argument& e) {
         throw std::runtime_error(path + ": " + e.what());
     }
-    loaded.source = {std::filesystem::path(path).filename().string(), image.content_hash, image.input_colorspace,
-                     image.working_colorspace};
+    loaded.source = {std::filesystem::path(path).filename().string(),
+                     image.content_hash,
+                     image.input_colorspace,
+                     image.working_colorspace,
+                     {}};
     loaded.format = image.format;
     loaded.channels = image.channels;
     return loaded;

@@ -1,9 +1,11 @@
 // envmis compare IN: the variance study. Estimates direct lighting on analytic BSDFs with
 // every technique at equal sample count and reports how much MIS compensation gains.
+// With several inputs or a folder and --out-dir, every map's study, in parallel (library.h).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -15,11 +17,12 @@
 
 #include "cli.h"
 #include "envmis/io/image_io.h"
+#include "envmis/report/results.h"
 #include "envmis/study/comparison/comparison.h"
 #include "envmis/study/comparison/sweeps.h"
 #include "envmis/table/atomic_file.h"
+#include "library.h"
 #include "render.h"
-#include "envmis/report/results.h"
 #include "sweeps.h"
 
 namespace envmis::cli {
@@ -27,6 +30,12 @@ namespace {
 
 // The flags of `envmis compare`, as CLI11 fills them.
 struct CompareArgs {
+    std::vector<std::string> inputs;  // library mode with several, or a folder
+    std::string out_dir, summary;
+    uint32_t jobs = 1;
+    bool force = false, recursive = false;
+    bool show_progress = true;  // library mode shows one bar for all maps instead
+    const CLI::Option* threads_flag = nullptr;
     std::string input, bsdfs = "lambert,phong:50,ggx:0.1", techniques, normal, view, json, csv, images, plots,
                        alpha_sweep;
     RenderOptions render;
@@ -34,6 +43,7 @@ struct CompareArgs {
     uint32_t bins = 0;  // --bins; 0: kDefaultBins where a -bins technique runs
     uint64_t seed = 1;
     bool exact = false;
+    std::string source_hash;  // of the map's file, as library.h's hash_text spells it
     MapFlags map;
     const CLI::Option* alpha_flag = nullptr;  // --alpha: given, it fixes the bins' alpha too
 };
@@ -65,6 +75,7 @@ struct Setup {
     CompensatedMaps compensated;
     std::shared_ptr<const BinnedEnvMap> binned;  // with a -bins technique
     bool bins_auto = false;                      // its alpha chosen per bin
+    std::string source_hash;                     // hash_text of the map file's hash64
 
     StudyInputs inputs() const { return {plain, compensated, points, options, binned.get()}; }
     float alpha_of(const Bsdf& bsdf) const {
@@ -99,7 +110,9 @@ std::vector<std::string> split(const std::string& text) {
 }
 
 void add_study_flags(CLI::App& sub, CompareArgs& args) {
-    sub.add_option("input", args.input, "HDR image or table")->required();
+    sub.add_option("input", args.inputs,
+                   "HDR image or table; several, or folders of them, with --out-dir (library mode)")
+        ->required();
     sub.add_option("--bsdf", args.bsdfs,
                    "BSDFs: lambert[:ALBEDO], phong:N[:ALBEDO], ggx:ALPHA[:F0], comma-separated; ALBEDO and F0 grey, "
                    "0 to 1 (default 0.8; GGX's F0 0.95/0.64/0.54)")
@@ -172,7 +185,7 @@ void add_sweep_flags(CLI::App& sub, CompareArgs& args) {
 
 // The plain map as the flags and the file say, and the fixed alpha (--alpha, or the
 // table's own).
-std::pair<EnvMap, float> load_plain(const CompareArgs& args, std::string& map_name) {
+std::pair<EnvMap, float> load_plain(const CompareArgs& args, std::string& map_name, std::string& source_hash) {
     // The plain density; the compensated ones are built from its radiance, as --alpha
     // says (or as a table was built).
     MapFlags flags = args.map;
@@ -180,6 +193,7 @@ std::pair<EnvMap, float> load_plain(const CompareArgs& args, std::string& map_na
     flags.alpha_auto = false;
     LoadedMap loaded = load_map(args.input, flags);
     map_name = loaded.source.name;
+    source_hash = hash_text(loaded.source.content_hash);
     const float fixed_alpha = !loaded.from_table         ? args.map.alpha
                               : loaded.map.compensated() ? loaded.map.options().compensation.alpha
                                                          : 0.0f;
@@ -250,8 +264,8 @@ Setup prepare(const CompareArgs& args) {
         if (!output->empty()) prepare_output(*output);
     if (!args.images.empty()) std::filesystem::create_directories(args.images);
     if (!args.plots.empty()) std::filesystem::create_directories(args.plots);
-    std::string map_name;
-    auto [plain, fixed_alpha] = load_plain(args, map_name);
+    std::string map_name, source_hash;
+    auto [plain, fixed_alpha] = load_plain(args, map_name, source_hash);
     std::vector<ShadingPoint> points;
     if (!args.normal.empty()) {
         const Vec3 n = parse_vector(args.normal, "--normal");
@@ -283,11 +297,13 @@ Setup prepare(const CompareArgs& args) {
             std::move(bsdf_alphas),
             std::move(compensated),
             std::move(binned),
-            bins_auto_alpha(args)};
+            bins_auto_alpha(args),
+            std::move(source_hash)};
 }
 
 // A RunControl that shows `label`'s progress on stderr and stops at Ctrl-C.
-RunControl watched(const char* label) {
+RunControl watched(const CompareArgs& args, const char* label) {
+    if (!args.show_progress) return {&interrupted(), {}};
     auto bar = std::make_shared<std::optional<Progress>>();
     return {&interrupted(), [label, bar](size_t done, size_t total) {
                 if (!*bar) bar->emplace(label, total);
@@ -299,7 +315,7 @@ Outcome run_compare(const CompareArgs& args, const Setup& setup) {
     Outcome outcome;
     const bool sweeping = !setup.swept.empty() || args.allocation_sweep;
     if (!sweeping) {
-        outcome.comparison = compare(setup.inputs(), watched("compare"));
+        outcome.comparison = compare(setup.inputs(), watched(args, "compare"));
     }
     if (!setup.swept.empty()) {
         // auto's choices and alpha = 0 are swept too, to say where auto stands.
@@ -313,12 +329,12 @@ Outcome run_compare(const CompareArgs& args, const Setup& setup) {
         StudyInputs inputs = setup.inputs();
         inputs.options.techniques = setup.alpha_techniques;
         outcome.alphas_swept = alphas.size();
-        outcome.alpha = run_alpha_sweep(inputs, alphas, args.exact, watched("alpha sweep"));
+        outcome.alpha = run_alpha_sweep(inputs, alphas, args.exact, watched(args, "alpha sweep"));
     }
     if (args.allocation_sweep && !interrupted()) {
         StudyInputs inputs = setup.inputs();
         inputs.options.techniques = setup.allocation_techniques;
-        outcome.allocation = run_allocation_sweep(inputs, args.allocation_sweep, watched("allocation sweep"));
+        outcome.allocation = run_allocation_sweep(inputs, args.allocation_sweep, watched(args, "allocation sweep"));
     }
     return outcome;
 }
@@ -398,9 +414,37 @@ nlohmann::json albedo_json(std::span<const Bsdf> bsdfs) {
     return albedo;
 }
 
-nlohmann::json inputs_json(const Setup& s, size_t points_done) {
+// Every flag that changes the numbers compare writes, or which files it writes, spelled
+// canonically: recorded in the JSON's inputs ("options"), so that library mode can tell
+// whether a map's results are what the same flags would give now. --threads, which
+// changes only the timings, is left out.
+std::string options_text(const CompareArgs& a) {
+    std::ostringstream text;
+    text << "bsdf=" << a.bsdfs << " techniques=" << a.techniques << " bins=" << a.bins << " spp=" << a.spp
+         << " env-samples=" << a.env_samples << " bsdf-samples=" << a.bsdf_samples << " seed=" << a.seed
+         << " normal=" << a.normal << " view=" << a.view << " points=" << a.points;
+    char alpha[32];
+    std::snprintf(alpha, sizeof alpha, "%.9g", a.map.alpha);
+    const bool alpha_given = a.alpha_flag && a.alpha_flag->count() > 0;
+    text << " alpha="
+         << (a.map.alpha_auto ? "auto"
+             : alpha_given    ? alpha
+                              : "(default)")
+         << " compensate=" << !a.map.no_compensate << " colorspace=" << a.map.colorspace
+         << " working-space=" << a.map.working_space << " axes=" << a.map.axes << " mapping=" << a.map.mapping
+         << " alpha-sweep=" << a.alpha_sweep << " exact=" << a.exact << " allocation-sweep=" << a.allocation_sweep
+         << " csv=" << !a.csv.empty() << " plots=" << !a.plots.empty() << " images=" << !a.images.empty();
+    if (!a.images.empty())
+        text << " image=" << a.render.size << " image-spp=" << a.render.spp
+             << " reference-spp=" << a.render.reference_spp;
+    return text.str();
+}
+
+nlohmann::json inputs_json(const CompareArgs& args, const Setup& s, size_t points_done) {
     const ComparisonOptions& o = s.options;
     nlohmann::json inputs = {{"map", s.map_name},
+                             {"source_hash", s.source_hash},
+                             {"options", options_text(args)},
                              {"width", s.plain.width()},
                              {"height", s.plain.height()},
                              {"alpha", s.map_alpha},
@@ -437,9 +481,9 @@ void write_plot(const CompareArgs& args, Written& written, const char* name, con
     written.plots.push_back(name);
 }
 
-void write_comparison(const CompareArgs& args, const Setup& s, const Comparison& c, Written& w) {
-    if (c.points_done < s.points.size()) std::cout << "interrupted: results cover the points done\n";
-    print_comparison(std::cout, c);
+void write_comparison(std::ostream& out, const CompareArgs& args, const Setup& s, const Comparison& c, Written& w) {
+    if (c.points_done < s.points.size()) out << "interrupted: results cover the points done\n";
+    print_comparison(out, c);
     const auto alpha_of = [&s](const Bsdf& b) { return s.alpha_of(b); };
     w.json["results"] = stats_results_json(c, alpha_of);
     for (const BsdfComparison& b : c.bsdfs) w.json["verdicts"].push_back(verdict(b));
@@ -453,14 +497,14 @@ void write_comparison(const CompareArgs& args, const Setup& s, const Comparison&
 
 // --exact: per BSDF, each fixed-weight technique's exact variance over mis-balance's,
 // the geometric mean over points and the worst point.
-void write_exact(const Setup& s, Written& w) {
+void write_exact(std::ostream& out, const Setup& s, Written& w) {
     const StudyInputs inputs = s.inputs();
     const Technique balance = Technique::parse("mis-balance");
-    std::cout << "exact var/mis: exact variance / that of mis-balance (quadrature, one subdivision), geometric mean "
-                 "over points (worst point)\n";
+    out << "exact var/mis: exact variance / that of mis-balance (quadrature, one subdivision), geometric mean "
+           "over points (worst point)\n";
     for (size_t b = 0; b < s.options.bsdfs.size(); ++b) {
         const std::vector<double> baseline = exact_point_variances(inputs, balance, b, 1);
-        std::cout << "  " << s.options.bsdfs[b].name() << ":";
+        out << "  " << s.options.bsdfs[b].name() << ":";
         for (const Technique& t : s.options.techniques) {
             if (t.adaptive() || t.mixture) continue;
             throw_if_interrupted();  // each technique's quadrature over every point takes up to seconds
@@ -471,19 +515,20 @@ void write_exact(const Setup& s, Written& w) {
             const double mean = geometric_mean_ratios(v, baseline, 1).front();
             char text[96];
             std::snprintf(text, sizeof text, " %s %.3f (%.3f)", t.name().c_str(), mean, worst);
-            std::cout << text;
+            out << text;
             w.json["exact"][s.options.bsdfs[b].name()][t.name()] = {{"ratio", mean}, {"worst", worst}};
         }
-        std::cout << "\n";
+        out << "\n";
     }
 }
 
-void write_alpha_sweep(const CompareArgs& args, const Setup& s, const AlphaSweep& sweep, size_t swept, Written& w) {
+void write_alpha_sweep(std::ostream& out, const CompareArgs& args, const Setup& s, const AlphaSweep& sweep,
+                       size_t swept, Written& w) {
     const std::vector<float>* auto_alphas = s.choice ? &s.bsdf_alphas : nullptr;
-    std::cout << "alpha sweep: " << swept << " values; var/mis: geometric mean over points of "
-              << "variance / variance of mis-balance; exact: the same from exact variances (noise-free)\n";
-    if (sweep.interrupted) std::cout << "interrupted: the sweep covers the " << sweep.alphas.size() << " alphas done\n";
-    print_alpha_sweep(std::cout, sweep, auto_alphas);
+    out << "alpha sweep: " << swept << " values; var/mis: geometric mean over points of "
+        << "variance / variance of mis-balance; exact: the same from exact variances (noise-free)\n";
+    if (sweep.interrupted) out << "interrupted: the sweep covers the " << sweep.alphas.size() << " alphas done\n";
+    print_alpha_sweep(out, sweep, auto_alphas);
     const std::vector<SweepRow> rows = sweep_rows(sweep);
     w.json["sweep"] = nlohmann::json::array();
     for (const SweepRow& row : rows) w.json["sweep"].push_back(sweep_row_json(row));
@@ -493,12 +538,13 @@ void write_alpha_sweep(const CompareArgs& args, const Setup& s, const AlphaSweep
         write_plot(args, w, "alpha_sweep.png", alpha_sweep_plot(sweep, s.map_name));
 }
 
-void write_allocation_sweep(const CompareArgs& args, const Setup& s, const AllocationSweep& sweep, Written& w) {
-    std::cout << "allocation sweep: " << args.allocation_sweep << " samples per estimate, split "
-              << "n_env:n_bsdf; efficiency = 1 / (variance * seconds per estimate)\n";
+void write_allocation_sweep(std::ostream& out, const CompareArgs& args, const Setup& s, const AllocationSweep& sweep,
+                            Written& w) {
+    out << "allocation sweep: " << args.allocation_sweep << " samples per estimate, split "
+        << "n_env:n_bsdf; efficiency = 1 / (variance * seconds per estimate)\n";
     if (sweep.interrupted)
-        std::cout << "interrupted: the sweep covers the " << sweep.allocations.size() << " allocations done\n";
-    print_allocation_sweep(std::cout, sweep);
+        out << "interrupted: the sweep covers the " << sweep.allocations.size() << " allocations done\n";
+    print_allocation_sweep(out, sweep);
     const std::vector<SweepRow> rows = sweep_rows(sweep, s.compensated);
     w.json["allocation"] = nlohmann::json::array();
     for (const SweepRow& row : rows) w.json["allocation"].push_back(sweep_row_json(row));
@@ -509,24 +555,24 @@ void write_allocation_sweep(const CompareArgs& args, const Setup& s, const Alloc
 
 // The pictures of --images: one compensated map for every sphere (with auto, its
 // map-wide choice).
-void write_pictures(const CompareArgs& args, const Setup& s) {
+void write_pictures(std::ostream& out, const CompareArgs& args, const Setup& s) {
     std::optional<CompensatedMaps> map_wide;
     if (s.choice) map_wide = compensated_maps(s.plain, std::vector<float>{s.map_alpha});
     const StudyInputs inputs{s.plain, map_wide ? *map_wide : s.compensated, s.points, s.options, s.binned.get()};
     const auto montage = render_comparison(inputs, args.render, args.images, s.map_name, {&interrupted(), {}});
-    std::cout << "pictures: " << args.images << " (montage: " << montage.string() << ")\n";
+    out << "pictures: " << args.images << " (montage: " << montage.string() << ")\n";
 }
 
 // Everything compare writes: the header, tables, JSON, CSV, plots and pictures.
-void write_compare(const CompareArgs& args, const Setup& s, const Outcome& outcome) {
+void write_compare(std::ostream& out, const CompareArgs& args, const Setup& s, const Outcome& outcome) {
     const size_t points_done = outcome.comparison ? outcome.comparison->points_done : s.points.size();
-    std::cout << header_line(s, points_done);
-    if (s.choice) print_alpha_choice(std::cout, *s.choice, s.options.bsdfs);
-    Written w{{{"inputs", inputs_json(s, points_done)}}, {}, {}};
-    if (outcome.comparison) write_comparison(args, s, *outcome.comparison, w);
-    if (outcome.comparison && args.exact && outcome.comparison->points_done == s.points.size()) write_exact(s, w);
-    if (outcome.alpha) write_alpha_sweep(args, s, *outcome.alpha, outcome.alphas_swept, w);
-    if (outcome.allocation) write_allocation_sweep(args, s, *outcome.allocation, w);
+    out << header_line(s, points_done);
+    if (s.choice) print_alpha_choice(out, *s.choice, s.options.bsdfs);
+    Written w{{{"inputs", inputs_json(args, s, points_done)}}, {}, {}};
+    if (outcome.comparison) write_comparison(out, args, s, *outcome.comparison, w);
+    if (outcome.comparison && args.exact && outcome.comparison->points_done == s.points.size()) write_exact(out, s, w);
+    if (outcome.alpha) write_alpha_sweep(out, args, s, *outcome.alpha, outcome.alphas_swept, w);
+    if (outcome.allocation) write_allocation_sweep(out, args, s, *outcome.allocation, w);
     if ((outcome.alpha || outcome.allocation) && !args.csv.empty()) {
         std::ostringstream prefix;
         prefix << s.map_name << ',' << s.options.spp << ',' << s.options.seed << ',' << s.points.size() << ',';
@@ -537,29 +583,112 @@ void write_compare(const CompareArgs& args, const Setup& s, const Outcome& outco
     }
     if (!args.json.empty()) write_file_atomically(args.json, [&](std::ostream& out) { out << w.json.dump(2) << "\n"; });
     if (!w.plots.empty()) {
-        std::cout << "plots: " << args.plots << " (";
-        for (size_t i = 0; i < w.plots.size(); ++i) std::cout << (i ? ", " : "") << w.plots[i];
-        std::cout << ")\n";
+        out << "plots: " << args.plots << " (";
+        for (size_t i = 0; i < w.plots.size(); ++i) out << (i ? ", " : "") << w.plots[i];
+        out << ")\n";
     }
-    if (!args.images.empty()) write_pictures(args, s);
+    if (!args.images.empty()) write_pictures(out, args, s);
 }
 
 // A run stopped early prints the tables of what is done (each says it is partial) and
 // writes no file: a reader of the JSON, CSV or pictures could not tell them from a
 // whole run's. Then it throws Interrupted, saying so.
-void write_partial(const CompareArgs& args, const Setup& s, const Outcome& outcome) {
+void write_partial(std::ostream& out, const CompareArgs& args, const Setup& s, const Outcome& outcome) {
     CompareArgs printed = args;
     printed.json.clear();
     printed.csv.clear();
     printed.plots.clear();
     printed.images.clear();
-    write_compare(printed, s, outcome);
+    write_compare(out, printed, s, outcome);
     const bool outputs = !(args.json.empty() && args.csv.empty() && args.plots.empty() && args.images.empty());
     std::string detail = "the results above are partial";
     if (outcome.comparison)
         detail = "the results above cover " + std::to_string(outcome.comparison->points_done) + " of " +
                  std::to_string(s.points.size()) + " points";
     throw Interrupted(detail + (outputs ? "; no file written" : ""));
+}
+
+}  // namespace
+
+namespace {
+
+void add_library_flags(CLI::App& sub, CompareArgs& args) {
+    sub.add_option("--out-dir", args.out_dir,
+                   "Library mode (several inputs or a folder): each map's JSON to DIR/<stem>.json, and "
+                   "DIR/summary.json; --csv, --plots and --images then name folders receiving each map's files");
+    add_jobs_flag(sub, args.jobs);
+    sub.add_flag("--force", args.force, "Library mode: run every map, also those whose JSON is up to date");
+    sub.add_flag("--recursive", args.recursive, "Library mode: also the maps in subfolders of a folder input");
+    sub.add_option("--summary", args.summary,
+                   "Library mode: the JSON summary of every map's result (default: DIR/summary.json)");
+}
+
+// One map's study, start to end; `out` takes what it prints.
+void compare_one(const CompareArgs& args, std::ostream& out) {
+    const Setup setup = prepare(args);
+    const Outcome outcome = run_compare(args, setup);
+    if (interrupted())
+        write_partial(out, args, setup, outcome);
+    else
+        write_compare(out, args, setup, outcome);
+}
+
+// True where `json` holds results of the source whose bytes hash to `hash`, run with
+// `options`. A file that cannot be read or parsed is not up to date.
+bool results_up_to_date(const std::filesystem::path& json, uint64_t hash, const std::string& options) {
+    std::ifstream in(json);
+    if (!in) return false;
+    const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_discarded() || !j.is_object() || !j.contains("inputs") || !j["inputs"].is_object()) return false;
+    const nlohmann::json& inputs = j["inputs"];
+    return inputs.value("source_hash", "") == hash_text(hash) && inputs.value("options", "") == options;
+}
+
+// Several inputs or a folder: each map's study to DIR/<stem>.json, on the pool of --jobs;
+// each map's --threads defaults to its share of the cores.
+void run_library_compare(const CompareArgs& args) {
+    if (args.out_dir.empty()) {
+        std::error_code ec;
+        for (const std::string& input : args.inputs)
+            if (std::filesystem::is_directory(input, ec))
+                throw std::runtime_error(input + ": a directory; a folder of maps needs --out-dir DIR (library mode)");
+        throw std::runtime_error("--out-dir: required with several inputs, or with --summary (library mode)");
+    }
+    if (!args.json.empty())
+        throw std::runtime_error("--json: not in library mode; each map's JSON goes to --out-dir/<stem>.json");
+    const std::filesystem::path dir = args.out_dir;
+    const std::vector<LibraryItem> items = plan_outputs(expand_inputs(args.inputs, args.recursive, true), dir, ".json");
+    std::filesystem::create_directories(dir);
+    for (const LibraryItem& item : items) prepare_output(item.output);
+    CompareArgs shared = args;
+    shared.show_progress = false;
+    if (!(args.threads_flag && args.threads_flag->count() > 0))
+        shared.threads = std::max(1u, hardware_cores() / std::min<uint32_t>(args.jobs, uint32_t(items.size())));
+    const std::string options = options_text(args);
+    run_library(
+        items,
+        {"compare", args.jobs, args.summary.empty() ? dir / "summary.json" : std::filesystem::path(args.summary)},
+        [&](const LibraryItem& item, uint64_t hash) {
+            MapOutcome outcome;
+            if (!args.force && results_up_to_date(item.output, hash, options)) {
+                outcome.status = "up-to-date";
+                outcome.printed = "envmis compare: " + item.output.string() + " is up to date\n";
+                return outcome;
+            }
+            CompareArgs one = shared;
+            one.input = item.input.string();
+            one.json = item.output.string();
+            const std::string stem = item.input.stem().string();
+            if (!args.csv.empty()) one.csv = (std::filesystem::path(args.csv) / (stem + ".csv")).string();
+            if (!args.plots.empty()) one.plots = (std::filesystem::path(args.plots) / stem).string();
+            if (!args.images.empty()) one.images = (std::filesystem::path(args.images) / stem).string();
+            if (!args.csv.empty()) std::filesystem::create_directories(args.csv);
+            std::ostringstream out;
+            compare_one(one, out);
+            outcome.status = "written";
+            outcome.printed = out.str();
+            return outcome;
+        });
 }
 
 }  // namespace
@@ -571,15 +700,17 @@ Subcommand add_compare(CLI::App& app) {
     add_study_flags(*sub, *args);
     add_output_flags(*sub, *args);
     add_sweep_flags(*sub, *args);
+    add_library_flags(*sub, *args);
     add_map_flags(*sub, args->map);
     args->alpha_flag = sub->get_option("--alpha");
+    args->threads_flag = sub->get_option("--threads");
     return {sub, [args] {
-                const Setup setup = prepare(*args);
-                const Outcome outcome = run_compare(*args, setup);
-                if (interrupted())
-                    write_partial(*args, setup, outcome);
-                else
-                    write_compare(*args, setup, outcome);
+                std::error_code ec;
+                if (args->inputs.size() > 1 || !args->out_dir.empty() || !args->summary.empty() ||
+                    std::filesystem::is_directory(args->inputs.front(), ec))
+                    return run_library_compare(*args);
+                args->input = args->inputs.front();
+                compare_one(*args, std::cout);
             }};
 }
 

@@ -1,4 +1,5 @@
-// envmis precompute IN -o OUT.envmis: build a map's sampler and save it as a table.
+// envmis precompute IN -o OUT.envmis: build a map's sampler and save it as a table; with
+// several inputs or a folder, every map into the folder OUT, in parallel (library.h).
 #include <algorithm>
 #include <charconv>
 #include <chrono>
@@ -7,8 +8,11 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
+#include <vector>
 
 #include "cli.h"
+#include "library.h"
 
 namespace envmis::cli {
 namespace {
@@ -33,16 +37,23 @@ void print_compact_error(std::ostream& out, const EnvMap& map) {
 
 // The arguments of `envmis precompute`.
 struct PrecomputeArgs {
-    std::string input, output;
+    std::vector<std::string> inputs;
+    std::string output, summary;
     MapFlags map;
     bool compact = false;
     uint32_t bins = 0;  // K = g^2 normal bins (sampling/binned.h); 0: a single density
     uint32_t cell_columns = 0;
+    uint32_t jobs = 1;
+    bool force = false, recursive = false;
 };
 
 void add_precompute_flags(CLI::App& sub, PrecomputeArgs& args) {
-    sub.add_option("input", args.input, "HDR image (EXR, .hdr, .pfm, TIFF, ...)")->required();
-    sub.add_option("-o,--output", args.output, "Table file to write (.envmis)")->required();
+    sub.add_option("input", args.inputs,
+                   "HDR images (EXR, .hdr, .pfm, TIFF, ...) or folders of them; one image: OUT is the table, "
+                   "several or a folder: OUT is a folder receiving OUT/<stem>.envmis each")
+        ->required();
+    sub.add_option("-o,--output", args.output, "Table file to write (.envmis), or with several inputs a folder")
+        ->required();
     sub.add_flag("--compact", args.compact,
                  "Store the radiance in RGBE (4 bytes/texel instead of 16; density rebuilt on load); prints the error");
     CLI::Option* bins =
@@ -56,18 +67,62 @@ void add_precompute_flags(CLI::App& sub, PrecomputeArgs& args) {
         ->type_name("N")
         ->check(in_range(uint32_t{0}, uint32_t{4096}))
         ->needs(bins);
+    add_jobs_flag(sub, args.jobs);
+    sub.add_flag("--force", args.force,
+                 "Library mode: rebuild every table, also those up to date (same source bytes and options)");
+    sub.add_flag("--recursive", args.recursive, "Library mode: also the images in subfolders of a folder input");
+    sub.add_option("--summary", args.summary,
+                   "Library mode: the JSON summary of every map's result (default: OUT/summary.json)");
     add_map_flags(sub, args.map);
 }
 
+// The options a table is built with, spelled canonically: recorded in the table
+// (TableSource::build_options), equal exactly when the same flags would build the same
+// table from the same source. The effective alpha is recorded ("auto", or the value to
+// 9 digits), not how it was asked for.
+std::string build_options(const PrecomputeArgs& args) {
+    const MapFlags& m = args.map;
+    const bool automatic = args.bins ? m.alpha_auto || !m.alpha_given : m.alpha_auto;
+    char alpha[32];
+    std::snprintf(alpha, sizeof alpha, "%.9g", m.alpha);
+    std::ostringstream text;
+    text << "compensate=" << !m.no_compensate << " alpha="
+         << (m.no_compensate ? "-"
+             : automatic     ? "auto"
+                             : alpha)
+         << " mapping=" << m.mapping << " colorspace=" << (m.colorspace.empty() ? "(file)" : m.colorspace)
+         << " working-space=" << m.working_space << " axes=" << m.axes << " compact=" << args.compact
+         << " bins=" << args.bins << " cell-columns=" << args.cell_columns;
+    return text.str();
+}
+
+// What a written table's summary entry records of it.
+nlohmann::json table_details(const LoadedMap& loaded, const EnvMap& map, double write_ms) {
+    const EnvMapStats& s = map.stats();
+    return {{"width", map.width()},
+            {"height", map.height()},
+            {"compensated", map.options().compensation.enabled},
+            {"alpha", map.options().compensation.alpha},
+            {"mean_luminance", s.mean_luminance},
+            {"max_luminance", s.max_luminance},
+            {"zeroed_texels", s.zeroed_texels},
+            {"fallback", std::string(to_string(s.fallback))},
+            {"complete", map.complete()},
+            {"bins", loaded.bins ? loaded.bins->bins_per_side * loaded.bins->bins_per_side : 0},
+            {"load_ms", loaded.load_ms},
+            {"build_ms", loaded.build_ms},
+            {"write_ms", write_ms}};
+}
+
 // `map` is loaded.map, or the plain map of `binned` (which then holds it).
-void print_precompute(const PrecomputeArgs& args, const LoadedMap& loaded, const EnvMap& map,
-                      const BinnedEnvMap* binned, double bins_ms, double write_ms) {
-    std::cout << "envmis precompute: " << args.input << " -> " << args.output << "\n";
-    print_summary(std::cout, loaded, map);
-    if (binned) print_bins_cost(std::cout, *binned, bins_ms);
-    if (args.compact) print_compact_error(std::cout, map);
-    std::cout << std::fixed << std::setprecision(1) << "  time          load " << loaded.load_ms << " ms, build "
-              << loaded.build_ms << " ms, write " << write_ms << " ms\n";
+void print_precompute(std::ostream& out, const PrecomputeArgs& args, const LibraryItem& item, const LoadedMap& loaded,
+                      const EnvMap& map, const BinnedEnvMap* binned, double bins_ms, double write_ms) {
+    out << "envmis precompute: " << item.input.string() << " -> " << item.output.string() << "\n";
+    print_summary(out, loaded, map);
+    if (binned) print_bins_cost(out, *binned, bins_ms);
+    if (args.compact) print_compact_error(out, map);
+    out << std::fixed << std::setprecision(1) << "  time          load " << loaded.load_ms << " ms, build "
+        << loaded.build_ms << " ms, write " << write_ms << " ms\n";
 }
 
 // The bins as the map flags ask: --alpha auto per bin (also without --alpha: the choice
@@ -81,35 +136,103 @@ BinnedOptions binned_options(const PrecomputeArgs& args) {
     return o;
 }
 
+// The source as load_map read it, with the options it was built with.
+TableSource recorded_source(const PrecomputeArgs& args, const LoadedMap& loaded) {
+    TableSource source = loaded.source;
+    source.build_options = build_options(args);
+    return source;
+}
+
 // With --bins the table's texels hold the plain map, and the compensation the flags ask
 // for goes into the bins.
-void run_precompute_binned(const PrecomputeArgs& args) {
+nlohmann::json precompute_binned(const PrecomputeArgs& args, const LibraryItem& item, std::ostream& out,
+                                 bool show_progress) {
     MapFlags plain = args.map;
     plain.no_compensate = true;
     plain.alpha_auto = false;
-    LoadedMap loaded = load_map(args.input, plain);
-    if (loaded.from_table) throw std::runtime_error(args.input + ": is already a table; give an image");
+    LoadedMap loaded = load_map(item.input.string(), plain);
+    if (loaded.from_table) throw std::runtime_error(item.input.string() + ": is already a table; give an image");
     const auto build_start = std::chrono::steady_clock::now();
-    std::optional<Progress> progress(std::in_place, "building bins", 1);
+    std::optional<Progress> progress;
+    if (show_progress) progress.emplace("building bins", 1);
     const BinnedEnvMap binned(std::move(loaded.map), binned_options(args), &interrupted());
     progress.reset();
     const double bins_ms = milliseconds_since(build_start);
     loaded.bins = binned.layout();
     const auto start = std::chrono::steady_clock::now();
-    write_table(args.output, binned, loaded.source, args.compact ? TableEncoding::compact : TableEncoding::full,
-                &interrupted());
-    print_precompute(args, loaded, binned.plain(), &binned, bins_ms, milliseconds_since(start));
+    write_table(item.output, binned, recorded_source(args, loaded),
+                args.compact ? TableEncoding::compact : TableEncoding::full, &interrupted());
+    const double write_ms = milliseconds_since(start);
+    print_precompute(out, args, item, loaded, binned.plain(), &binned, bins_ms, write_ms);
+    nlohmann::json details = table_details(loaded, binned.plain(), write_ms);
+    details["bins_build_ms"] = bins_ms;
+    return details;
+}
+
+// One map: its table written, what precompute prints on `out`, and its summary details.
+nlohmann::json precompute_one(const PrecomputeArgs& args, const LibraryItem& item, std::ostream& out,
+                              bool show_progress) {
+    if (args.bins != 0) return precompute_binned(args, item, out, show_progress);
+    const LoadedMap loaded = load_map(item.input.string(), args.map);
+    if (loaded.from_table) throw std::runtime_error(item.input.string() + ": is already a table; give an image");
+    const auto start = std::chrono::steady_clock::now();
+    write_table(item.output, loaded.map, recorded_source(args, loaded),
+                args.compact ? TableEncoding::compact : TableEncoding::full, &interrupted());
+    const double write_ms = milliseconds_since(start);
+    print_precompute(out, args, item, loaded, loaded.map, nullptr, 0, write_ms);
+    return table_details(loaded, loaded.map, write_ms);
+}
+
+// True where `output` is a table of the source whose bytes hash to `hash`, built with
+// `options`; only its header is read. A table that cannot be read is not up to date.
+bool up_to_date(const std::filesystem::path& output, uint64_t hash, const std::string& options) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(output, ec)) return false;
+    try {
+        const TableHeader header = read_table_header(output);
+        return header.source.content_hash == hash && header.source.build_options == options;
+    } catch (const TableError&) {
+        return false;
+    }
+}
+
+// Each map of `items` on the pool of --jobs, skipping those up to date, with a summary.
+void precompute_items(const PrecomputeArgs& args, const std::vector<LibraryItem>& items,
+                      const std::filesystem::path& summary) {
+    for (const LibraryItem& item : items) prepare_output(item.output);
+    const std::string options = build_options(args);
+    run_library(items, {"precompute", args.jobs, summary}, [&](const LibraryItem& item, uint64_t hash) {
+        MapOutcome outcome;
+        if (!args.force && up_to_date(item.output, hash, options)) {
+            outcome.status = "up-to-date";
+            outcome.printed = "envmis precompute: " + item.output.string() + " is up to date\n";
+            return outcome;
+        }
+        std::ostringstream out;
+        outcome.details = precompute_one(args, item, out, false);
+        outcome.status = "written";
+        outcome.printed = out.str();
+        return outcome;
+    });
 }
 
 void run_precompute(const PrecomputeArgs& args) {
-    prepare_output(args.output);
-    if (args.bins != 0) return run_precompute_binned(args);
-    const LoadedMap loaded = load_map(args.input, args.map);
-    if (loaded.from_table) throw std::runtime_error(args.input + ": is already a table; give an image");
-    const auto start = std::chrono::steady_clock::now();
-    write_table(args.output, loaded.map, loaded.source, args.compact ? TableEncoding::compact : TableEncoding::full,
-                &interrupted());
-    print_precompute(args, loaded, loaded.map, nullptr, 0, milliseconds_since(start));
+    std::error_code ec;
+    if (args.inputs.size() == 1 && !std::filesystem::is_directory(args.inputs.front(), ec)) {
+        const LibraryItem item{args.inputs.front(), args.output};
+        if (!args.summary.empty()) return precompute_items(args, {item}, args.summary);
+        prepare_output(args.output);
+        precompute_one(args, item, std::cout, true);
+        return;
+    }
+    // Several inputs or a folder: each map to OUT/<stem>.envmis.
+    const std::filesystem::path dir = args.output;
+    const std::vector<LibraryItem> items =
+        plan_outputs(expand_inputs(args.inputs, args.recursive, false), dir, ".envmis");
+    if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
+        throw std::runtime_error(dir.string() + ": exists and is not a folder (with several inputs, -o is a folder)");
+    std::filesystem::create_directories(dir);
+    precompute_items(args, items, args.summary.empty() ? dir / "summary.json" : std::filesystem::path(args.summary));
 }
 
 }  // namespace

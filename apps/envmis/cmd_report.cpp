@@ -17,8 +17,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
-#include "envmis/table/atomic_file.h"
 #include "envmis/report/results.h"
+#include "envmis/table/atomic_file.h"
 
 namespace envmis::cli {
 namespace {
@@ -29,9 +29,12 @@ using nlohmann::json;
 struct ReportArgs {
     std::vector<std::string> inputs;
     std::string output, title = "envmis results", command, plots;
+    bool no_timing = false;  // leave out what measured time decides (--no-timing)
 };
 
-json read_results(const std::string& path) {
+// The results of one compare run; empty for the summary of a library run
+// (envmis compare --out-dir DIR writes it next to the maps' JSON, so DIR/*.json holds it).
+std::optional<json> read_results(const std::string& path) {
     std::ifstream in(path);
     if (!in) throw std::runtime_error(path + ": cannot open");
     json j;
@@ -40,6 +43,7 @@ json read_results(const std::string& path) {
     } catch (const json::exception& e) {
         throw std::runtime_error(path + ": not JSON (" + e.what() + ")");
     }
+    if (j.is_object() && j.contains("envmis_summary")) return std::nullopt;
     const bool measured =
         (j.contains("results") && j["results"].is_array()) || j.contains("sweep") || j.contains("allocation");
     if (!j.contains("inputs") || !measured)
@@ -119,7 +123,8 @@ void write_strength(std::ostream& out, const std::vector<json>& runs) {
 }
 
 // Sample allocation: the most efficient n_env:n_bsdf split per (map, BSDF, technique).
-void write_allocation(std::ostream& out, const std::vector<json>& runs) {
+void write_allocation(std::ostream& out, const std::vector<json>& runs, bool no_timing) {
+    if (no_timing) return;  // the best split is the one of highest measured efficiency
     bool header = false;
     for (const json& run : runs) {
         if (!run.contains("allocation")) continue;
@@ -292,19 +297,23 @@ constexpr StatsColumn kReportColumns[] = {{"mean", "mean", 0, "%.4g"},
                                           {"variance_ratio_vs_mis", "var/mis", 0, "%.3f"}};
 
 // Each run's full table.
-void write_tables(std::ostream& out, const std::vector<json>& runs) {
+void write_tables(std::ostream& out, const std::vector<json>& runs, bool no_timing) {
+    std::vector<StatsColumn> columns;
+    for (const StatsColumn& c : columns)
+        if (!no_timing || (std::string_view(c.key) != "ns_per_estimate" && std::string_view(c.key) != "efficiency"))
+            columns.push_back(c);
     for (const json& run : runs) {
         if (!run.contains("results")) continue;
         const json& in = run["inputs"];
         out << "## " << in.value("map", "?") << " (" << in.value("width", 0) << "x" << in.value("height", 0)
             << "), alpha " << number(in.value("alpha", 1.0), "%.3g") << "\n\n| bsdf | technique |";
-        for (const StatsColumn& c : kReportColumns) out << " " << c.heading << " |";
+        for (const StatsColumn& c : columns) out << " " << c.heading << " |";
         out << "\n|---|---|";
-        for (size_t i = 0; i < std::size(kReportColumns); ++i) out << "---:|";
+        for (size_t i = 0; i < columns.size(); ++i) out << "---:|";
         out << "\n";
         for (const json& r : run["results"]) {
             out << "| " << r["bsdf"].get<std::string>() << " | " << r["technique"].get<std::string>() << " |";
-            for (const StatsColumn& c : kReportColumns) out << " " << cell_text(r[c.key].get<double>(), c) << " |";
+            for (const StatsColumn& c : columns) out << " " << cell_text(r[c.key].get<double>(), c) << " |";
             out << "\n";
         }
         out << "\n";
@@ -317,15 +326,22 @@ void write_report(std::ostream& out, const std::vector<json>& runs, const Report
     write_summary(out, techniques, cases);
     write_optimal(out, cases);
     write_strength(out, runs);
-    write_allocation(out, runs);
+    write_allocation(out, runs, args.no_timing);
     write_plots(out, runs, args.plots);
-    write_tables(out, runs);
+    write_tables(out, runs, args.no_timing);
 }
 
 void run_report(const ReportArgs& args) {
     prepare_output(args.output);
     std::vector<json> runs;
-    for (const std::string& path : args.inputs) runs.push_back(read_results(path));
+    for (const std::string& path : args.inputs) {
+        if (std::optional<json> run = read_results(path))
+            runs.push_back(std::move(*run));
+        else
+            std::cerr << "note: " << printable(path)
+                      << ": the summary of a library run, not a map's results; skipped\n";
+    }
+    if (runs.empty()) throw std::runtime_error(args.inputs.front() + ": no results of envmis compare among the inputs");
     write_file_atomically(args.output, [&](std::ostream& out) { write_report(out, runs, args); });
     std::cout << "report: " << args.output << " (" << runs.size() << " runs)\n";
 }
@@ -339,6 +355,9 @@ Subcommand add_report(CLI::App& app) {
     sub->add_option("-o,--output", args->output, "Markdown file to write")->required();
     sub->add_option("--title", args->title, "Title of the report")->capture_default_str();
     sub->add_option("--command", args->command, "The command that made the results, quoted in the report");
+    sub->add_flag("--no-timing", args->no_timing,
+                  "Leave out what measured time decides (ns/estimate, efficiency, the allocation section): the "
+                  "report then depends only on the inputs and seeds, e.g. to compare a sharded run with one process");
     sub->add_option("--plots", args->plots,
                     "Folder, relative to the report, holding each map's plots (MAP/variance_vs_balance.png, ...)");
     return {sub, [args] { run_report(*args); }};

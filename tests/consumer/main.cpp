@@ -80,7 +80,7 @@ void check_samples(const envmis::EnvMap& map, const envmis::EnvMap& loaded) {
 }
 
 void check_map(const envmis::EnvMap& map, const std::filesystem::path& table_file) {
-    const envmis::TableSource source{"sky.exr", 42, "lin_rec709", "lin_rec709"};
+    const envmis::TableSource source{"sky.exr", 42, "lin_rec709", "lin_rec709", ""};
     envmis::write_table(table_file, map, source);
     check(envmis::looks_like_table(table_file), "the written table is not recognised");
     const envmis::Table table = envmis::read_table(table_file);

@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
     try {
         const std::filesystem::path dir = argv[1];
         std::filesystem::create_directories(dir);
-        const envmis::TableSource source{"seed.exr", 0x1234, "lin_rec709", "lin_rec709"};
+        const envmis::TableSource source{"seed.exr", 0x1234, "lin_rec709", "lin_rec709", ""};
 
         envmis::write_table(dir / "compensated_4x2.envmis", envmis::EnvMap(sky(4, 2)), source);
 

@@ -38,8 +38,8 @@ T load(const std::vector<std::byte>& bytes, size_t at) {
     return value;
 }
 
-// The bins-section size a version 4 header gives (bytes up to header_end); 0 where there
-// is none or the metadata is too damaged to find it.
+// The bins-section size a version 4 or later header gives (right after the three strings) (bytes up to header_end); 0
+// where there is none or the metadata is too damaged to find it.
 inline size_t bins_size(const std::vector<std::byte>& bytes, size_t header_end) {
     if (load<uint32_t>(bytes, kVersionField) < 4) return 0;
     size_t at = kPreamble + kFixedMetadata;

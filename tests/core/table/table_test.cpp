@@ -60,7 +60,7 @@ protected:
 
     fs::path dir_;
     EnvMap map_;
-    TableSource source_{"sky.exr", 0x1234abcd5678ef90ull, "lin_rec709", "ACEScg"};
+    TableSource source_{"sky.exr", 0x1234abcd5678ef90ull, "lin_rec709", "ACEScg", "compensate=1 alpha=0.75"};
 };
 
 // `loaded` samples exactly as `expected`: every field of n samples, bit for bit, and
@@ -86,6 +86,7 @@ TEST_F(TableTest, RoundTripKeepsOptionsStatsAndSource) {
     EXPECT_EQ(t.source.content_hash, source_.content_hash);
     EXPECT_EQ(t.source.input_colorspace, source_.input_colorspace);
     EXPECT_EQ(t.source.working_colorspace, source_.working_colorspace);
+    EXPECT_EQ(t.source.build_options, source_.build_options);
     EXPECT_EQ(t.map.options().compensation.alpha, 0.75f);
     EXPECT_TRUE(t.map.options().compensation.enabled);
     EXPECT_EQ(t.map.options().axes, Axes::parse("y-up"));
@@ -223,15 +224,18 @@ void reseal(std::vector<char>& bytes) {
     std::memcpy(bytes.data() + kPreamble + m, &digest, sizeof digest);
 }
 
-// The same table (without bins) as an older version writes it: no bins-section size;
-// before version 3 no metadata padding; version 1 also has a reserved 0 where later
-// versions keep the mapping.
+// The same table as an older version writes it: version 4 has no build options; before
+// it, no bins-section size (and no bins); before version 3 no metadata padding; version 1
+// also has a reserved 0 where later versions keep the mapping.
 std::vector<char> as_version(std::vector<char> bytes, uint32_t version) {
     const uint32_t m = u32_at(bytes, kMetadataSizeAt);
     uint32_t unpadded = static_cast<uint32_t>(unpadded_metadata(bytes));
-    EXPECT_EQ(u32_at(bytes, kPreamble + unpadded), 0u) << "a table with bins has no older version";
+    if (version == 4)
+        unpadded += 4;  // keeps the bins-section size
+    else
+        EXPECT_EQ(u32_at(bytes, kPreamble + unpadded), 0u) << "a table with bins has no older version";
     bytes.erase(bytes.begin() + kPreamble + unpadded, bytes.begin() + kPreamble + m);
-    if (version == 3) {
+    if (version >= 3) {
         const uint32_t padding = (8 - unpadded % 8) % 8;
         bytes.insert(bytes.begin() + kPreamble + unpadded, padding, 0);
         unpadded += padding;
@@ -284,6 +288,46 @@ TEST_F(TableTest, VersionThreeTablesStillReadFromAMapping) {
 #endif
     EXPECT_FALSE(loaded.bins);
     expect_identical_samples(map_, loaded.map, 5, 1000);
+}
+
+// Version 4 is version 5 without the build options: such tables read, with none.
+TEST_F(TableTest, VersionFourTablesStillReadWithoutBuildOptions) {
+    const fs::path path = saved_table();
+    write_bytes(path, as_version(bytes_of(path), 4));
+    const Table loaded = read_table(path);
+    EXPECT_EQ(loaded.version, 4u);
+    EXPECT_EQ(loaded.source.name, source_.name);
+    EXPECT_EQ(loaded.source.build_options, "");
+    expect_identical_samples(map_, loaded.map, 5, 1000);
+    EXPECT_EQ(read_table_header(path).source.build_options, "");
+}
+
+// The header alone says what a tool needs to tell whether a table is up to date, and is
+// checked as read_table checks it; the payload is not read.
+TEST_F(TableTest, TheHeaderAloneGivesSizeOptionsAndSource) {
+    const fs::path path = saved_table();
+    const TableHeader header = read_table_header(path);
+    EXPECT_EQ(header.version, kTableVersion);
+    EXPECT_EQ(header.width, map_.width());
+    EXPECT_EQ(header.height, map_.height());
+    EXPECT_EQ(header.source.content_hash, source_.content_hash);
+    EXPECT_EQ(header.source.build_options, source_.build_options);
+    EXPECT_EQ(header.options.compensation.alpha, 0.75f);
+    EXPECT_EQ(header.stats.mean_luminance, map_.stats().mean_luminance);
+    EXPECT_FALSE(header.compact);
+    EXPECT_FALSE(header.binned);
+
+    std::vector<char> bytes = bytes_of(path);
+    bytes[bytes.size() - 9] ^= 1;  // the payload's last byte
+    write_bytes(path, bytes);
+    EXPECT_NO_THROW(read_table_header(path));
+    bytes[kPreamble + 1] ^= 1;  // the width
+    write_bytes(path, bytes);
+    EXPECT_THROW(read_table_header(path), TableError);
+    bytes.resize(bytes.size() - 1);
+    write_bytes(path, bytes);
+    EXPECT_THROW(read_table_header(path), TableError);
+    EXPECT_THROW(read_table_header(dir_ / "missing.envmis"), TableError);
 }
 
 // Version 3 pads the metadata block with zeros to a multiple of 8 bytes, so that the
@@ -494,7 +538,7 @@ TEST_F(BinnedTableTest, BinnedTablesRoundTripBitIdenticallyMappedOrCopied) {
     const fs::path path = saved_binned_table();
     for (TableLoading loading : {TableLoading::map, TableLoading::copy}) {
         Table table = read_table(path, loading);
-        EXPECT_EQ(table.version, 4u);
+        EXPECT_EQ(table.version, kTableVersion);
         ASSERT_TRUE(table.bins);
         expect_same_layout(*table.bins, binned_.layout());
         const BinnedEnvMap loaded = binned_map(std::move(table));
@@ -504,6 +548,7 @@ TEST_F(BinnedTableTest, BinnedTablesRoundTripBitIdenticallyMappedOrCopied) {
 #if defined(__unix__) || defined(__APPLE__)
     EXPECT_TRUE(read_table(path).mapped);
 #endif
+    EXPECT_TRUE(read_table_header(path).binned);
     const std::vector<char> bytes = bytes_of(path);
     const Table parsed = parse_table(std::as_bytes(std::span(bytes)), "mem");
     ASSERT_TRUE(parsed.bins);

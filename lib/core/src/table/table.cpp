@@ -152,6 +152,7 @@ std::vector<std::byte> metadata_block(const EnvMap& map, const EnvMapStats& s, c
     w.put_string(source.input_colorspace);
     w.put_string(source.working_colorspace);
     w.put(bins_size);
+    w.put_string(source.build_options);
     w.bytes.resize((w.bytes.size() + kMetadataAlignment - 1) / kMetadataAlignment * kMetadataAlignment);
     return std::move(w.bytes);
 }
@@ -248,7 +249,8 @@ namespace {
 // The plain map's table, with `layout`'s bins section if not null.
 void write_map(const std::filesystem::path& path, const EnvMap& map, const TableSource& source, TableEncoding encoding,
                const BinLayout* layout, StopFlag stop) {
-    for (const std::string* s : {&source.name, &source.input_colorspace, &source.working_colorspace})
+    for (const std::string* s :
+         {&source.name, &source.input_colorspace, &source.working_colorspace, &source.build_options})
         if (s->size() > kMaxStringSize)
             throw TableError(path.string() + ": metadata string longer than " + std::to_string(kMaxStringSize) +
                              " bytes");
@@ -454,6 +456,7 @@ Header parse_header(std::span<const std::byte> head, uint64_t file_size, std::st
     source.input_colorspace = meta.take_string("input colour space");
     source.working_colorspace = meta.take_string("working colour space");
     if (version >= 4) out.bins_size = meta.take<uint32_t>("bins section size");
+    if (version >= 5) source.build_options = meta.take_string("build options");
 
     in.take_bytes(metadata_size, "metadata");
     if (in.take<uint64_t>("header checksum") != header_digest) in.fail("corrupted header (checksum mismatch)");
@@ -682,6 +685,22 @@ BinnedEnvMap binned_map(Table&& table) {
     } catch (const std::invalid_argument& e) {
         fail(name, std::string("bins do not fit the map: ") + e.what());
     }
+}
+
+TableHeader read_table_header(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw TableError(path.string() + ": no such file");
+    if (!std::filesystem::is_regular_file(path, ec)) throw TableError(path.string() + ": not a regular file");
+    std::ifstream file(path, std::ios::binary | std::ios::ate);
+    if (!file) throw TableError(describe_errno(path, "open"));
+    const std::streamoff size = file.tellg();
+    if (size < 0) throw TableError(path.string() + ": cannot determine the file size");
+    std::vector<std::byte> head(std::min<size_t>(static_cast<size_t>(size), kPreambleSize + kMaxMetadataSize + 8));
+    file.seekg(0);
+    if (!file.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size())))
+        throw TableError(describe_errno(path, "read"));
+    Header h = parse_header(head, static_cast<uint64_t>(size), path.string());
+    return {h.version, h.w, h.h, h.options, h.stats, std::move(h.source), h.compact, h.bins_size != 0};
 }
 
 bool looks_like_table(const std::filesystem::path& path) noexcept {

@@ -1,6 +1,6 @@
 // Table files: a built EnvMap saved to disk, readable with envmis::core alone.
 //
-// The format (version 4; versions 1 to 3 are read too) is specified in docs/table-format.md: a fixed preamble (magic,
+// The format (version 5; versions 1 to 4 are read too) is specified in docs/table-format.md: a fixed preamble (magic,
 // version, byte order, total size), a metadata block with the build options and the
 // source's name and content hash, a header checksum, then the payload (the image
 // density q sin(theta) and the RGB radiance, both float32) and a payload checksum, and,
@@ -28,9 +28,9 @@
 
 namespace envmis {
 
-// Every table is written as version 4, with or without bins: a version 3 reader would
-// misread the bins-section size that version 4 adds to the metadata.
-inline constexpr uint32_t kTableVersion = 4;
+// Every table is written as version 5, with or without bins: a version 4 reader would
+// refuse the build-options string that version 5 adds to the metadata as unexpected bytes.
+inline constexpr uint32_t kTableVersion = 5;
 
 // Where a table's map came from.
 struct TableSource {
@@ -38,6 +38,12 @@ struct TableSource {
     uint64_t content_hash = 0;       // hash64 of the source file's bytes
     std::string input_colorspace;    // colour space the pixels were read in
     std::string working_colorspace;  // colour space of the stored radiance
+    // The options the writer built the map with, in its own canonical spelling (envmis
+    // precompute: "alpha=auto bins=64 ..."), at most 4096 bytes. The reader does not
+    // interpret it: it records what the stored map cannot say (that alpha was chosen
+    // automatically, the flags as given), so that a tool can tell whether a table is what
+    // the same options would build now. Empty where not recorded (tables before version 5).
+    std::string build_options;
 };
 
 struct Table {
@@ -101,6 +107,23 @@ enum class TableLoading { map, copy };
 // Reads and verifies a table. Throws TableError if the file is missing, truncated,
 // corrupted (checksums), of another format, or of an unsupported version.
 Table read_table(const std::filesystem::path& path, TableLoading loading = TableLoading::map);
+
+// What a table's header says, without its payload.
+struct TableHeader {
+    uint32_t version = 0;  // the file's format version
+    uint32_t width = 0, height = 0;
+    EnvMapOptions options;
+    EnvMapStats stats;
+    TableSource source;
+    bool compact = false;  // RGBE payload (TableEncoding::compact)
+    bool binned = false;   // has a bins section
+};
+
+// Reads and verifies a table's header only: the preamble, the metadata block and its
+// checksum, and the file's size against the sizes they give (at most 64 KiB read,
+// whatever the table's size). Throws TableError as read_table does for those parts; a
+// payload or bins section that is corrupted is found only by read_table.
+TableHeader read_table_header(const std::filesystem::path& path);
 
 // The same checks on bytes already in memory; `name` appears in error messages.
 Table parse_table(std::span<const std::byte> bytes, std::string_view name);

@@ -1,0 +1,213 @@
+#include "library.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include <OpenImageIO/imageio.h>
+
+#include "cli.h"
+#include "envmis/math/hash.h"
+#include "envmis/table/atomic_file.h"
+
+namespace envmis::cli {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string lower(std::string text) {
+    std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
+    return text;
+}
+
+// The extensions OpenImageIO's readers claim ("openexr:exr,sxr;hdr:hdr,rgbe;..."), with the dot.
+std::set<std::string> image_extensions() {
+    std::set<std::string> extensions;
+    const std::string list = OIIO::get_string_attribute("extension_list");
+    std::stringstream formats(list);
+    for (std::string format; std::getline(formats, format, ';');) {
+        std::stringstream names(format.substr(format.find(':') + 1));
+        for (std::string name; std::getline(names, name, ',');)
+            if (!name.empty()) extensions.insert("." + lower(name));
+    }
+    return extensions;
+}
+
+std::vector<fs::path> folder_files(const fs::path& folder, bool recursive, const std::set<std::string>& extensions) {
+    std::vector<fs::path> files;
+    std::error_code ec;
+    const auto keep = [&](const fs::directory_entry& entry) {
+        std::error_code type_ec;
+        if (entry.is_regular_file(type_ec) && extensions.count(lower(entry.path().extension().string())))
+            files.push_back(entry.path());
+    };
+    if (recursive) {
+        for (fs::recursive_directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) keep(*it);
+    } else {
+        for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) keep(*it);
+    }
+    if (ec) throw std::runtime_error(folder.string() + ": cannot read the folder: " + ec.message());
+    if (files.empty())
+        throw std::runtime_error(folder.string() +
+                                 ": a directory without image files (a folder input gives every file in it that "
+                                 "OpenImageIO reads)");
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
+}  // namespace
+
+std::vector<fs::path> expand_inputs(const std::vector<std::string>& inputs, bool recursive, bool tables) {
+    std::set<std::string> extensions = image_extensions();
+    if (tables) extensions.insert(".envmis");
+    std::vector<fs::path> files;
+    for (const std::string& input : inputs) {
+        std::error_code ec;
+        if (!fs::is_directory(input, ec)) {
+            files.emplace_back(input);
+            continue;
+        }
+        const std::vector<fs::path> found = folder_files(input, recursive, extensions);
+        files.insert(files.end(), found.begin(), found.end());
+    }
+    return files;
+}
+
+std::vector<LibraryItem> plan_outputs(const std::vector<fs::path>& inputs, const fs::path& dir,
+                                      const std::string& extension) {
+    std::vector<LibraryItem> items;
+    std::map<fs::path, fs::path> writer;  // output -> its input
+    for (const fs::path& input : inputs) {
+        const fs::path output = dir / (input.stem().string() + extension);
+        const auto [it, added] = writer.emplace(output, input);
+        if (!added)
+            throw std::runtime_error(it->second.string() + " and " + input.string() + ": both would write " +
+                                     output.string() + " (rename one, or run them separately)");
+        items.push_back({input, output});
+    }
+    return items;
+}
+
+uint32_t hardware_cores() { return std::max(1u, std::thread::hardware_concurrency()); }
+
+CLI::Option* add_jobs_flag(CLI::App& app, uint32_t& jobs) {
+    jobs = hardware_cores();
+    return app
+        .add_option("--jobs", jobs,
+                    "With several inputs or a folder: maps run at once, 1 to 1024 (default: the core count)")
+        ->check(in_range(uint32_t{1}, kMaxJobs))
+        ->capture_default_str();
+}
+
+uint64_t file_hash(const fs::path& path) {
+    std::error_code ec;
+    if (!fs::exists(path, ec)) throw std::runtime_error(path.string() + ": no such file");
+    if (!fs::is_regular_file(path, ec)) throw std::runtime_error(path.string() + ": not a regular file");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error(path.string() + ": cannot open");
+    Hasher hasher;
+    std::vector<char> block(size_t{1} << 20);
+    while (in) {
+        in.read(block.data(), static_cast<std::streamsize>(block.size()));
+        hasher.update(std::as_bytes(std::span(block.data(), static_cast<size_t>(in.gcount()))));
+        throw_if_interrupted();
+    }
+    if (in.bad()) throw std::runtime_error(path.string() + ": cannot read");
+    return hasher.digest();
+}
+
+std::string hash_text(uint64_t hash) {
+    char text[17];
+    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
+    return text;
+}
+
+namespace {
+
+// A failure's message, naming the file where the error itself does not.
+std::string naming(const fs::path& input, const std::string& message) {
+    return message.find(input.string()) == std::string::npos ? input.string() + ": " + message : message;
+}
+
+// One map through `job`, timed, its failure caught: the summary's entry.
+nlohmann::json run_one(const LibraryItem& item, const MapJob& job, std::string& printed, std::string& error) {
+    const auto start = std::chrono::steady_clock::now();
+    nlohmann::json entry = {{"input", item.input.string()}, {"output", item.output.string()}};
+    try {
+        std::error_code ec;
+        const uintmax_t bytes = fs::file_size(item.input, ec);
+        if (!ec) entry["bytes"] = bytes;
+        const uint64_t hash = file_hash(item.input);
+        entry["source_hash"] = hash_text(hash);
+        MapOutcome outcome = job(item, hash);
+        entry["status"] = outcome.status;
+        entry["details"] = std::move(outcome.details);
+        printed = std::move(outcome.printed);
+    } catch (const Interrupted&) {
+        entry["status"] = "interrupted";
+    } catch (const std::exception& e) {
+        entry["status"] = interrupted() ? "interrupted" : "failed";
+        if (!interrupted()) entry["error"] = error = naming(item.input, e.what());
+    }
+    entry["seconds"] = milliseconds_since(start) / 1e3;
+    return entry;
+}
+
+void write_summary(const LibraryRun& run, const std::vector<nlohmann::json>& entries) {
+    std::map<std::string, size_t> counts;
+    for (const nlohmann::json& e : entries) ++counts[e.value("status", "not started")];
+    nlohmann::json summary = {
+        {"envmis_summary", run.command}, {"maps", entries.size()}, {"counts", counts}, {"results", entries}};
+    write_file_atomically(run.summary, [&](std::ostream& out) { out << summary.dump(2) << "\n"; });
+}
+
+}  // namespace
+
+void run_library(const std::vector<LibraryItem>& items, const LibraryRun& run, const MapJob& job) {
+    prepare_output(run.summary);
+    std::vector<nlohmann::json> entries(items.size());
+    for (size_t i = 0; i < items.size(); ++i)
+        entries[i] = {
+            {"input", items[i].input.string()}, {"output", items[i].output.string()}, {"status", "not started"}};
+    std::mutex lock;  // guards the progress bar, the entries and the standard streams
+    size_t done = 0, failed = 0;
+    std::optional<Progress> progress(std::in_place, run.command + " " + std::to_string(items.size()) + " maps",
+                                     items.size());
+    std::atomic<size_t> next{0};
+    const auto worker = [&] {
+        for (size_t i; !interrupted() && (i = next++) < items.size();) {
+            std::string printed, error;
+            nlohmann::json entry = run_one(items[i], job, printed, error);
+            const std::lock_guard guard(lock);
+            if (!error.empty()) std::cerr << "envmis: " << error << "\n", ++failed;
+            std::cout << printed << std::flush;
+            entries[i] = std::move(entry);
+            progress->update(++done);
+        }
+    };
+    {
+        std::vector<std::jthread> pool;
+        const size_t threads = std::min<size_t>(run.jobs, items.size());
+        for (size_t t = 1; t < threads; ++t) pool.emplace_back(worker);
+        worker();
+    }
+    progress.reset();
+    write_summary(run, entries);
+    if (interrupted())
+        throw Interrupted(std::to_string(done) + " of " + std::to_string(items.size()) + " maps done, listed in " +
+                          run.summary.string());
+    if (failed)
+        throw std::runtime_error(std::to_string(failed) + " of " + std::to_string(items.size()) +
+                                 " maps failed, listed in " + run.summary.string());
+}
+
+}  // namespace envmis::cli
