@@ -3,9 +3,9 @@
 
 For each map: ns/sample of EnvMap.sample(u) at N points (u from envmis.uniform_points),
 with new output arrays each call and with out= an earlier call's, and of the core's sample_many on
-the same map and points (one array per coordinate, outputs preallocated, image points
-included), timed inside C++ by envmis._maps._time_sample_many; medians over --repeats
-runs each, interleaved so that both see the same machine load. Run with the package on
+the same map and points (one array per coordinate, image points included; outputs
+allocated in each call, or once), timed inside C++ by envmis._maps._time_sample_many;
+medians over --repeats runs each, interleaved so that all see the same machine load. Run with the package on
 the path:
 
     PYTHONPATH=build/python /usr/bin/python3 scripts/python_bench.py
@@ -33,7 +33,7 @@ def synthetic(width, height, seed=1):
 def measure(env, n, repeats):
     u = envmis.uniform_points(n, seed=1)
     out = env.sample(u)  # also warms the map's pages
-    fresh, reused, cpp = [], [], []
+    fresh, reused, cpp_fresh, cpp = [], [], [], []
     for _ in range(repeats):
         start = time.perf_counter()
         env.sample(u)
@@ -41,8 +41,9 @@ def measure(env, n, repeats):
         start = time.perf_counter()
         env.sample(u, out=out)
         reused.append(time.perf_counter() - start)
+        cpp_fresh.append(envmis._maps._time_sample_many(env, u, 1, fresh_outputs=True))
         cpp.append(envmis._maps._time_sample_many(env, u, 1))
-    return [statistics.median(t) * 1e9 / n for t in (fresh, reused, cpp)]
+    return [statistics.median(t) * 1e9 / n for t in (fresh, cpp_fresh, reused, cpp)]
 
 
 def main():
@@ -56,10 +57,12 @@ def main():
     if args.large:
         maps.append(("synthetic 4096x2048", synthetic(4096, 2048)))
     print(f"N = {args.n}, median of {args.repeats}")
-    print(f"{'map':22} {'new outputs':>12} {'out= reused':>12} {'C++ batch':>10}  ns/sample; ratios to C++")
+    print("ns/sample; new outputs: Python's new arrays against C++ outputs allocated in the call;")
+    print("reused: Python's out= against C++ outputs allocated once; ratio = Python / C++")
+    print(f"{'map':22} {'new: Python':>12} {'C++':>8} {'ratio':>6} {'reused: Python':>15} {'C++':>8} {'ratio':>6}")
     for name, env in maps:
-        fresh, reused, cpp = measure(env, args.n, args.repeats)
-        print(f"{name:22} {fresh:12.2f} {reused:12.2f} {cpp:10.2f}  {fresh / cpp:.3f} {reused / cpp:.3f}")
+        fresh, cpp_fresh, reused, cpp = measure(env, args.n, args.repeats)
+        print(f"{name:22} {fresh:12.2f} {cpp_fresh:8.2f} {fresh / cpp_fresh:6.3f} {reused:15.2f} {cpp:8.2f} {reused / cpp:6.3f}")
 
 
 if __name__ == "__main__":

@@ -383,13 +383,14 @@ void bind_functions(py::module_& m) {
     m.def("uniform_points", &uniform_points, py::arg("n"), py::arg("seed"), docs::kUniformPoints);
     m.def(
         "_time_sample_many",
-        [](const EnvMap& map, const py::object& u_object, int repeats) {
+        [](const EnvMap& map, const py::object& u_object, int repeats, bool fresh_outputs) {
             const auto u = float_array(u_object, "envmis._time_sample_many", "u", {-1, 2});
             if (repeats < 1) throw std::invalid_argument("envmis._time_sample_many: repeats must be >= 1");
             py::gil_scoped_release released;
-            return time_sample_many(map.view(), u.data(), static_cast<size_t>(u.shape(0)), repeats);
+            return time_sample_many(map.view(), u.data(), static_cast<size_t>(u.shape(0)), repeats, fresh_outputs);
         },
-        py::arg("map"), py::arg("u"), py::arg("repeats"), docs::kTimeSampleMany);
+        py::arg("map"), py::arg("u"), py::arg("repeats"), py::kw_only(), py::arg("fresh_outputs") = false,
+        docs::kTimeSampleMany);
 }
 
 }  // namespace

@@ -40,6 +40,6 @@ void lookup(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, co
 // given as one array per coordinate (u's columns), writing every output sample writes
 // (the image point too) into arrays of n: the reference that sample()'s cost is compared
 // with (scripts/python_bench.py). Allocates its arrays before timing.
-double time_sample_many(const EnvMapView& env, const float* u, size_t n, int repeats);
+double time_sample_many(const EnvMapView& env, const float* u, size_t n, int repeats, bool fresh_outputs);
 
 }  // namespace envmis::python

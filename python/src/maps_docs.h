@@ -163,8 +163,10 @@ float32 (n, 2): a mt19937_64 seeded with `seed`, 24 random bits per coordinate (
 grid k / 2^24), u then v per point; so map.sample(uniform_points(n, seed)) equals the
 command's CSV bit for bit. O(n).)";
 inline constexpr const char* kTimeSampleMany = R"(Benchmark helper: the median wall time in seconds over `repeats`
-runs of the C++ batch call sample_many on u (its columns as separate arrays, outputs
-preallocated, image points included), measured inside C++: the reference for
-EnvMap.sample's cost (scripts/python_bench.py).)";
+runs of the C++ batch call sample_many on u (its columns as separate arrays, image points
+included), measured inside C++: the reference for EnvMap.sample's cost
+(scripts/python_bench.py). Outputs preallocated and touched once before timing, or with
+fresh_outputs newly allocated in each run, their page faults timed (as a new NumPy
+array's are).)";
 
 }  // namespace envmis::python::docs
