@@ -10,5 +10,7 @@ build_dir=${ENVMIS_BUILD_DIR:-build}
 bash scripts/setup.sh
 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release
 cmake --build "$build_dir" -j"$(nproc)" --target envmis
+# compare writes into folders that exist (it creates only the --images one itself).
+mkdir -p out
 "$build_dir/apps/envmis" compare data/envmaps/rooitou_park_1k.hdr --images out --json out/results.json \
   --csv out/results.csv "$@"
