@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -18,6 +19,7 @@
 #include "cli.h"
 #include "envmis/math/hash.h"
 #include "envmis/table/atomic_file.h"
+#include "envmis/table/table.h"
 
 namespace envmis::cli {
 namespace fs = std::filesystem;
@@ -138,11 +140,81 @@ std::string naming(const fs::path& input, const std::string& message) {
     return message.find(input.string()) == std::string::npos ? input.string() + ": " + message : message;
 }
 
-// One map through `job`, timed, its failure caught: the summary's entry.
-nlohmann::json run_one(const LibraryItem& item, const MapJob& job, std::string& printed, std::string& error) {
-    const auto start = std::chrono::steady_clock::now();
+// The texels of an input's map, from its header alone (a table's, or an image's display
+// window, which load_image reads); 0 where that cannot be read: the job then fails and says why.
+uint64_t header_texels(const fs::path& input) {
+    if (looks_like_table(input)) {
+        try {
+            const TableHeader header = read_table_header(input);
+            return uint64_t{header.width} * header.height;
+        } catch (const std::exception&) {
+            return 0;
+        }
+    }
+    const auto in = OIIO::ImageInput::open(input.string());
+    if (!in) {
+        OIIO::geterror();  // clears this thread's message, which the job's own load reports
+        return 0;
+    }
+    const OIIO::ImageSpec& spec = in->spec();
+    return uint64_t(std::max(spec.full_width, 0)) * uint64_t(std::max(spec.full_height, 0));
+}
+
+// Admits maps to run while their estimated needs fit together in the memory that was
+// available when no map ran; a map that does not fit waits for running ones to finish.
+// Nothing running, a map is checked alone against the memory available then, as
+// check_memory does, and so never waits for ever.
+class MemoryGate {
+public:
+    // True once `need` bytes are admitted (release them after); false if a signal arrived
+    // while waiting. Throws check_memory's error for a map that does not fit alone.
+    bool admit(const fs::path& input, uint64_t need) {
+        std::unique_lock guard(lock_);
+        while (running_ > 0 && budget_ && held_ + need > *budget_) {
+            if (interrupted()) return false;
+            // A signal does not notify: look again at least every 100 ms.
+            changed_.wait_for(guard, std::chrono::milliseconds(100));
+        }
+        if (running_ == 0) {
+            budget_ = available_memory();
+            check_memory(input.string(), need);
+        }
+        ++running_, held_ += need;
+        return true;
+    }
+    // Releases what admit took, on every way out of the map's job.
+    struct Admitted {
+        MemoryGate& gate;
+        uint64_t need;
+        ~Admitted() { gate.release(need); }
+    };
+
+private:
+    void release(uint64_t need) {
+        {
+            const std::lock_guard guard(lock_);
+            --running_, held_ -= need;
+        }
+        changed_.notify_all();
+    }
+
+    std::mutex lock_;
+    std::condition_variable changed_;
+    std::optional<uint64_t> budget_;  // empty: unknown (not Linux, no limit), every map admitted
+    uint64_t held_ = 0;
+    uint32_t running_ = 0;
+};
+
+// One map through `job` once the gate admits it, timed, its failure caught: the summary's entry.
+nlohmann::json run_one(const LibraryItem& item, const MapJob& job, MemoryGate& gate, uint64_t bytes_per_texel,
+                       std::string& printed, std::string& error) {
     nlohmann::json entry = {{"input", item.input.string()}, {"output", item.output.string()}};
+    auto start = std::chrono::steady_clock::now();
     try {
+        const uint64_t need = header_texels(item.input) * bytes_per_texel;
+        if (!gate.admit(item.input, need)) return entry;
+        const MemoryGate::Admitted admitted{gate, need};
+        start = std::chrono::steady_clock::now();
         std::error_code ec;
         const uintmax_t bytes = fs::file_size(item.input, ec);
         if (!ec) entry["bytes"] = bytes;
@@ -183,15 +255,18 @@ void run_library(const std::vector<LibraryItem>& items, const LibraryRun& run, c
     std::optional<Progress> progress(std::in_place, run.command + " " + std::to_string(items.size()) + " maps",
                                      items.size());
     std::atomic<size_t> next{0};
+    MemoryGate gate;
     const auto worker = [&] {
         for (size_t i; !interrupted() && (i = next++) < items.size();) {
             std::string printed, error;
-            nlohmann::json entry = run_one(items[i], job, printed, error);
+            nlohmann::json entry = run_one(items[i], job, gate, run.bytes_per_texel, printed, error);
+            if (!entry.contains("status")) continue;  // a signal arrived while it waited: not started
             const std::lock_guard guard(lock);
             if (!error.empty()) std::cerr << "envmis: " << error << "\n", ++failed;
             std::cout << printed << std::flush;
+            // A map stopped by the signal is not done: the message after the run says so.
+            if (entry["status"] != "interrupted") progress->update(++done);
             entries[i] = std::move(entry);
-            progress->update(++done);
         }
     };
     {

@@ -59,10 +59,18 @@ struct LibraryRun {
     std::string command;  // "precompute" or "compare": the progress bar's label and the summary's
     uint32_t jobs = 1;
     std::filesystem::path summary;  // the summary to write
+    // A map's job's peak memory per texel of its map (the header's width x height): what
+    // the memory check below expects each map to take.
+    uint64_t bytes_per_texel = 0;
 };
 
 // Runs `job` over `items` on min(jobs, items) threads, each map once, with one progress
-// bar (maps done of the total) on stderr. A map that fails is reported at once on stderr
+// bar (maps done of the total) on stderr. Maps run at once only while their needs
+// (bytes_per_texel x texels) fit together in the memory available (available_memory())
+// when none ran; a map that does not fit waits for running ones to finish, and one that
+// does not fit alone fails with check_memory's message ("FILE: needs N MB of memory, more
+// than the M MB available"). An estimate, from the headers alone: other processes' use
+// changes under it, and bytes_per_texel is measured, not a bound. A map that fails is reported at once on stderr
 // ("envmis: FILE: problem") and in the summary, and the others go on. Writes the summary
 // atomically: per map its input and output paths, status ("written", "up-to-date",
 // "failed", or "interrupted" and "not started" after Ctrl-C), error, seconds, source hash,

@@ -14,8 +14,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <nlohmann/json.hpp>
+
 #include <chrono>
 #include <filesystem>
+#include <map>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -131,10 +134,10 @@ public:
         return s;
     }
 
-    // The names in the test's folder (hidden ones included).
-    std::set<std::string> listing() const {
+    // The names in the test's folder, or in `sub` inside it (hidden ones included).
+    std::set<std::string> listing(const std::string& sub = "") const {
         std::set<std::string> names;
-        for (const auto& e : fs::directory_iterator(dir_)) names.insert(e.path().filename().string());
+        for (const auto& e : fs::directory_iterator(dir_ / sub)) names.insert(e.path().filename().string());
         return names;
     }
 
@@ -201,6 +204,59 @@ TEST_F(Interrupt, ACompareSignalledWithSigtermExits143AndWritesNoResults) {
     expect_stopped_by(s, SIGTERM);
     EXPECT_EQ(listing(), (std::set<std::string>{"map.exr", "plots"}));
     EXPECT_TRUE(fs::is_empty(file("plots")));
+}
+
+// ---------------------------------------------------------------------------------
+// Library mode: one job (--jobs 1) over maps/ in name order, a.hdr (not an image: it
+// fails at once), b.exr, c.exr; signalled once the bar says a third of the maps is done,
+// inside b's work. The run still writes its summary, saying what became of each map.
+
+// Each map's status in the summary at `path`, by input file name.
+std::map<std::string, std::string> summary_statuses(const fs::path& path) {
+    const nlohmann::json summary = nlohmann::json::parse(envmis::test::read_file(path));
+    std::map<std::string, std::string> statuses;
+    for (const nlohmann::json& entry : summary.at("results"))
+        statuses[fs::path(entry.at("input").get<std::string>()).filename().string()] = entry.at("status");
+    return statuses;
+}
+
+const std::map<std::string, std::string> kStoppedInB = {
+    {"a.hdr", "failed"}, {"b.exr", "interrupted"}, {"c.exr", "not started"}};
+
+void make_library(const Interrupt& t, int w, int h) {
+    fs::create_directories(t.file("maps"));
+    envmis::test::write_text(t.file("maps/a.hdr"), "#?RADIANCE\nnot an image\n");
+    write_exr(t.file("maps/b.exr"), w, h);
+    write_exr(t.file("maps/c.exr"), w, h);
+}
+
+TEST_F(Interrupt, ALibraryPrecomputeSignalledInsideAMapExits130AndSummarisesEveryMap) {
+    make_library(*this, 512, 256);
+    // Bins over a fine cell grid: b's build takes many seconds.
+    const Stopped s = interrupt(
+        {"precompute", path("maps"), "-o", path("out"), "--jobs", "1", "--bins", "4096", "--cell-columns", "256"},
+        "3 maps  33%", SIGINT);
+    expect_stopped_by(s, SIGINT);
+    EXPECT_NE(s.err.find("1 of 3 maps done, listed in " + path("out/summary.json")), std::string::npos) << s;
+    ASSERT_TRUE(fs::exists(file("out/summary.json"))) << s;
+    EXPECT_EQ(summary_statuses(file("out/summary.json")), kStoppedInB);
+    // No table, whole or half-written, and no temporary: only the summary.
+    EXPECT_EQ(listing("out"), std::set<std::string>{"summary.json"});
+}
+
+TEST_F(Interrupt, ALibraryCompareSignalledInsideAMapExits130AndSummarisesEveryMap) {
+    make_library(*this, 32, 16);
+    const Stopped s =
+        interrupt({"compare", path("maps"), "--out-dir", path("out"), "--jobs", "1", "--spp", "1000000000", "--points",
+                   "3", "--bsdf", "lambert", "--techniques", "mis-balance,env", "--csv", path("out/csv")},
+                  "3 maps  33%", SIGTERM);
+    expect_stopped_by(s, SIGTERM);
+    EXPECT_NE(s.err.find("1 of 3 maps done, listed in " + path("out/summary.json")), std::string::npos) << s;
+    ASSERT_TRUE(fs::exists(file("out/summary.json"))) << s;
+    EXPECT_EQ(summary_statuses(file("out/summary.json")), kStoppedInB);
+    // No JSON or CSV of b's partial study, and no temporary.
+    EXPECT_EQ(listing("out"), (std::set<std::string>{"csv", "summary.json"}));
+    EXPECT_TRUE(fs::is_empty(file("out/csv")));
 }
 
 }  // namespace
