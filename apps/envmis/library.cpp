@@ -139,7 +139,7 @@ std::string naming(const fs::path& input, const std::string& message) {
 }
 
 // One map through `job`, timed, its failure caught: the summary's entry.
-nlohmann::json run_one(const LibraryItem& item, const MapJob& job, std::string& printed, std::string& error) {
+nlohmann::json run_one(const LibraryItem& item, const MapJob& job, MapOutcome& outcome, std::string& error) {
     const auto start = std::chrono::steady_clock::now();
     nlohmann::json entry = {{"input", item.input.string()}, {"output", item.output.string()}};
     try {
@@ -148,10 +148,9 @@ nlohmann::json run_one(const LibraryItem& item, const MapJob& job, std::string& 
         if (!ec) entry["bytes"] = bytes;
         const uint64_t hash = file_hash(item.input);
         entry["source_hash"] = hash_text(hash);
-        MapOutcome outcome = job(item, hash);
+        outcome = job(item, hash);
         entry["status"] = outcome.status;
         entry["details"] = std::move(outcome.details);
-        printed = std::move(outcome.printed);
     } catch (const Interrupted&) {
         entry["status"] = "interrupted";
     } catch (const std::exception& e) {
@@ -185,11 +184,13 @@ void run_library(const std::vector<LibraryItem>& items, const LibraryRun& run, c
     std::atomic<size_t> next{0};
     const auto worker = [&] {
         for (size_t i; !interrupted() && (i = next++) < items.size();) {
-            std::string printed, error;
-            nlohmann::json entry = run_one(items[i], job, printed, error);
+            MapOutcome outcome;
+            std::string error;
+            nlohmann::json entry = run_one(items[i], job, outcome, error);
             const std::lock_guard guard(lock);
+            std::cerr << outcome.notes;
             if (!error.empty()) std::cerr << "envmis: " << error << "\n", ++failed;
-            std::cout << printed << std::flush;
+            std::cout << outcome.printed << std::flush;
             entries[i] = std::move(entry);
             progress->update(++done);
         }
