@@ -35,7 +35,7 @@ struct CompareArgs {
     std::string out_dir, summary;
     uint32_t jobs = 1;
     bool force = false, recursive = false;
-    bool show_progress = true;  // library mode shows one bar for all maps instead
+    bool show_progress = true;         // library mode shows one bar for all maps instead
     std::ostream* notes = &std::cerr;  // the map loader's notices (library mode: the map's own)
     const CLI::Option* threads_flag = nullptr;
     std::string input, bsdfs = "lambert,phong:50,ggx:0.1", techniques, normal, view, json, csv, images, plots,
@@ -429,12 +429,10 @@ std::string options_text(const CompareArgs& a) {
     return text.str();
 }
 
-
 nlohmann::json inputs_json(const CompareArgs& args, const Setup& s, size_t points_done) {
     nlohmann::json inputs = envmis::inputs_json({s.map_name, s.plain.width(), s.plain.height(), s.map_alpha,
                                                  s.choice ? &*s.choice : nullptr, &s.options, s.bsdf_alphas,
-                                                 s.binned.get(), s.bins_auto,
-                                                 std::span(s.points).first(points_done)});
+                                                 s.binned.get(), s.bins_auto, std::span(s.points).first(points_done)});
     inputs["source_hash"] = s.source_hash;
     inputs["options"] = options_text(args);
     return inputs;

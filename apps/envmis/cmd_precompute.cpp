@@ -118,7 +118,10 @@ void print_precompute(std::ostream& out, const PrecomputeArgs& args, const Libra
 // and the compensation the flags ask for goes into the bins.
 nlohmann::json precompute_one(const PrecomputeArgs& args, const LibraryItem& item, std::ostream& out,
                               std::ostream& notes, bool show_progress) {
-    if (looks_like_table(item.input)) throw std::runtime_error(item.input.string() + ": is already a table; give an image");
+    if (looks_like_table(item.input)) {
+        read_table_header(item.input);  // a broken table says what is wrong with it
+        throw std::runtime_error(item.input.string() + ": is already a table; give an image");
+    }
     std::optional<Progress> progress;
     if (show_progress && args.bins != 0) progress.emplace("building bins", 1);
     BuiltMap built = build_map(item.input, precompute_request(args), &interrupted());

@@ -116,9 +116,9 @@ Setup prepare(const EnvMap& map, const CompareArguments& args) {
 
 // compare --json's "inputs" (without the command's source_hash and options).
 py::dict inputs_dict(const Setup& s, const std::string& name, size_t points_done) {
-    const nlohmann::json inputs = inputs_json({name, s.plain().width(), s.plain().height(), s.map_alpha,
-                                               s.choice ? &*s.choice : nullptr, &s.options, s.bsdf_alphas,
-                                               s.binned.get(), s.bins_auto, std::span(s.points).first(points_done)});
+    const nlohmann::json inputs =
+        inputs_json({name, s.plain().width(), s.plain().height(), s.map_alpha, s.choice ? &*s.choice : nullptr,
+                     &s.options, s.bsdf_alphas, s.binned.get(), s.bins_auto, std::span(s.points).first(points_done)});
     return to_python(inputs).cast<py::dict>();
 }
 

@@ -34,8 +34,8 @@ EnvMapOptions map_options(const BuildRequest& r, LumaCoefficients luma) {
 
 // The map of loaded pixels into `built`; what EnvMap refuses in them (their power
 // overflowing float) is the source's fault and names it.
-void build_pixels(RgbImage image, const BuildRequest& r, LumaCoefficients luma, const std::string& name,
-                  StopFlag stop, BuiltMap& built) {
+void build_pixels(RgbImage image, const BuildRequest& r, LumaCoefficients luma, const std::string& name, StopFlag stop,
+                  BuiltMap& built) {
     EnvMapOptions options = map_options(r, luma);
     if (options.mapping == Mapping::equal_area && image.width != image.height)
         throw std::invalid_argument(name + ": an equal-area map must be square, this one is " +
@@ -77,8 +77,8 @@ std::string canonical_options(const BuildRequest& r) {
              : automatic   ? "auto"
                            : alpha)
          << " mapping=" << r.mapping << " colorspace=" << (r.colorspace.empty() ? "(file)" : r.colorspace)
-         << " working-space=" << r.working_space << " axes=" << r.axes << " compact=" << r.compact
-         << " bins=" << r.bins << " cell-columns=" << r.cell_columns;
+         << " working-space=" << r.working_space << " axes=" << r.axes << " compact=" << r.compact << " bins=" << r.bins
+         << " cell-columns=" << r.cell_columns;
     return text.str();
 }
 

@@ -16,15 +16,15 @@ namespace envmis {
 
 // What a comparison ran on; the pointers may be null, the spans refer to the caller's data.
 struct ComparisonInputs {
-    std::string map;                              // the map's name
-    uint32_t width = 0, height = 0;               // of the plain map, texels
-    float alpha = 0;                              // the map-wide compensation strength
-    const AlphaChoice* choice = nullptr;          // with alpha auto: the choice that gave the alphas
-    const ComparisonOptions* options = nullptr;   // spp, seed, threads, allocation, BSDFs
-    std::span<const float> bsdf_alphas;           // per BSDF of options->bsdfs, in order
-    const BinnedEnvMap* binned = nullptr;         // the -bins techniques' bins
-    bool bins_auto = false;                       // their alpha chosen per bin
-    std::span<const ShadingPoint> points_done;    // the shading points the results cover
+    std::string map;                             // the map's name
+    uint32_t width = 0, height = 0;              // of the plain map, texels
+    float alpha = 0;                             // the map-wide compensation strength
+    const AlphaChoice* choice = nullptr;         // with alpha auto: the choice that gave the alphas
+    const ComparisonOptions* options = nullptr;  // spp, seed, threads, allocation, BSDFs
+    std::span<const float> bsdf_alphas;          // per BSDF of options->bsdfs, in order
+    const BinnedEnvMap* binned = nullptr;        // the -bins techniques' bins
+    bool bins_auto = false;                      // their alpha chosen per bin
+    std::span<const ShadingPoint> points_done;   // the shading points the results cover
 };
 
 // {"map", "width", "height", "alpha", "alpha_auto", "spp", "seed", "threads",
