@@ -18,22 +18,13 @@
 #include <sstream>
 #include <string_view>
 
-#include "envmis/io/image_io.h"
 #include "envmis/table/atomic_file.h"
 
 namespace envmis::cli {
 
 void add_map_flags(CLI::App& app, MapFlags& flags) {
     app.add_flag("--no-compensate", flags.no_compensate, "Sample proportionally to luminance (no MIS compensation)");
-    const CLI::Validator alpha_value(
-        [](std::string& text) -> std::string {
-            if (text == "auto") return {};
-            char* end = nullptr;
-            const float alpha = std::strtof(text.c_str(), &end);
-            if (end != text.c_str() && *end == '\0' && alpha >= 0 && std::isfinite(alpha)) return {};
-            return "'" + text + "': expected a number >= 0 or auto";
-        },
-        "");
+    const CLI::Validator alpha_value([](std::string& text) { return alpha_problem(text); }, "");
     app.add_option_function<std::string>(
            "--alpha",
            [&flags](const std::string& text) {
@@ -55,6 +46,18 @@ void add_map_flags(CLI::App& app, MapFlags& flags) {
         ->capture_default_str();
     app.add_option("--axes", flags.axes, "World frame of directions: z-up, y-up or a signed permutation like x,z,-y")
         ->capture_default_str();
+}
+
+BuildRequest build_request(const MapFlags& flags) {
+    BuildRequest request;
+    request.compensate = !flags.no_compensate;
+    if (flags.alpha_given && !flags.alpha_auto) request.alpha = flags.alpha;
+    request.alpha_auto = flags.alpha_auto;
+    request.axes = flags.axes;
+    request.mapping = flags.mapping;
+    request.colorspace = flags.colorspace;
+    request.working_space = flags.working_space;
+    return request;
 }
 
 namespace {
@@ -92,17 +95,7 @@ CLI::Validator size_validator(bool single, uint32_t min_side, uint32_t max_side)
 }
 
 CLI::Validator bins_validator() {
-    return CLI::Validator(
-        [](std::string& text) -> std::string {
-            uint32_t k = 0;
-            const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), k);
-            const uint32_t g = bins_per_side(k);
-            if (error == std::errc() && end == text.data() + text.size() && g >= 1 && g <= 64 && g * g == k) return {};
-            return text +
-                   ": expected a square number of bins (g x g octahedral grid) from 1 to 4096, such as 64, "
-                   "100 or 144";
-        },
-        "K");
+    return CLI::Validator([](std::string& text) { return bins_problem(text); }, "K");
 }
 
 namespace {
@@ -249,9 +242,9 @@ std::string resident_memory() {
            "), peak " + mb("VmHWM:");
 }
 
-LoadedMap load_map(const std::string& path, const MapFlags& flags) {
-    const auto start = std::chrono::steady_clock::now();
+LoadedMap load_map(const std::string& path, const MapFlags& flags, std::ostream& notes) {
     if (looks_like_table(path)) {
+        const auto start = std::chrono::steady_clock::now();
         Table table = read_table(path);
         LoadedMap loaded{std::move(table.map), std::move(table.source), true, "envmis table"};
         loaded.table_version = table.version;
@@ -260,40 +253,18 @@ LoadedMap load_map(const std::string& path, const MapFlags& flags) {
         loaded.load_ms = milliseconds_since(start);
         return loaded;
     }
-    io::LoadedImage image = io::load_image(path, {flags.colorspace, flags.working_space, &interrupted()});
-    for (const std::string& notice : image.notices) std::cerr << "note: " << notice << "\n";
-    LoadedMap loaded;
-    loaded.load_ms = milliseconds_since(start);
-    EnvMapOptions options;
-    options.compensation = {!flags.no_compensate, flags.alpha};
-    options.luma = image.luma;
-    options.axes = Axes::parse(flags.axes);
-    options.mapping = parse_mapping(flags.mapping);
-    if (options.mapping == Mapping::equal_area && image.image.width != image.image.height)
-        throw std::runtime_error(path + ": an equal-area map must be square, this one is " +
-                                 std::to_string(image.image.width) + "x" + std::to_string(image.image.height));
-    if (options.mapping == Mapping::equirect && image.image.width == image.image.height && image.image.width > 1)
-        std::cerr << "note: " << path << " is square; it is read as equirect (pass --mapping equal-area for an "
-                  << "equal-area octahedral map)\n";
-    // What EnvMap refuses in a loaded image (its power overflowing float) is the file's fault.
-    try {
-        if (flags.alpha_auto && !flags.no_compensate) {
-            loaded.alpha_choice = choose_alpha(image.image, options);
-            options.compensation.alpha = loaded.alpha_choice->alpha;
-        }
-        const auto build_start = std::chrono::steady_clock::now();
-        loaded.map = EnvMap(std::move(image.image), options, &interrupted());
-        loaded.build_ms = milliseconds_since(build_start);
-    } catch (const std::invalid_argument& e) {
-        throw std::runtime_error(path + ": " + e.what());
-    }
-    loaded.source = {std::filesystem::path(path).filename().string(),
-                     image.content_hash,
-                     image.input_colorspace,
-                     image.working_colorspace,
-                     {}};
-    loaded.format = image.format;
-    loaded.channels = image.channels;
+    BuiltMap built = build_map(path, build_request(flags), &interrupted());
+    for (const std::string& notice : built.notices) notes << "note: " << notice << "\n";
+    return loaded_map(built);
+}
+
+LoadedMap loaded_map(BuiltMap& built) {
+    LoadedMap loaded{std::move(built.map), std::move(built.source), false, std::move(built.format)};
+    loaded.channels = built.channels;
+    loaded.load_ms = built.load_ms;
+    loaded.build_ms = built.build_ms;
+    loaded.alpha_choice = std::move(built.alpha_choice);
+    if (built.binned) loaded.bins = built.binned->layout();
     return loaded;
 }
 

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <iostream>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -21,6 +22,7 @@
 #include <CLI/CLI.hpp>
 
 #include "envmis/interrupt.h"
+#include "envmis/precompute/build.h"
 #include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"
 #include "envmis/study/comparison/alpha.h"
@@ -40,6 +42,8 @@ struct MapFlags {
     std::string mapping = "equirect";  // or "equal-area" (a square image)
 };
 void add_map_flags(CLI::App& app, MapFlags& flags);
+// The request the flags make (no bins, not compact).
+BuildRequest build_request(const MapFlags& flags);
 
 // The bounds of a count, size or seed flag, in the flag's own type T (an integer):
 // "-n: Value -5 not in range 1 to 1099511627776". The text is read as a decimal T in full:
@@ -73,7 +77,7 @@ std::optional<Size> parse_size(const std::string& text, bool single, uint32_t mi
 CLI::Validator size_validator(bool single, uint32_t min_side = 1, uint32_t max_side = kMaxCells1D);
 
 // A bin count flag (--bins K): a square number g^2 with g 1 to 64, as BinnedOptions
-// takes it; its side g.
+// takes it (bins_problem in build.h); its side g.
 CLI::Validator bins_validator();
 inline uint32_t bins_per_side(uint32_t bins) {
     return static_cast<uint32_t>(std::lround(std::sqrt(static_cast<double>(bins))));
@@ -113,11 +117,14 @@ struct LoadedMap {
     std::optional<BinLayout> bins = {};            // a binned table's bins (map: the plain map)
 };
 
-// Reads a table (recognised by its magic) or loads an image and builds its map; the
-// loader's notices go to stderr, each a line "note: FILE: ...". An image whose map
-// cannot be built (its power overflows float, say) is an error naming the file; an
-// interruption (above) stops the load and the build.
-LoadedMap load_map(const std::string& path, const MapFlags& flags);
+// Reads a table (recognised by its magic) or loads an image and builds its map
+// (build_map in build.h); the notices go to `notes`, each a line "note: FILE: ...". An
+// image whose map cannot be built (its power overflows float, say) is an error naming
+// the file; an interruption (above) stops the load and the build.
+LoadedMap load_map(const std::string& path, const MapFlags& flags, std::ostream& notes = std::cerr);
+// A map built from an image, as load_map returns it; a binned map's bins stay in `built`
+// (loaded.bins is their layout, loaded.map empty).
+LoadedMap loaded_map(BuiltMap& built);
 
 // The summary that precompute and info print, of `loaded`'s map or of `map` (precompute
 // --bins moves loaded.map into its BinnedEnvMap); with the bins' layout if it has one.

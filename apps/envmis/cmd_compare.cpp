@@ -17,6 +17,7 @@
 
 #include "cli.h"
 #include "envmis/io/image_io.h"
+#include "envmis/report/inputs.h"
 #include "envmis/report/results.h"
 #include "envmis/study/comparison/comparison.h"
 #include "envmis/study/comparison/sweeps.h"
@@ -34,7 +35,8 @@ struct CompareArgs {
     std::string out_dir, summary;
     uint32_t jobs = 1;
     bool force = false, recursive = false;
-    bool show_progress = true;  // library mode shows one bar for all maps instead
+    bool show_progress = true;         // library mode shows one bar for all maps instead
+    std::ostream* notes = &std::cerr;  // the map loader's notices (library mode: the map's own)
     const CLI::Option* threads_flag = nullptr;
     std::string input, bsdfs = "lambert,phong:50,ggx:0.1", techniques, normal, view, json, csv, images, plots,
                        alpha_sweep;
@@ -191,7 +193,7 @@ std::pair<EnvMap, float> load_plain(const CompareArgs& args, std::string& map_na
     MapFlags flags = args.map;
     flags.no_compensate = true;
     flags.alpha_auto = false;
-    LoadedMap loaded = load_map(args.input, flags);
+    LoadedMap loaded = load_map(args.input, flags, *args.notes);
     map_name = loaded.source.name;
     source_hash = hash_text(loaded.source.content_hash);
     const float fixed_alpha = !loaded.from_table         ? args.map.alpha
@@ -401,19 +403,6 @@ std::string header_line(const Setup& s, size_t points_done) {
     return header.str();
 }
 
-// Each BSDF's reflectance, as JSON: [r, g, b] by BSDF name.
-nlohmann::json albedo_json(std::span<const Bsdf> bsdfs) {
-    nlohmann::json albedo = nlohmann::json::object();
-    auto value = [](float v) {
-        char text[32];
-        std::snprintf(text, sizeof text, "%g", v);
-        return std::stod(text);
-    };
-    for (const Bsdf& b : bsdfs)
-        albedo[b.name()] = {value(b.reflectance.r), value(b.reflectance.g), value(b.reflectance.b)};
-    return albedo;
-}
-
 // Every flag that changes the numbers compare writes, or which files it writes, spelled
 // canonically: recorded in the JSON's inputs ("options"), so that library mode can tell
 // whether a map's results are what the same flags would give now. --threads, which
@@ -441,29 +430,11 @@ std::string options_text(const CompareArgs& a) {
 }
 
 nlohmann::json inputs_json(const CompareArgs& args, const Setup& s, size_t points_done) {
-    const ComparisonOptions& o = s.options;
-    nlohmann::json inputs = {{"map", s.map_name},
-                             {"source_hash", s.source_hash},
-                             {"options", options_text(args)},
-                             {"width", s.plain.width()},
-                             {"height", s.plain.height()},
-                             {"alpha", s.map_alpha},
-                             {"alpha_auto", s.choice.has_value()},
-                             {"spp", o.spp},
-                             {"seed", o.seed},
-                             {"threads", o.threads},
-                             {"env_samples", o.allocation.env},
-                             {"bsdf_samples", o.allocation.bsdf},
-                             {"points_done", points_done},
-                             {"albedo", albedo_json(o.bsdfs)}};
-    for (size_t b = 0; b < o.bsdfs.size(); ++b) inputs["bsdf_alpha"][o.bsdfs[b].name()] = s.bsdf_alphas[b];
-    if (s.choice) inputs["alpha_choice"] = alpha_choice_json(*s.choice, o.bsdfs);
-    if (s.binned) inputs["bins"] = {{"count", s.binned->bins()}, {"alpha_auto", s.bins_auto}};
-    for (size_t i = 0; i < points_done; ++i) {
-        const ShadingPoint& p = s.points[i];
-        inputs["points"].push_back(
-            {{"normal", {p.normal.x, p.normal.y, p.normal.z}}, {"view", {p.wo.x, p.wo.y, p.wo.z}}});
-    }
+    nlohmann::json inputs = envmis::inputs_json({s.map_name, s.plain.width(), s.plain.height(), s.map_alpha,
+                                                 s.choice ? &*s.choice : nullptr, &s.options, s.bsdf_alphas,
+                                                 s.binned.get(), s.bins_auto, std::span(s.points).first(points_done)});
+    inputs["source_hash"] = s.source_hash;
+    inputs["options"] = options_text(args);
     return inputs;
 }
 
@@ -687,10 +658,12 @@ void run_library_compare(const CompareArgs& args) {
                     if (!args.plots.empty()) one.plots = (std::filesystem::path(args.plots) / stem).string();
                     if (!args.images.empty()) one.images = (std::filesystem::path(args.images) / stem).string();
                     if (!args.csv.empty()) std::filesystem::create_directories(args.csv);
-                    std::ostringstream out;
+                    std::ostringstream out, notes;
+                    one.notes = &notes;
                     compare_one(one, out);
                     outcome.status = "written";
                     outcome.printed = out.str();
+                    outcome.notes = notes.str();
                     return outcome;
                 });
 }

@@ -1,7 +1,6 @@
 // envmis precompute IN -o OUT.envmis: build a map's sampler and save it as a table; with
 // several inputs or a folder, every map into the folder OUT, in parallel (library.h).
 #include <algorithm>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -76,24 +75,13 @@ void add_precompute_flags(CLI::App& sub, PrecomputeArgs& args) {
     add_map_flags(sub, args.map);
 }
 
-// The options a table is built with, spelled canonically: recorded in the table
-// (TableSource::build_options), equal exactly when the same flags would build the same
-// table from the same source. The effective alpha is recorded ("auto", or the value to
-// 9 digits), not how it was asked for.
-std::string build_options(const PrecomputeArgs& args) {
-    const MapFlags& m = args.map;
-    const bool automatic = args.bins ? m.alpha_auto || !m.alpha_given : m.alpha_auto;
-    char alpha[32];
-    std::snprintf(alpha, sizeof alpha, "%.9g", m.alpha);
-    std::ostringstream text;
-    text << "compensate=" << !m.no_compensate << " alpha="
-         << (m.no_compensate ? "-"
-             : automatic     ? "auto"
-                             : alpha)
-         << " mapping=" << m.mapping << " colorspace=" << (m.colorspace.empty() ? "(file)" : m.colorspace)
-         << " working-space=" << m.working_space << " axes=" << m.axes << " compact=" << args.compact
-         << " bins=" << args.bins << " cell-columns=" << args.cell_columns;
-    return text.str();
+// The request the flags make (build.h), with --bins, --cell-columns and --compact.
+BuildRequest precompute_request(const PrecomputeArgs& args) {
+    BuildRequest request = build_request(args.map);
+    request.bins = args.bins;
+    request.cell_columns = args.cell_columns;
+    request.compact = args.compact;
+    return request;
 }
 
 // What a written table's summary entry records of it.
@@ -125,62 +113,34 @@ void print_precompute(std::ostream& out, const PrecomputeArgs& args, const Libra
         << loaded.build_ms << " ms, write " << write_ms << " ms\n";
 }
 
-// The bins as the map flags ask: --alpha auto per bin (also without --alpha: the choice
-// is what makes bins pay for every BSDF), --alpha X or --no-compensate (0) for every bin.
-BinnedOptions binned_options(const PrecomputeArgs& args) {
-    BinnedOptions o;
-    o.bins_per_side = bins_per_side(args.bins);
-    o.cell_columns = args.cell_columns;
-    o.auto_alpha = (args.map.alpha_auto || !args.map.alpha_given) && !args.map.no_compensate;
-    o.alpha = args.map.no_compensate ? 0.0f : args.map.alpha;
-    return o;
-}
-
-// The source as load_map read it, with the options it was built with.
-TableSource recorded_source(const PrecomputeArgs& args, const LoadedMap& loaded) {
-    TableSource source = loaded.source;
-    source.build_options = build_options(args);
-    return source;
-}
-
-// With --bins the table's texels hold the plain map, and the compensation the flags ask
-// for goes into the bins.
-nlohmann::json precompute_binned(const PrecomputeArgs& args, const LibraryItem& item, std::ostream& out,
-                                 bool show_progress) {
-    MapFlags plain = args.map;
-    plain.no_compensate = true;
-    plain.alpha_auto = false;
-    LoadedMap loaded = load_map(item.input.string(), plain);
-    if (loaded.from_table) throw std::runtime_error(item.input.string() + ": is already a table; give an image");
-    const auto build_start = std::chrono::steady_clock::now();
-    std::optional<Progress> progress;
-    if (show_progress) progress.emplace("building bins", 1);
-    const BinnedEnvMap binned(std::move(loaded.map), binned_options(args), &interrupted());
-    progress.reset();
-    const double bins_ms = milliseconds_since(build_start);
-    loaded.bins = binned.layout();
-    const auto start = std::chrono::steady_clock::now();
-    write_table(item.output, binned, recorded_source(args, loaded),
-                args.compact ? TableEncoding::compact : TableEncoding::full, &interrupted());
-    const double write_ms = milliseconds_since(start);
-    print_precompute(out, args, item, loaded, binned.plain(), &binned, bins_ms, write_ms);
-    nlohmann::json details = table_details(loaded, binned.plain(), write_ms);
-    details["bins_build_ms"] = bins_ms;
-    return details;
-}
-
-// One map: its table written, what precompute prints on `out`, and its summary details.
+// One map: its table written, what precompute prints on `out` and its notices on
+// `notes`, and its summary details. With --bins the table's texels hold the plain map,
+// and the compensation the flags ask for goes into the bins.
 nlohmann::json precompute_one(const PrecomputeArgs& args, const LibraryItem& item, std::ostream& out,
-                              bool show_progress) {
-    if (args.bins != 0) return precompute_binned(args, item, out, show_progress);
-    const LoadedMap loaded = load_map(item.input.string(), args.map);
-    if (loaded.from_table) throw std::runtime_error(item.input.string() + ": is already a table; give an image");
+                              std::ostream& notes, bool show_progress) {
+    if (looks_like_table(item.input)) {
+        read_table_header(item.input);  // a broken table says what is wrong with it
+        throw std::runtime_error(item.input.string() + ": is already a table; give an image");
+    }
+    std::optional<Progress> progress;
+    if (show_progress && args.bins != 0) progress.emplace("building bins", 1);
+    BuiltMap built = build_map(item.input, precompute_request(args), &interrupted());
+    progress.reset();
+    for (const std::string& notice : built.notices) notes << "note: " << notice << "\n";
+    const LoadedMap loaded = loaded_map(built);
+    const BinnedEnvMap* binned = built.binned ? &*built.binned : nullptr;
+    const EnvMap& map = binned ? binned->plain() : loaded.map;
+    const TableEncoding encoding = args.compact ? TableEncoding::compact : TableEncoding::full;
     const auto start = std::chrono::steady_clock::now();
-    write_table(item.output, loaded.map, recorded_source(args, loaded),
-                args.compact ? TableEncoding::compact : TableEncoding::full, &interrupted());
+    if (binned)
+        write_table(item.output, *binned, loaded.source, encoding, &interrupted());
+    else
+        write_table(item.output, map, loaded.source, encoding, &interrupted());
     const double write_ms = milliseconds_since(start);
-    print_precompute(out, args, item, loaded, loaded.map, nullptr, 0, write_ms);
-    return table_details(loaded, loaded.map, write_ms);
+    print_precompute(out, args, item, loaded, map, binned, built.bins_ms, write_ms);
+    nlohmann::json details = table_details(loaded, map, write_ms);
+    if (binned) details["bins_build_ms"] = built.bins_ms;
+    return details;
 }
 
 // True where `output` is a table of the source whose bytes hash to `hash`, built with
@@ -205,7 +165,7 @@ constexpr uint64_t kFullPeak = 32, kCompactPeak = 64;
 void precompute_items(const PrecomputeArgs& args, const std::vector<LibraryItem>& items,
                       const std::filesystem::path& summary) {
     for (const LibraryItem& item : items) prepare_output(item.output);
-    const std::string options = build_options(args);
+    const std::string options = canonical_options(precompute_request(args));
     run_library(items, {"precompute", args.jobs, summary, args.compact ? kCompactPeak : kFullPeak},
                 [&](const LibraryItem& item, uint64_t hash) {
                     MapOutcome outcome;
@@ -214,10 +174,11 @@ void precompute_items(const PrecomputeArgs& args, const std::vector<LibraryItem>
                         outcome.printed = "envmis precompute: " + item.output.string() + " is up to date\n";
                         return outcome;
                     }
-                    std::ostringstream out;
-                    outcome.details = precompute_one(args, item, out, false);
+                    std::ostringstream out, notes;
+                    outcome.details = precompute_one(args, item, out, notes, false);
                     outcome.status = "written";
                     outcome.printed = out.str();
+                    outcome.notes = notes.str();
                     return outcome;
                 });
 }
@@ -228,7 +189,7 @@ void run_precompute(const PrecomputeArgs& args) {
         const LibraryItem item{args.inputs.front(), args.output};
         if (!args.summary.empty()) return precompute_items(args, {item}, args.summary);
         prepare_output(args.output);
-        precompute_one(args, item, std::cout, true);
+        precompute_one(args, item, std::cout, std::cerr, true);
         return;
     }
     // Several inputs or a folder: each map to OUT/<stem>.envmis.

@@ -207,7 +207,7 @@ private:
 
 // One map through `job` once the gate admits it, timed, its failure caught: the summary's entry.
 nlohmann::json run_one(const LibraryItem& item, const MapJob& job, MemoryGate& gate, uint64_t bytes_per_texel,
-                       std::string& printed, std::string& error) {
+                       MapOutcome& outcome, std::string& error) {
     nlohmann::json entry = {{"input", item.input.string()}, {"output", item.output.string()}};
     auto start = std::chrono::steady_clock::now();
     try {
@@ -220,10 +220,9 @@ nlohmann::json run_one(const LibraryItem& item, const MapJob& job, MemoryGate& g
         if (!ec) entry["bytes"] = bytes;
         const uint64_t hash = file_hash(item.input);
         entry["source_hash"] = hash_text(hash);
-        MapOutcome outcome = job(item, hash);
+        outcome = job(item, hash);
         entry["status"] = outcome.status;
         entry["details"] = std::move(outcome.details);
-        printed = std::move(outcome.printed);
     } catch (const Interrupted&) {
         entry["status"] = "interrupted";
     } catch (const std::exception& e) {
@@ -258,12 +257,14 @@ void run_library(const std::vector<LibraryItem>& items, const LibraryRun& run, c
     MemoryGate gate;
     const auto worker = [&] {
         for (size_t i; !interrupted() && (i = next++) < items.size();) {
-            std::string printed, error;
-            nlohmann::json entry = run_one(items[i], job, gate, run.bytes_per_texel, printed, error);
+            MapOutcome outcome;
+            std::string error;
+            nlohmann::json entry = run_one(items[i], job, gate, run.bytes_per_texel, outcome, error);
             if (!entry.contains("status")) continue;  // a signal arrived while it waited: not started
             const std::lock_guard guard(lock);
+            std::cerr << outcome.notes;
             if (!error.empty()) std::cerr << "envmis: " << error << "\n", ++failed;
-            std::cout << printed << std::flush;
+            std::cout << outcome.printed << std::flush;
             // A map stopped by the signal is not done: the message after the run says so.
             if (entry["status"] != "interrupted") progress->update(++done);
             entries[i] = std::move(entry);

@@ -45,11 +45,13 @@ uint64_t file_hash(const std::filesystem::path& path);
 std::string hash_text(uint64_t hash);
 
 // What one map's job reports: "written" or "up-to-date", what it would have printed on
-// standard output (printed whole as the map finishes, never interleaved with another's),
-// and the figures for the summary.
+// standard output and its notices for standard error ("note: FILE: ..." lines; both
+// printed whole as the map finishes, never interleaved with another's or the progress
+// bar), and the figures for the summary.
 struct MapOutcome {
     std::string status;
     std::string printed;
+    std::string notes;
     nlohmann::json details = nlohmann::json::object();
 };
 // A map's job, given its input's hash; throws to fail (the message names the file).

@@ -59,22 +59,6 @@ void print_alpha_choice(std::ostream& out, const AlphaChoice& choice, std::span<
     }
 }
 
-nlohmann::json alpha_choice_json(const AlphaChoice& choice, std::span<const Bsdf> bsdfs) {
-    nlohmann::json j = {{"criterion", "exact variance of mis-balance-comp / mis-balance, geometric mean over points"},
-                        {"width", choice.width},
-                        {"height", choice.height},
-                        {"seconds", choice.seconds},
-                        {"map_alpha", choice.alpha},
-                        {"candidates", nlohmann::json::array()}};
-    for (size_t b = 0; b < bsdfs.size(); ++b) j["bsdf_alpha"][bsdfs[b].name()] = choice.bsdf_alphas[b];
-    for (const AlphaCandidate& c : choice.candidates) {
-        nlohmann::json per_bsdf;
-        for (size_t b = 0; b < bsdfs.size(); ++b) per_bsdf[bsdfs[b].name()] = c.per_bsdf[b];
-        j["candidates"].push_back({{"alpha", c.alpha}, {"all", c.criterion}, {"per_bsdf", per_bsdf}});
-    }
-    return j;
-}
-
 void print_alpha_sweep(std::ostream& out, const AlphaSweep& sweep, const std::vector<float>* auto_alphas) {
     char line[256];
     std::snprintf(line, sizeof line, "%-8s %-10s %-17s", "alpha", "bsdf", "technique");

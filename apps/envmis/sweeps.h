@@ -16,9 +16,9 @@
 
 namespace envmis::cli {
 
-// The table of --alpha auto's candidates, per BSDF and over all, the choices marked.
+// The table of --alpha auto's candidates, per BSDF and over all, the choices marked
+// (alpha_choice_json in envmis/report/inputs.h is its JSON).
 void print_alpha_choice(std::ostream& out, const AlphaChoice& choice, std::span<const Bsdf> bsdfs);
-nlohmann::json alpha_choice_json(const AlphaChoice& choice, std::span<const Bsdf> bsdfs);
 
 // The table, then per BSDF the best alpha and, with `auto_alphas` (per BSDF, each one
 // of the sweep's alphas), where --alpha auto's choice stands: its ratio over the

@@ -49,6 +49,7 @@ class MapSource(TypedDict):
     content_hash: int
     input_colorspace: str
     working_colorspace: str
+    build_options: str
 
 class EnvMap:
     def __init__(

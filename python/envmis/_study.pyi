@@ -95,7 +95,7 @@ class Comparison:
     """One dict per BSDF and technique, the keys of compare --json's "results"; variance is
     that of ONE estimate (radiance units squared); non-finite values are None."""
     inputs: dict[str, Any]
-    """compare --json's "inputs"; alpha_choice as choose_alpha() returns it."""
+    """compare --json's "inputs" in the same shape (alpha_choice included), less its source_hash and options."""
     exact: Optional[dict[str, dict[str, dict[str, float]]]]
     """With exact=True, {bsdf: {technique: {"ratio", "worst"}}}: exact variance over mis-balance's."""
     @property

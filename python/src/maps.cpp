@@ -17,6 +17,7 @@
 
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <utility>
@@ -33,6 +34,7 @@ namespace {
 struct Provenance {
     TableSource source;
     bool mapped = false;
+    std::optional<BuildRequest> request;  // what built it; empty for a table
 };
 
 template <class T>
@@ -57,19 +59,20 @@ Provenance provenance_of(const std::shared_ptr<T>& map) {
 py::object to_python(Built built) {
     const py::object warn = py::module_::import("warnings").attr("warn");
     for (const std::string& notice : built.notices) warn(notice, py::arg("stacklevel") = 2);
-    Provenance provenance{std::move(built.source), built.mapped};
+    Provenance provenance{std::move(built.source), built.mapped, std::move(built.request)};
     if (built.binned) return py::cast(held(std::move(*built.binned), std::move(provenance)));
     return py::cast(held(std::move(built.map), std::move(provenance)));
 }
 
 // alpha: None (not given), a number, or "auto"; the messages are the command line's.
-BuildOptions build_options(bool compensate, const py::object& alpha, std::string axes, std::string mapping,
+BuildRequest build_request(bool compensate, const py::object& alpha, std::string axes, std::string mapping,
                            const py::object& colorspace, std::string working_space) {
-    BuildOptions o;
+    BuildRequest o;
     o.compensate = compensate;
     if (py::isinstance<py::str>(alpha)) {
         const auto text = alpha.cast<std::string>();
-        if (text != "auto") throw std::invalid_argument("alpha: '" + text + "': expected a number >= 0 or auto");
+        if (const std::string problem = alpha_problem(text); !problem.empty())
+            throw std::invalid_argument("alpha: " + problem);
         o.alpha_auto = true;
     } else if (!alpha.is_none()) {
         o.alpha = alpha.cast<float>();
@@ -85,7 +88,20 @@ py::dict source_dict(const TableSource& s) {
     py::dict d;
     d["name"] = s.name, d["content_hash"] = s.content_hash;
     d["input_colorspace"] = s.input_colorspace, d["working_colorspace"] = s.working_colorspace;
+    d["build_options"] = s.build_options;
     return d;
+}
+
+// The source a table of the map records: for a map built here, the canonical options of
+// its request with the table's own encoding, as `envmis precompute` records them.
+template <class T>
+TableSource saved_source(const std::shared_ptr<T>& map, bool compact) {
+    Provenance provenance = provenance_of(map);
+    if (provenance.request) {
+        provenance.request->compact = compact;
+        provenance.source.build_options = canonical_options(*provenance.request);
+    }
+    return provenance.source;
 }
 
 py::dict stats_dict(const EnvMapStats& s) {
@@ -128,7 +144,7 @@ py::object radiance_view(const py::object& self) {
                           self);
 }
 
-std::shared_ptr<EnvMap> from_array(const py::object& radiance, const BuildOptions& options) {
+std::shared_ptr<EnvMap> from_array(const py::object& radiance, const BuildRequest& options) {
     const auto array = float_array(radiance, "envmis.EnvMap", "radiance", {-1, -1, 3}, "HW");
     if (array.shape(0) > UINT32_MAX || array.shape(1) > UINT32_MAX)
         throw std::invalid_argument("envmis.EnvMap: radiance: more than 2^32 - 1 rows or columns");
@@ -140,7 +156,7 @@ std::shared_ptr<EnvMap> from_array(const py::object& radiance, const BuildOption
         py::gil_scoped_release released;
         built = from_pixels(std::move(image), options);
     }
-    return held(std::move(built.map), {std::move(built.source), false});
+    return held(std::move(built.map), {std::move(built.source), false, std::move(built.request)});
 }
 
 // The outputs of sample for n points, as the Samples named tuple: new arrays, or the
@@ -256,7 +272,7 @@ void bind_envmap(py::module_& m) {
     py::class_<EnvMap, std::shared_ptr<EnvMap>>(m, "EnvMap", py::dynamic_attr(), docs::kEnvMap)
         .def(py::init([](const py::object& radiance, bool compensate, const py::object& alpha, std::string axes,
                          std::string mapping, const py::object& colorspace, std::string working_space) {
-                 return from_array(radiance, build_options(compensate, alpha, std::move(axes), std::move(mapping),
+                 return from_array(radiance, build_request(compensate, alpha, std::move(axes), std::move(mapping),
                                                            colorspace, std::move(working_space)));
              }),
              py::arg("radiance"), py::kw_only(), py::arg("compensate") = true, py::arg("alpha") = 1.0f,
@@ -287,7 +303,7 @@ void bind_envmap(py::module_& m) {
         .def(
             "save",
             [](const std::shared_ptr<EnvMap>& map, const std::filesystem::path& path, bool compact) {
-                const TableSource source = provenance_of(map).source;
+                const TableSource source = saved_source(map, compact);
                 py::gil_scoped_release released;
                 write_table(path, *map, source, compact ? TableEncoding::compact : TableEncoding::full);
             },
@@ -327,7 +343,7 @@ void bind_binned(py::module_& m) {
         .def(
             "save",
             [](const std::shared_ptr<BinnedEnvMap>& map, const std::filesystem::path& path, bool compact) {
-                const TableSource source = provenance_of(map).source;
+                const TableSource source = saved_source(map, compact);
                 py::gil_scoped_release released;
                 write_table(path, *map, source, compact ? TableEncoding::compact : TableEncoding::full);
             },
@@ -356,7 +372,7 @@ void bind_functions(py::module_& m) {
         [](const std::filesystem::path& path, bool compensate, const py::object& alpha, std::string axes,
            std::string mapping, const py::object& colorspace, std::string working_space, uint32_t bins,
            uint32_t cell_columns) {
-            BuildOptions o = build_options(compensate, alpha, std::move(axes), std::move(mapping), colorspace,
+            BuildRequest o = build_request(compensate, alpha, std::move(axes), std::move(mapping), colorspace,
                                            std::move(working_space));
             o.bins = bins, o.cell_columns = cell_columns;
             Built built;

@@ -66,8 +66,9 @@ inline constexpr const char* kStats =
     "compensation set to density 0, 'fallback': 'none' | 'uncompensated' | 'uniform'}.";
 inline constexpr const char* kSource =
     "Where the map came from, as its table file records it: {'name': the source image's file name (no folders), "
-    "'content_hash': hash64 of its bytes (int), 'input_colorspace', 'working_colorspace'}; empty strings and 0 for a "
-    "map made outside this module.";
+    "'content_hash': hash64 of its bytes (int), 'input_colorspace', 'working_colorspace', 'build_options': the "
+    "options it was built with as `envmis precompute` spells them in its tables (save() records them with its own "
+    "compact)}; empty strings and 0 for a map made outside this module.";
 inline constexpr const char* kMapped =
     "True if the radiance is borrowed from a read-only memory mapping of a table file (load_table(mapped=True)).";
 inline constexpr const char* kRadiance =
@@ -104,7 +105,10 @@ inline constexpr const char* kSave = R"(Writes the map as a table file (envmis::
 compact=False stores the float32 density and radiance (16 bytes a texel; loads
 bit-identical); compact=True the radiance in RGBE (4 bytes a texel; loads as the map of
 the RGBE-rounded pixels). Written to a temporary file in the same folder and renamed
-when complete: a failure leaves no partial table. Records the map's source. Raises
+when complete: a failure leaves no partial table. Records the map's source and the
+options it was built with as `envmis precompute` records them, so that a table saved
+here from an image file is up to date for precompute's library mode with the same
+options. Raises
 TableError on I/O failure or a destination that is not a regular file.)";
 
 inline constexpr const char* kBinned = R"(A normal-aware map (envmis::BinnedEnvMap): K bins of normals,

@@ -39,7 +39,10 @@ inline py::array_t<float, py::array::c_style> float_array(const py::handle& obje
     if (!py::isinstance<py::array>(object)) fail(std::string("a ") + py::str(py::type::of(object)).cast<std::string>());
     const auto array = py::reinterpret_borrow<py::array>(object);
     std::string given = "(";
-    for (py::ssize_t d = 0; d < array.ndim(); ++d) given += (d ? ", " : "") + std::to_string(array.shape(d));
+    for (py::ssize_t d = 0; d < array.ndim(); ++d) {
+        if (d) given += ", ";
+        given += std::to_string(array.shape(d));
+    }
     given += array.ndim() == 1 ? ",)" : ")";
     const std::string dtype = py::str(array.dtype()).cast<std::string>();
     bool fits = array.dtype().equal(py::dtype::of<float>()) && array.ndim() == static_cast<py::ssize_t>(shape.size());

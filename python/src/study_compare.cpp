@@ -5,15 +5,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 
+#include "envmis/report/inputs.h"
 #include "envmis/report/results.h"
 #include "envmis/study/comparison/alpha.h"
-#include "study_alpha.h"
 #include "study_arguments.h"
 #include "study_json.h"
 #include "study_watch.h"
@@ -115,44 +114,12 @@ Setup prepare(const EnvMap& map, const CompareArguments& args) {
     return s;
 }
 
-// Each BSDF's reflectance as the command writes it: [r, g, b] by name, each "%g".
-nlohmann::json albedo_json(std::span<const Bsdf> bsdfs) {
-    nlohmann::json albedo = nlohmann::json::object();
-    auto value = [](float v) {
-        char text[32];
-        std::snprintf(text, sizeof text, "%g", v);
-        return std::stod(text);
-    };
-    for (const Bsdf& b : bsdfs)
-        albedo[b.name()] = {value(b.reflectance.r), value(b.reflectance.g), value(b.reflectance.b)};
-    return albedo;
-}
-
-// compare --json's "inputs", but alpha_choice in envmis.choose_alpha's form.
+// compare --json's "inputs" (without the command's source_hash and options).
 py::dict inputs_dict(const Setup& s, const std::string& name, size_t points_done) {
-    const ComparisonOptions& o = s.options;
-    nlohmann::json inputs = {{"map", name},
-                             {"width", s.plain().width()},
-                             {"height", s.plain().height()},
-                             {"alpha", s.map_alpha},
-                             {"alpha_auto", s.choice.has_value()},
-                             {"spp", o.spp},
-                             {"seed", o.seed},
-                             {"threads", o.threads},
-                             {"env_samples", o.allocation.env},
-                             {"bsdf_samples", o.allocation.bsdf},
-                             {"points_done", points_done},
-                             {"albedo", albedo_json(o.bsdfs)}};
-    for (size_t b = 0; b < o.bsdfs.size(); ++b) inputs["bsdf_alpha"][o.bsdfs[b].name()] = s.bsdf_alphas[b];
-    if (s.binned) inputs["bins"] = {{"count", s.binned->bins()}, {"alpha_auto", s.bins_auto}};
-    for (size_t i = 0; i < points_done; ++i) {
-        const ShadingPoint& p = s.points[i];
-        inputs["points"].push_back(
-            {{"normal", {p.normal.x, p.normal.y, p.normal.z}}, {"view", {p.wo.x, p.wo.y, p.wo.z}}});
-    }
-    py::dict dict = to_python(inputs).cast<py::dict>();
-    if (s.choice) dict["alpha_choice"] = alpha_choice_dict(*s.choice, o.bsdfs);
-    return dict;
+    const nlohmann::json inputs =
+        inputs_json({name, s.plain().width(), s.plain().height(), s.map_alpha, s.choice ? &*s.choice : nullptr,
+                     &s.options, s.bsdf_alphas, s.binned.get(), s.bins_auto, std::span(s.points).first(points_done)});
+    return to_python(inputs).cast<py::dict>();
 }
 
 // compare --exact's figures: per BSDF, each fixed-weight technique's exact variance
@@ -284,8 +251,9 @@ records: compare --json's "results": a dict per BSDF and technique (in that orde
   point_variance_rel_se (per point, in point order). A non-finite value is None, as in
   the JSON file.
 inputs: compare --json's "inputs" (map, width, height, alpha, alpha_auto, bsdf_alpha,
-  spp, seed, threads, env_samples, bsdf_samples, points_done, albedo, points, bins),
-  with alpha_choice as envmis.choose_alpha returns it.
+  spp, seed, threads, env_samples, bsdf_samples, points_done, albedo, points, bins,
+  alpha_choice), written by the command's own code (envmis/report/inputs.h); only its
+  source_hash and options are the command's alone.
 exact: with exact=True, {bsdf: {technique: {"ratio", "worst"}}}: exact variance over
   that of mis-balance, geometric mean over points and the worst point; else None.)")
         .def_readonly("records", &ComparisonResult::records)

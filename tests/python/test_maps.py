@@ -6,6 +6,7 @@ raises with the command's messages, and the views copy nothing."""
 
 import ast
 import gc
+import json
 import math
 import os
 import pathlib
@@ -163,11 +164,31 @@ def test_a_saved_binned_map_loads_with_the_same_bins(tmp_path):
     table = envmis.load_table(tmp_path / "binned.envmis")
     assert isinstance(table, envmis.BinnedEnvMap)
     assert (table.bins, table.classes, table.lobe_exponents) == (9, 3, binned.lobe_exponents)
-    assert table.source == binned.source and table.source["name"] == PARK.name
+    # The table records the options with its own encoding, as precompute --compact does.
+    assert table.source == {**binned.source, "build_options": binned.source["build_options"].replace(
+        "compact=0", "compact=1")} and table.source["name"] == PARK.name
     normals = np.tile(np.array([[0, 0, 1]], np.float32), (1000, 1))
     u = envmis.uniform_points(1000, seed=2)
     # Compact: the RGBE-rounded map, which a .hdr source already is.
     assert np.array_equal(bits(table.sample(u, normals, 1).pdf), bits(binned.sample(u, normals, 1).pdf))
+
+
+@needs_cli
+@pytest.mark.parametrize("keywords, compact, flags", [
+    ({}, False, []),
+    ({"alpha": 2.0, "bins": 9, "axes": "y-up"}, True, ["--alpha", "2", "--bins", "9", "--axes", "y-up", "--compact"]),
+])
+def test_a_table_saved_from_python_is_up_to_date_for_precompute_with_the_same_options(tmp_path, keywords, compact,
+                                                                                       flags):
+    table, summary = tmp_path / "park.envmis", tmp_path / "summary.json"
+    envmis.load(PARK, **keywords).save(table, compact=compact)
+    statuses = []
+    for more in ([], ["--no-compensate"]):
+        result = run_cli("precompute", PARK, "-o", table, "--summary", summary, *flags, *more)
+        assert result.returncode == 0, result.stderr
+        statuses += [entry["status"] for entry in json.loads(summary.read_text())["results"]]
+    # Other options rebuild it.
+    assert statuses == ["up-to-date", "written"]
 
 
 def test_the_views_copy_nothing_and_cannot_be_written(tmp_path):

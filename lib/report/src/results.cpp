@@ -78,7 +78,10 @@ nlohmann::json stats_json(const TechniqueStats& stats, StatsDetail detail) {
 
 std::string csv_header(std::span<const char* const> keys) {
     std::string header;
-    for (const char* key : keys) header += (header.empty() ? "" : ",") + std::string(key);
+    for (const char* key : keys) {
+        if (!header.empty()) header += ',';
+        header += key;
+    }
     return header;
 }
 
