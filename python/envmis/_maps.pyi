@@ -3,6 +3,10 @@
 Directions: float32 unit vectors in the map's world frame. pdf: per steradian.
 Radiance: linear RGB in the map's working colour space. uv: image points in [0, 1)^2.
 Every array argument must be float32 and C-contiguous; others raise ValueError.
+Points u must satisfy 0 <= u < 1 in every coordinate (NaN fails), else ValueError naming
+the first: note that rng.random(...).astype(np.float32) can round up to 1.0 (use
+envmis.uniform_points or rng.random(..., dtype=np.float32)).
+An `out` array must be writeable. alpha is a number >= 0 or the str "auto", no other str.
 """
 
 import os

@@ -55,7 +55,8 @@ class Bsdf:
     def pdf(self, wo: _F32, wi: _F32) -> _F32:
         """float32 (N,): solid-angle density (1/sr) of sample(wo) at wi, over the whole sphere."""
     def sample(self, wo: _F32, u: _F32) -> tuple[_F32, _F32, _F32]:
-        """(wi (N, 3), pdf (N,), value (N, 3) = eval(wo, wi)) for wo (N, 3) and u (N, 2) in [0, 1)^2."""
+        """(wi (N, 3), pdf (N,), value (N, 3) = eval(wo, wi)) for wo (N, 3) and u (N, 2) in [0, 1)^2
+        (every value 0 <= u < 1, NaN not: ValueError naming the first that is not)."""
     def __eq__(self, other: object) -> bool: ...
     def __hash__(self) -> int: ...
 

@@ -169,10 +169,10 @@ struct SampleOutputs {
             radiance = new_float_array({n, 3}), uv = new_float_array({n, 2});
             return;
         }
-        direction = float_array(out.attr("direction"), where, "out.direction", {n, 3});
-        pdf = float_array(out.attr("pdf"), where, "out.pdf", {n});
-        radiance = float_array(out.attr("radiance"), where, "out.radiance", {n, 3});
-        uv = float_array(out.attr("uv"), where, "out.uv", {n, 2});
+        direction = writeable_float_array(out.attr("direction"), where, "out.direction", {n, 3});
+        pdf = writeable_float_array(out.attr("pdf"), where, "out.pdf", {n});
+        radiance = writeable_float_array(out.attr("radiance"), where, "out.radiance", {n, 3});
+        uv = writeable_float_array(out.attr("uv"), where, "out.uv", {n, 2});
     }
     InterleavedSamples arrays() {
         return {direction.mutable_data(), pdf.mutable_data(), radiance.mutable_data(), uv.mutable_data()};
@@ -185,6 +185,7 @@ struct SampleOutputs {
 py::object sample_plain(const EnvMap& map, const py::object& u_object, const py::object& out_object) {
     const char* where = "envmis.EnvMap.sample";
     const auto u = float_array(u_object, where, "u", {-1, 2});
+    check_unit_points(u, where, "u");
     SampleOutputs out(u.shape(0), out_object, where);
     const InterleavedSamples arrays = out.arrays();
     {
@@ -230,6 +231,7 @@ py::object sample_binned(const BinnedEnvMap& map, const py::object& u_object, co
                          uint32_t lobe, const py::object& out_object) {
     const char* where = "envmis.BinnedEnvMap.sample";
     const auto u = float_array(u_object, where, "u", {-1, 2});
+    check_unit_points(u, where, "u");
     const auto normals = normals_for(normals_object, where, u.shape(0), "u");
     lobe_of(map, lobe, where);
     SampleOutputs out(u.shape(0), out_object, where);
@@ -401,6 +403,7 @@ void bind_functions(py::module_& m) {
         "_time_sample_many",
         [](const EnvMap& map, const py::object& u_object, int repeats, bool fresh_outputs) {
             const auto u = float_array(u_object, "envmis._time_sample_many", "u", {-1, 2});
+            check_unit_points(u, "envmis._time_sample_many", "u");
             if (repeats < 1) throw std::invalid_argument("envmis._time_sample_many: repeats must be >= 1");
             py::gil_scoped_release released;
             return time_sample_many(map.view(), u.data(), static_cast<size_t>(u.shape(0)), repeats, fresh_outputs);

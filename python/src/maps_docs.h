@@ -82,12 +82,16 @@ inline constexpr const char* kDensity =
 inline constexpr const char* kSample = R"(Directions drawn from the map for N points.
 
 u: float32 (N, 2), points in [0, 1)^2 (a random or low-discrepancy sequence;
-   envmis.uniform_points gives what `envmis sample` draws). Returns Samples (direction,
+   envmis.uniform_points gives what `envmis sample` draws). Every value must satisfy
+   0 <= u < 1, else ValueError naming the first that does not, as in: u[12, 1] = 1 is
+   outside [0, 1); NaN fails. Beware rng.random(...).astype(np.float32): float64 values at or
+   above 1 - 2^-25 round to 1.0f; use envmis.uniform_points, rng.random(..., dtype=np.float32),
+   or np.minimum(u, np.nextafter(np.float32(1), np.float32(0))). Returns Samples (direction,
    pdf per steradian, radiance, uv), bit-identical to N calls of the C++ EnvMap::sample,
    through the core's batch call sample_many (SIMD with AVX2). Cost: O(N), about the C++
    batch call's per sample (docs/performance.md), GIL released.
-out: None (new arrays, N x 36 bytes), or a Samples of float32 C-contiguous arrays of
-   these shapes (an earlier call's) to write into and return. Reusing them matters at
+out: None (new arrays, N x 36 bytes), or a Samples of float32 C-contiguous writeable
+   arrays of these shapes (an earlier call's) to write into and return. Reusing them matters at
    large N: writing fresh pages costs the kernel's page faults, which on a virtual machine
    can cost more than the sampling (docs/performance.md, "Python").)";
 inline constexpr const char* kPdf = R"(The solid-angle pdf (per steradian) of sampling each direction.
@@ -127,7 +131,7 @@ inline constexpr const char* kBinnedComplete =
     "True if every bin of lobe class `lobe` samples wherever its normals see light (no texel zeroed by compensation).";
 inline constexpr const char* kBinnedSample = R"(Directions drawn for N (point, normal) pairs.
 
-u: float32 (N, 2) in [0, 1)^2; normals: float32 (N, 3), the shading normals in the world
+u: float32 (N, 2) in [0, 1)^2 (checked as EnvMap.sample checks it); normals: float32 (N, 3), the shading normals in the world
 frame (their bin: the octahedral cell of the normalised vector); lobe: the lobe class (0
 to classes - 1). Returns Samples as EnvMap.sample does, bit-identical to N single calls
 of the C++ BinnedEnvMapView::sample; out as EnvMap.sample's. O(N), GIL released.)";

@@ -85,6 +85,7 @@ py::tuple bsdf_sample(const Bsdf& bsdf, const py::handle& wo_in, const py::handl
     if (wo.shape(0) != u.shape(0))
         throw std::invalid_argument(std::string(where) + ": wo and u must have as many rows; got " +
                                     std::to_string(wo.shape(0)) + " and " + std::to_string(u.shape(0)));
+    check_unit_points(u, where, "u");
     const auto n = static_cast<py::ssize_t>(wo.shape(0));
     auto wi = new_float_array({n, 3}), pdf = new_float_array({n}), value = new_float_array({n, 3});
     float *w = wi.mutable_data(), *p = pdf.mutable_data(), *v = value.mutable_data();
@@ -155,7 +156,9 @@ pdf the solid-angle density (per steradian) of sample over the whole sphere.)")
              "float32 (N,): the solid-angle density (1/sr) of sample(wo) at wi, over the whole sphere.")
         .def("sample", &bsdf_sample, py::arg("wo"), py::arg("u"),
              "(wi float32 (N, 3), pdf float32 (N,), value float32 (N, 3)) for wo float32 (N, 3) and u float32 (N, 2) "
-             "in [0, 1)^2: value is eval(wo, wi), value / pdf the sampling weight; pdf 0 means no sample.")
+             "in [0, 1)^2: value is eval(wo, wi), value / pdf the sampling weight; pdf 0 means no sample. A u "
+             "outside 0 <= u < 1 (NaN included) raises ValueError naming the first (\"u[3, 0] = 1 is outside "
+             "[0, 1)\"), as EnvMap.sample does.")
         .def("__eq__", [](const Bsdf& a, const Bsdf& b) { return a.name() == b.name(); })
         .def("__hash__", [](const Bsdf& b) { return py::hash(py::str(b.name())); })
         .def("__repr__", [](const Bsdf& b) { return "envmis.Bsdf.parse('" + b.name() + "')"; });

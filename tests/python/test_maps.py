@@ -334,3 +334,60 @@ def test_sample_writes_into_the_arrays_of_out_and_checks_their_shapes(small_maps
     short = out._replace(uv=np.zeros((99, 2), np.float32))
     with pytest.raises(ValueError, match=r"out.uv must be a float32 array of shape \(100, 2\); got .* \(99, 2\)"):
         env.sample(u, out=short)
+
+
+def test_a_read_only_out_array_is_refused_naming_it(small_maps):
+    env = small_maps["plain"]
+    u = envmis.uniform_points(10, seed=1)
+    out = env.sample(u)
+    out.pdf.flags.writeable = False
+    with pytest.raises(ValueError, match=r"^envmis.EnvMap.sample: out.pdf is not writeable$"):
+        env.sample(u, out=out)
+
+
+@pytest.fixture(scope="module")
+def park_binned():
+    return envmis.load(PARK, bins=9)
+
+
+def sample_call(kind, small_maps, park_binned):
+    """The three samplers taking points u (N, 2), each as f(u, out=None)."""
+    if kind == "EnvMap":
+        return lambda u, out=None: small_maps["plain"].sample(u, out=out)
+    if kind == "BinnedEnvMap":
+        normals = np.tile(np.array([[0, 0, 1]], np.float32), (16, 1))
+        return lambda u, out=None: park_binned.sample(u, normals, 1, out=out)
+    wo = np.tile(np.array([[0.6, 0.0, 0.8]], np.float32), (16, 1))
+    return lambda u, out=None: envmis.Bsdf.ggx(0.2).sample(wo, u)
+
+
+@pytest.mark.parametrize("kind", ["EnvMap", "BinnedEnvMap", "Bsdf"])
+@pytest.mark.parametrize("value, shown", [(1.0, "1"), (-0.1, "-0.1"), (np.nan, "nan"), (2.5, "2.5"), (np.inf, "inf")])
+def test_points_outside_the_unit_square_are_refused_naming_the_first(small_maps, park_binned, kind, value, shown):
+    sample = sample_call(kind, small_maps, park_binned)
+    u = envmis.uniform_points(16, seed=3)
+    u[12, 1] = value
+    u[14, 0] = value
+    with pytest.raises(ValueError) as error:
+        sample(u)
+    assert str(error.value) == f"envmis.{kind}.sample: u[12, 1] = {shown} is outside [0, 1)"
+
+
+@pytest.mark.parametrize("kind", ["EnvMap", "BinnedEnvMap", "Bsdf"])
+def test_the_ends_of_the_unit_square_are_accepted(small_maps, park_binned, kind):
+    u = envmis.uniform_points(16, seed=3)
+    u[0] = 0.0
+    u[1] = np.nextafter(np.float32(1), np.float32(0))
+    assert np.all(np.isfinite(sample_call(kind, small_maps, park_binned)(u)[1]))
+
+
+def test_a_refused_u_leaves_the_out_arrays_untouched(small_maps):
+    env = small_maps["compensated"]
+    u = envmis.uniform_points(5000, seed=6)
+    out = env.sample(u)
+    before = [a.copy() for a in out]
+    bad = envmis.uniform_points(5000, seed=7)
+    bad[4999, 0] = 1.0
+    with pytest.raises(ValueError, match=r"u\[4999, 0\] = 1 is outside"):
+        env.sample(bad, out=out)
+    assert all(np.array_equal(bits(a), bits(b)) for a, b in zip(out, before))
