@@ -70,9 +70,15 @@ BuildRequest build_request(bool compensate, const py::object& alpha, std::string
     BuildRequest o;
     o.compensate = compensate;
     if (py::isinstance<py::str>(alpha)) {
+        // Among strings only "auto": a number given as a string ("0.5") is refused rather
+        // than read, as Python reads no str as a float.
         const auto text = alpha.cast<std::string>();
-        if (const std::string problem = alpha_problem(text); !problem.empty())
-            throw std::invalid_argument("alpha: " + problem);
+        if (text != "auto") {
+            const std::string problem = alpha_problem(text);
+            throw std::invalid_argument(
+                "alpha: " +
+                (problem.empty() ? "'" + text + "': expected a number >= 0 or auto (a number, not a str)" : problem));
+        }
         o.alpha_auto = true;
     } else if (!alpha.is_none()) {
         o.alpha = alpha.cast<float>();

@@ -148,8 +148,8 @@ path: an image that OpenImageIO reads (EXR, .hdr, .pfm, TIFF...), converted with
    table file (recognised by its magic), whose own recorded options are used: the keywords
    are then ignored, as the command ignores its flags for a table.
 compensate: compensate the density for MIS (False: luminance times solid angle).
-alpha: compensation strength >= 0, or "auto" (choose_alpha: the candidate with the lowest
-   exact variance of balance MIS). Default: 1, or with bins auto per bin and lobe class.
+alpha: compensation strength, a number >= 0, or the str "auto" (choose_alpha: the
+   candidate with the lowest exact variance of balance MIS); any other str is refused. Default: 1, or with bins auto per bin and lobe class.
 axes: the world frame of directions: "z-up", "y-up" or a signed permutation like "x,z,-y".
 mapping: "equirect" (latitude-longitude) or "equal-area" (octahedral, a square image).
 bins: K = g^2 (g 1 to 64) gives a BinnedEnvMap as `precompute --bins K` builds it;

@@ -298,6 +298,8 @@ def test_a_bad_file_raises_the_message_the_command_prints(tmp_path, case):
         ({"bins": 5}, "bins: 5: expected a square number of bins (g x g octahedral grid) from 1 to 4096"),
         ({"alpha": "fast"}, "alpha: 'fast': expected a number >= 0 or auto"),
         ({"alpha": -1.5}, "alpha: '-1.5': expected a number >= 0 or auto"),
+        ({"alpha": "0.5"}, "alpha: '0.5': expected a number >= 0 or auto (a number, not a str)"),
+        ({"alpha": "Auto"}, "alpha: 'Auto': expected a number >= 0 or auto"),
         ({"mapping": "equal-area"}, "an equal-area map must be square, this one is 1024x512"),
         ({"axes": "up"}, "up"),
     ],
@@ -306,6 +308,11 @@ def test_invalid_options_raise_value_errors_that_name_them(options, message):
     with pytest.raises(ValueError) as error:
         envmis.load(PARK, **options)
     assert message in str(error.value)
+
+
+def test_an_array_map_refuses_alpha_as_a_str_other_than_auto():
+    with pytest.raises(ValueError, match=r"^alpha: '0.5': expected a number >= 0 or auto"):
+        envmis.EnvMap(random_radiance(16, 8, seed=1), alpha="0.5")
 
 
 def test_alpha_auto_chooses_a_strength_and_is_recorded_in_the_options():
