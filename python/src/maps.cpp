@@ -4,11 +4,12 @@
 // std::shared_ptr (py::class_<EnvMap, std::shared_ptr<EnvMap>>), so that envmis._study,
 // which imports this module, takes them as arguments (const EnvMap&,
 // std::shared_ptr<const BinnedEnvMap>) through pybind11's shared type registry. A binned
-// map's `plain` is a shared_ptr aliasing the binned map, which it keeps alive.
+// map's `plain` points into the binned map, which its deleter keeps alive.
 //
-// What a C++ map does not hold, where it came from (TableSource) and whether its
-// radiance maps a table file, rides in its shared_ptr's deleter (Provenance), so that it
-// follows the map into every Python object of it, a binned map's plain map included.
+// What a C++ map does not hold, where it came from (TableSource), how (the request, or a
+// table file) and whether its radiance maps a table file, rides in its shared_ptr's
+// deleter (Provenance), so that it follows the map into every Python object of it. A
+// binned map's plain map has its own: a table of it records what it is, not the bins.
 // The density, which EnvMap does not keep (its buffer became the CDF), is computed on
 // first access and kept in the Python object's __dict__.
 #include <pybind11/pybind11.h>
@@ -20,6 +21,7 @@
 #include <optional>
 #include <random>
 #include <sstream>
+#include <string_view>
 #include <utility>
 
 #include "envmis/io/image_io.h"
@@ -35,12 +37,22 @@ struct Provenance {
     TableSource source;
     bool mapped = false;
     std::optional<BuildRequest> request;  // what built it; empty for a table
+    bool from_table = false;              // read from a table file
+    bool compact = false;                 // that table's payload was RGBE (rounded radiance)
 };
 
 template <class T>
 struct Deleter {
     Provenance provenance;
     void operator()(T* map) const noexcept { delete map; }
+};
+
+// The deleter of a binned map's plain map, which is part of the binned map: it deletes
+// nothing, and holds the binned map until the last reference to the plain map goes.
+struct PartOf {
+    Provenance provenance;
+    std::shared_ptr<BinnedEnvMap> whole;
+    void operator()(EnvMap*) const noexcept {}
 };
 
 template <class T>
@@ -53,13 +65,30 @@ template <class T>
 Provenance provenance_of(const std::shared_ptr<T>& map) {
     if (const auto* d = std::get_deleter<Deleter<EnvMap>>(map)) return d->provenance;
     if (const auto* d = std::get_deleter<Deleter<BinnedEnvMap>>(map)) return d->provenance;
+    if (const auto* d = std::get_deleter<PartOf>(map)) return d->provenance;
     return {};
+}
+
+// A binned map's plain map: for a build, the request of that map alone (precompute
+// --no-compensate: with bins the texels keep the plain density); for a table, an
+// unknown request (no options recorded, so precompute's library mode rebuilds it).
+std::shared_ptr<EnvMap> plain_of(const std::shared_ptr<BinnedEnvMap>& map) {
+    Provenance provenance = provenance_of(map);
+    if (provenance.request) {
+        BuildRequest& r = *provenance.request;
+        r.compensate = false, r.alpha.reset(), r.alpha_auto = false, r.bins = 0, r.cell_columns = 0;
+        provenance.source.build_options = canonical_options(r);
+    } else {
+        provenance.source.build_options.clear();
+    }
+    return {const_cast<EnvMap*>(&map->plain()), PartOf{std::move(provenance), map}};
 }
 
 py::object to_python(Built built) {
     const py::object warn = py::module_::import("warnings").attr("warn");
     for (const std::string& notice : built.notices) warn(notice, py::arg("stacklevel") = 2);
-    Provenance provenance{std::move(built.source), built.mapped, std::move(built.request)};
+    Provenance provenance{std::move(built.source), built.mapped, std::move(built.request), built.from_table,
+                          built.compact};
     if (built.binned) return py::cast(held(std::move(*built.binned), std::move(provenance)));
     return py::cast(held(std::move(built.map), std::move(provenance)));
 }
@@ -98,14 +127,26 @@ py::dict source_dict(const TableSource& s) {
     return d;
 }
 
-// The source a table of the map records: for a map built here, the canonical options of
-// its request with the table's own encoding, as `envmis precompute` records them.
+// The source a table of the map records, its build options describing exactly what is
+// saved: for a map built here, the canonical options of its request with the table's
+// own encoding, as `envmis precompute` records them; for a map read from a table, that
+// table's options with compact= rewritten. A compact (RGBE-rounded) table saved full is
+// no build of the source, nor are options without compact= (an older table's): they
+// record none, so that precompute's library mode rebuilds them.
 template <class T>
 TableSource saved_source(const std::shared_ptr<T>& map, bool compact) {
     Provenance provenance = provenance_of(map);
+    std::string& options = provenance.source.build_options;
     if (provenance.request) {
         provenance.request->compact = compact;
-        provenance.source.build_options = canonical_options(*provenance.request);
+        options = canonical_options(*provenance.request);
+    } else if (provenance.from_table) {
+        constexpr std::string_view kCompact = " compact=";
+        const size_t at = options.rfind(kCompact);
+        if (at == std::string::npos || at + kCompact.size() >= options.size() || (provenance.compact && !compact))
+            options.clear();
+        else
+            options[at + kCompact.size()] = compact ? '1' : '0';
     }
     return provenance.source;
 }
@@ -162,7 +203,7 @@ std::shared_ptr<EnvMap> from_array(const py::object& radiance, const BuildReques
         py::gil_scoped_release released;
         built = from_pixels(std::move(image), options);
     }
-    return held(std::move(built.map), {std::move(built.source), false, std::move(built.request)});
+    return held(std::move(built.map), {std::move(built.source), false, std::move(built.request), false, false});
 }
 
 // The outputs of sample for n points, as the Samples named tuple: new arrays, or the
@@ -323,12 +364,7 @@ void bind_envmap(py::module_& m) {
 
 void bind_binned(py::module_& m) {
     py::class_<BinnedEnvMap, std::shared_ptr<BinnedEnvMap>>(m, "BinnedEnvMap", py::dynamic_attr(), docs::kBinned)
-        .def_property_readonly(
-            "plain",
-            [](const std::shared_ptr<BinnedEnvMap>& map) {
-                return std::shared_ptr<EnvMap>(map, const_cast<EnvMap*>(&map->plain()));
-            },
-            docs::kPlain)
+        .def_property_readonly("plain", &plain_of, docs::kPlain)
         .def_property_readonly("width", [](const BinnedEnvMap& map) { return map.plain().width(); })
         .def_property_readonly("height", [](const BinnedEnvMap& map) { return map.plain().height(); })
         .def_property_readonly("bins", &BinnedEnvMap::bins, "K = g^2, the bins of normals (a g x g octahedral grid).")

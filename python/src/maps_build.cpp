@@ -21,6 +21,9 @@ Built built_from(BuiltMap map, const BuildRequest& request) {
 Built load_table(const std::filesystem::path& path, bool mapped) {
     Table table = read_table(path, mapped ? TableLoading::map : TableLoading::copy);
     Built built;
+    built.from_table = true;
+    // Its header again (at most 64 KiB): Table does not say how its payload was encoded.
+    built.compact = read_table_header(path).compact;
     built.source = table.source;
     built.mapped = table.mapped;
     if (table.bins)

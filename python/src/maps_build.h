@@ -24,6 +24,8 @@ struct Built {
     // What built it (empty for a table): save() records canonical_options of it, with
     // its own compact.
     std::optional<BuildRequest> request;
+    bool from_table = false;           // read from a table file
+    bool compact = false;              // that table's payload is RGBE (TableHeader::compact)
     bool mapped = false;               // the radiance is a mapping of the table file
     std::vector<std::string> notices;  // lines the command prints as "note: ..."
 };

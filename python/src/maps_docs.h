@@ -68,9 +68,13 @@ inline constexpr const char* kSource =
     "Where the map came from, as its table file records it: {'name': the source image's file name (no folders), "
     "'content_hash': hash64 of its bytes (int), 'input_colorspace', 'working_colorspace', 'build_options': the "
     "options it was built with as `envmis precompute` spells them in its tables (save() records them with its own "
-    "compact)}; empty strings and 0 for a map made outside this module.";
+    "compact), '' where unknown (a binned table's plain map, an older table)}; empty strings and 0 for a map made "
+    "outside this module.";
 inline constexpr const char* kMapped =
     "True if the radiance is borrowed from a read-only memory mapping of a table file (load_table(mapped=True)).";
+inline constexpr const char* kFromTable =
+    "True if the map was read from a table file (load_table, or load of a table), mapped or copied. envmis.compare "
+    "follows `envmis compare` on it: without compensation its default alpha is 0 (1 for a map built from an image).";
 inline constexpr const char* kRadiance =
     "The repaired radiance, float32 (H, W, 3), linear RGB in the working space: a read-only view of the map's own "
     "pixels (or of its table file's mapping), no copy; its base keeps the map alive.";
@@ -122,7 +126,8 @@ A shading point picks its bin by its normal (world frame); a lobe class by its B
 sharpness (lobe_class). Made by envmis.load(..., bins=K) or from a binned table. pdf and
 sample speak solid angle (per steradian) over world directions, as EnvMap's.)";
 inline constexpr const char* kPlain =
-    "The plain map the bins are built over (an EnvMap sharing this map's memory; it keeps this map alive).";
+    "The plain map the bins are built over (an EnvMap sharing this map's memory; it keeps this map alive). Its source "
+    "records what it is: the uncompensated map (compensate=0 ... bins=0), or no options for a binned table's.";
 inline constexpr const char* kExponents = "The lobe classes' Phong exponents, ascending; 0 is diffuse (Lambert).";
 inline constexpr const char* kLobeClass =
     "The lobe class of a BSDF with this Phong exponent (0 for Lambert): the nearest class on the scale "

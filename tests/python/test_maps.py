@@ -398,3 +398,42 @@ def test_a_refused_u_leaves_the_out_arrays_untouched(small_maps):
     with pytest.raises(ValueError, match=r"u\[4999, 0\] = 1 is outside"):
         env.sample(bad, out=out)
     assert all(np.array_equal(bits(a), bits(b)) for a, b in zip(out, before))
+
+
+def test_a_plain_map_of_a_binned_one_records_its_own_build_options(park_binned, tmp_path):
+    plain = park_binned.plain
+    options = plain.source["build_options"]
+    assert "compensate=0 alpha=-" in options and options.endswith("bins=0 cell-columns=0"), options
+    assert park_binned.source["build_options"].endswith("bins=9 cell-columns=0")
+    park_binned.save(tmp_path / "binned.envmis")
+    # A table's request is not known beyond its options: its plain map records none.
+    assert envmis.load_table(tmp_path / "binned.envmis").plain.source["build_options"] == ""
+
+
+@needs_cli
+def test_a_saved_plain_map_of_a_binned_one_is_up_to_date_only_for_an_uncompensated_precompute(park_binned, tmp_path):
+    statuses = []
+    for flags in (["--bins", "9"], ["--no-compensate"]):
+        table, summary = tmp_path / f"park{len(statuses)}.envmis", tmp_path / "summary.json"
+        park_binned.plain.save(table)
+        result = run_cli("precompute", PARK, "-o", table, "--summary", summary, *flags)
+        assert result.returncode == 0, result.stderr
+        statuses += [entry["status"] for entry in json.loads(summary.read_text())["results"]]
+    assert statuses == ["written", "up-to-date"]
+
+
+@pytest.mark.parametrize("first, then, options", [
+    (False, True, "compact=1"),   # a full table's map, rounded as precompute --compact rounds it
+    (True, True, "compact=1"),
+    (False, False, "compact=0"),
+    (True, False, ""),            # the rounded map stored full: no build of the source makes it
+])
+def test_a_table_saved_again_records_the_encoding_it_is_saved_in(tmp_path, first, then, options):
+    built = envmis.load(PARK)
+    built.save(tmp_path / "first.envmis", compact=first)
+    envmis.load_table(tmp_path / "first.envmis").save(tmp_path / "again.envmis", compact=then)
+    again = envmis.load_table(tmp_path / "again.envmis").source["build_options"]
+    if options:
+        assert again == built.source["build_options"].replace("compact=0", options)
+    else:
+        assert again == ""
