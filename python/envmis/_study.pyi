@@ -131,6 +131,9 @@ def compare(
 ) -> Comparison:
     """The variance study of `envmis compare` (same records for the same arguments and seed).
 
+    alpha None: the map's own strength if compensated, else 0 for a map read from a table
+    (map.from_table) and 1 for one built from an image, as the command's default.
+
     GIL released; Ctrl-C (or an exception from progress) stops it and is raised."""
 
 def exact_variances(

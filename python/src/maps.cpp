@@ -340,6 +340,9 @@ void bind_envmap(py::module_& m) {
             docs::kSource)
         .def_property_readonly(
             "mapped", [](const std::shared_ptr<EnvMap>& map) { return provenance_of(map).mapped; }, docs::kMapped)
+        .def_property_readonly(
+            "from_table", [](const std::shared_ptr<EnvMap>& map) { return provenance_of(map).from_table; },
+            docs::kFromTable)
         .def_property_readonly("radiance", &radiance_view, docs::kRadiance)
         .def_property_readonly("density", &density_view, docs::kDensity)
         .def("sample", &sample_plain, py::arg("u"), py::kw_only(), py::arg("out") = py::none(), docs::kSample)
@@ -378,6 +381,9 @@ void bind_binned(py::module_& m) {
             docs::kSource)
         .def_property_readonly(
             "mapped", [](const std::shared_ptr<BinnedEnvMap>& map) { return provenance_of(map).mapped; }, docs::kMapped)
+        .def_property_readonly(
+            "from_table", [](const std::shared_ptr<BinnedEnvMap>& map) { return provenance_of(map).from_table; },
+            docs::kFromTable)
         .def("sample", &sample_binned, py::arg("u"), py::arg("normals"), py::arg("lobe") = 0, py::kw_only(),
              py::arg("out") = py::none(), docs::kBinnedSample)
         .def("pdf", &pdf_binned, py::arg("directions"), py::arg("normals"), py::arg("lobe") = 0, docs::kBinnedPdf)

@@ -66,10 +66,11 @@ uint32_t bins_per_side(const CompareArguments& args, std::span<const Technique> 
     return uses_bins(techniques) ? g : 0;
 }
 
-// alpha: None (the map's own strength if it is compensated, else the command's 1),
-// "auto" or a finite number >= 0.
-std::optional<float> fixed_alpha(const py::object& alpha, const EnvMap& map) {
-    if (alpha.is_none()) return map.compensated() ? map.options().compensation.alpha : 1.0f;
+// alpha: None (the command's default: the map's own strength if it is compensated, else
+// 0 for a map read from a table, which was built so, and --alpha's 1 for one built from
+// an image), "auto" or a finite number >= 0.
+std::optional<float> fixed_alpha(const py::object& alpha, const EnvMap& map, bool from_table) {
+    if (alpha.is_none()) return map.compensated() ? map.options().compensation.alpha : from_table ? 0.0f : 1.0f;
     if (py::isinstance<py::str>(alpha)) {
         if (alpha.cast<std::string>() == "auto") return std::nullopt;
     } else if (py::isinstance<py::float_>(alpha) || py::isinstance<py::int_>(alpha)) {
@@ -86,7 +87,7 @@ Setup prepare(const EnvMap& map, const CompareArguments& args) {
     s.options = comparison_options(args);
     const uint32_t g = bins_per_side(args, s.options.techniques);
     s.points = shading_points(args.points, args.normals, args.views, kWhere);
-    const std::optional<float> fixed = fixed_alpha(args.alpha, map);
+    const std::optional<float> fixed = fixed_alpha(args.alpha, map, args.from_table);
     s.bins_auto = !fixed || args.alpha.is_none();
     py::gil_scoped_release release;
     if (map.options().compensation.enabled) {
@@ -200,6 +201,10 @@ std::string name_of(const py::object& map, const py::object& name) {
     return py::isinstance<py::dict>(source) && source.contains("name") ? source["name"].cast<std::string>() : "";
 }
 
+// True for a map that envmis.load_table (or load of a table) read: EnvMap.from_table,
+// which a map made outside envmis._maps does not have.
+bool from_table(const py::object& map) { return py::hasattr(map, "from_table") && map.attr("from_table").cast<bool>(); }
+
 py::array_t<double> copy_of(const std::vector<double>& values) {
     return py::array_t<double>(static_cast<py::ssize_t>(values.size()), values.data());
 }
@@ -224,7 +229,9 @@ points: K normals spread evenly over the sphere (1 to 10^6), each viewed head-on
   the viewer; default the normal).
 seed: 0 to 2^64-1. threads: workers (0: every hardware thread).
 alpha: the compensation strength, >= 0; 'auto' chooses it per BSDF (envmis.choose_alpha
-  over these BSDFs and points); None: the map's own if compensated, else 1. The -bins
+  over these BSDFs and points); None: the map's own if compensated, else 0 for a map
+  read from a table (map.from_table) and 1 for one built from an image, as the command's
+  default. The -bins
   techniques choose theirs per bin unless alpha is a number.
 env_samples, bsdf_samples: samples per MIS estimate, 0 to 65536.
 bins: normal bins K = g*g (1 <= g <= 64) of the -bins techniques; 0: 121 where one runs.
@@ -299,7 +306,7 @@ exact: with exact=True, {bsdf: {technique: {"ratio", "worst"}}}: exact variance 
                                      py::str(py::type::of(map).attr("__name__")).cast<std::string>());
             return run_compare(map.cast<const EnvMap&>(),
                                {bsdfs, techniques, spp, points, normals, views, seed, threads, alpha, env_samples,
-                                bsdf_samples, bins, exact, name_of(map, name), progress});
+                                bsdf_samples, bins, exact, from_table(map), name_of(map, name), progress});
         },
         py::arg("map"), py::kw_only(), py::arg("bsdfs") = py::make_tuple("lambert", "phong:50", "ggx:0.1"),
         py::arg("techniques") = py::none(), py::arg("spp") = 1024, py::arg("points") = 16,

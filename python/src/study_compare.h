@@ -17,6 +17,7 @@ namespace py = pybind11;
 struct CompareArguments {
     py::object bsdfs, techniques, spp, points, normals, views, seed, threads, alpha, env_samples, bsdf_samples, bins;
     bool exact = false;
+    bool from_table = false;  // the map was read from a table file (EnvMap.from_table)
     std::string name;
     py::object progress;
 };

@@ -86,6 +86,21 @@ def test_compare_records_equal_the_commands_json_for_the_same_arguments_and_seed
         assert got.inputs[key] == expected["inputs"][key], key
 
 
+def test_an_uncompensated_table_is_compared_with_the_commands_default_alpha_of_zero(tmp_path):
+    path = tmp_path / "plain.envmis"
+    envmis.EnvMap(synthetic_radiance(), compensate=False).save(path)
+    arguments = dict(bsdfs="lambert,phong:20", techniques=["mis-balance", "mis-balance-comp"], spp=32, points=3, seed=5)
+    expected = cli_json(path, tmp_path, "--seed", 5, "--spp", 32, "--points", 3, "--bsdf", arguments["bsdfs"],
+                        "--techniques", "mis-balance,mis-balance-comp")
+    table = envmis.load_table(path)
+    assert table.from_table and not table.compensated
+    got = envmis.compare(table, **arguments)
+    assert got.inputs["alpha"] == expected["inputs"]["alpha"] == 0
+    assert [without_timings(r) for r in got.records] == [without_timings(r) for r in expected["results"]]
+    # The same pixels built here, not read from a table: --alpha's default of 1.
+    assert envmis.compare(envmis.EnvMap(synthetic_radiance(), compensate=False), **arguments).inputs["alpha"] == 1
+
+
 def test_the_per_point_arrays_are_the_records_point_variances_in_point_order(env):
     c = envmis.compare(env, bsdfs=["lambert", envmis.Bsdf.phong(20)], techniques=["mis-balance", "bsdf"], spp=64,
                        points=3, seed=3)
