@@ -11,6 +11,7 @@ import math
 import os
 import pathlib
 import subprocess
+import weakref
 
 import numpy as np
 import pytest
@@ -191,6 +192,17 @@ def test_a_table_saved_from_python_is_up_to_date_for_precompute_with_the_same_op
     assert statuses == ["up-to-date", "written"]
 
 
+def mapping_of(address):
+    """The file (or "" for anonymous memory) of this process's mapping holding address."""
+    with open("/proc/self/maps") as maps:
+        for line in maps:
+            fields = line.split(maxsplit=5)
+            low, high = (int(a, 16) for a in fields[0].split("-"))
+            if low <= address < high:
+                return fields[5].strip() if len(fields) == 6 else ""
+    return None
+
+
 def test_the_views_copy_nothing_and_cannot_be_written(tmp_path):
     radiance = random_radiance(32, 16, seed=1)
     env = envmis.EnvMap(radiance)
@@ -207,11 +219,30 @@ def test_the_views_copy_nothing_and_cannot_be_written(tmp_path):
     assert table.mapped and np.shares_memory(table.radiance, table.radiance)
 
 
-def test_a_view_keeps_its_map_alive():
+@pytest.mark.skipif(not os.path.exists("/proc/self/maps"), reason="needs Linux's /proc/self/maps")
+def test_a_mapped_tables_radiance_view_is_the_file_mapping_itself(tmp_path):
+    path = tmp_path / "map.envmis"
+    envmis.EnvMap(random_radiance(64, 32, seed=3)).save(path)
+    mapped, copied = envmis.load_table(path), envmis.load_table(path, mapped=False)
+    assert mapped.mapped and not copied.mapped
+    first, last = mapped.radiance.__array_interface__["data"][0], mapped.radiance[-1, -1, 2:].ctypes.data
+    assert mapping_of(first) == mapping_of(last) == str(path)
+    assert mapping_of(copied.radiance.ctypes.data) != str(path)
+    assert np.array_equal(mapped.radiance, copied.radiance)
+
+
+def test_a_view_keeps_its_map_alive_and_only_while_it_exists():
     radiance = random_radiance(32, 16, seed=2, sun=False)
-    view = envmis.EnvMap(radiance).radiance
+    env = envmis.EnvMap(radiance)
+    alive = weakref.ref(env)
+    view = env.radiance
+    del env
     gc.collect()
+    assert alive() is not None, "the map went while a view of its pixels exists"
     assert np.array_equal(view, radiance)
+    del view
+    gc.collect()
+    assert alive() is None, "the map outlives its last view"
 
 
 def test_nan_infinite_and_negative_pixels_are_replaced_and_counted():
