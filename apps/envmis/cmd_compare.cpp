@@ -45,7 +45,10 @@ struct CompareArgs {
     uint32_t bins = 0;  // --bins; 0: kDefaultBins where a -bins technique runs
     uint64_t seed = 1;
     bool exact = false;
-    std::string source_hash;  // of the map's file, as library.h's hash_text spells it
+    // Library mode: hash_text of the file given, the key results_up_to_date checks (for a
+    // table, its own bytes: a table rebuilt with other options must run again). Empty: the
+    // loaded map's source hash (for a table, the image it was built from).
+    std::string source_hash;
     MapFlags map;
     const CLI::Option* alpha_flag = nullptr;  // --alpha: given, it fixes the bins' alpha too
 };
@@ -77,7 +80,7 @@ struct Setup {
     CompensatedMaps compensated;
     std::shared_ptr<const BinnedEnvMap> binned;  // with a -bins technique
     bool bins_auto = false;                      // its alpha chosen per bin
-    std::string source_hash;                     // hash_text of the map file's hash64
+    std::string source_hash;                     // inputs.source_hash of the JSON (CompareArgs::source_hash)
 
     StudyInputs inputs() const { return {plain, compensated, points, options, binned.get()}; }
     float alpha_of(const Bsdf& bsdf) const {
@@ -195,7 +198,7 @@ std::pair<EnvMap, float> load_plain(const CompareArgs& args, std::string& map_na
     flags.alpha_auto = false;
     LoadedMap loaded = load_map(args.input, flags, *args.notes);
     map_name = loaded.source.name;
-    source_hash = hash_text(loaded.source.content_hash);
+    source_hash = args.source_hash.empty() ? hash_text(loaded.source.content_hash) : args.source_hash;
     const float fixed_alpha = !loaded.from_table         ? args.map.alpha
                               : loaded.map.compensated() ? loaded.map.options().compensation.alpha
                                                          : 0.0f;
@@ -634,6 +637,10 @@ void run_library_compare(const CompareArgs& args) {
     const std::filesystem::path dir = args.out_dir;
     const std::vector<LibraryItem> items = plan_outputs(expand_inputs(args.inputs, args.recursive, true), dir, ".json");
     std::filesystem::create_directories(dir);
+    // The maps' CSV files share one folder, made once before any map runs.
+    std::error_code ec;
+    if (!args.csv.empty() && (std::filesystem::create_directories(args.csv, ec), ec))
+        throw std::runtime_error("--csv " + args.csv + ": cannot make the folder: " + ec.message());
     for (const LibraryItem& item : items) prepare_output(item.output);
     CompareArgs shared = args;
     shared.show_progress = false;
@@ -652,12 +659,12 @@ void run_library_compare(const CompareArgs& args) {
                     }
                     CompareArgs one = shared;
                     one.input = item.input.string();
+                    one.source_hash = hash_text(hash);
                     one.json = item.output.string();
                     const std::string stem = item.input.stem().string();
                     if (!args.csv.empty()) one.csv = (std::filesystem::path(args.csv) / (stem + ".csv")).string();
                     if (!args.plots.empty()) one.plots = (std::filesystem::path(args.plots) / stem).string();
                     if (!args.images.empty()) one.images = (std::filesystem::path(args.images) / stem).string();
-                    if (!args.csv.empty()) std::filesystem::create_directories(args.csv);
                     std::ostringstream out, notes;
                     one.notes = &notes;
                     compare_one(one, out);

@@ -299,7 +299,7 @@ constexpr StatsColumn kReportColumns[] = {{"mean", "mean", 0, "%.4g"},
 // Each run's full table.
 void write_tables(std::ostream& out, const std::vector<json>& runs, bool no_timing) {
     std::vector<StatsColumn> columns;
-    for (const StatsColumn& c : columns)
+    for (const StatsColumn& c : kReportColumns)
         if (!no_timing || (std::string_view(c.key) != "ns_per_estimate" && std::string_view(c.key) != "efficiency"))
             columns.push_back(c);
     for (const json& run : runs) {

@@ -5,7 +5,6 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -17,7 +16,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "cli.h"
-#include "envmis/math/hash.h"
+#include "envmis/io/image_io.h"
 #include "envmis/table/atomic_file.h"
 #include "envmis/table/table.h"
 
@@ -108,23 +107,6 @@ CLI::Option* add_jobs_flag(CLI::App& app, uint32_t& jobs) {
                     "With several inputs or a folder: maps run at once, 1 to 1024 (default: the core count)")
         ->check(in_range(uint32_t{1}, kMaxJobs))
         ->capture_default_str();
-}
-
-uint64_t file_hash(const fs::path& path) {
-    std::error_code ec;
-    if (!fs::exists(path, ec)) throw std::runtime_error(path.string() + ": no such file");
-    if (!fs::is_regular_file(path, ec)) throw std::runtime_error(path.string() + ": not a regular file");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error(path.string() + ": cannot open");
-    Hasher hasher;
-    std::vector<char> block(size_t{1} << 20);
-    while (in) {
-        in.read(block.data(), static_cast<std::streamsize>(block.size()));
-        hasher.update(std::as_bytes(std::span(block.data(), static_cast<size_t>(in.gcount()))));
-        throw_if_interrupted();
-    }
-    if (in.bad()) throw std::runtime_error(path.string() + ": cannot read");
-    return hasher.digest();
 }
 
 std::string hash_text(uint64_t hash) {
@@ -218,7 +200,7 @@ nlohmann::json run_one(const LibraryItem& item, const MapJob& job, MemoryGate& g
         std::error_code ec;
         const uintmax_t bytes = fs::file_size(item.input, ec);
         if (!ec) entry["bytes"] = bytes;
-        const uint64_t hash = file_hash(item.input);
+        const uint64_t hash = io::hash_file(item.input, &interrupted());
         entry["source_hash"] = hash_text(hash);
         outcome = job(item, hash);
         entry["status"] = outcome.status;

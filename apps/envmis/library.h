@@ -38,9 +38,6 @@ inline constexpr uint32_t kMaxJobs = 1024;
 // --jobs N: maps run at once, 1 to kMaxJobs (default: the core count).
 CLI::Option* add_jobs_flag(CLI::App& app, uint32_t& jobs);
 
-// envmis::hash64 of a file's bytes, read in blocks (the hash envmis::io records as a
-// table's source hash). Throws naming the file where it cannot be read.
-uint64_t file_hash(const std::filesystem::path& path);
 // A hash as tables and summaries print it: 16 lower-case hex digits.
 std::string hash_text(uint64_t hash);
 
@@ -54,7 +51,7 @@ struct MapOutcome {
     std::string notes;
     nlohmann::json details = nlohmann::json::object();
 };
-// A map's job, given its input's hash; throws to fail (the message names the file).
+// A map's job, given its input's hash (io::hash_file); throws to fail (the message names the file).
 using MapJob = std::function<MapOutcome(const LibraryItem&, uint64_t source_hash)>;
 
 struct LibraryRun {

@@ -194,6 +194,41 @@ TEST_F(Library, CompareWritesEachMapsJsonAndASummaryAndSkipsThemOnTheSecondRun) 
     EXPECT_NE(report.out.find("(2 runs)"), std::string::npos) << report;
 }
 
+TEST_F(Library, CompareOverTablesKeysEachResultOnItsTableSoASecondRunSkipsThemAndARebuildRunsAgain) {
+    make_maps(false);
+    ASSERT_EQ(envmis({"precompute", "maps", "-o", "tables"}).exit_code, 0);
+    const auto expect_tables = [&](const std::string& status) {
+        std::map<std::string, std::string> expected;
+        for (const std::string& stem : kStems) expected["tables/" + stem + ".envmis"] = status;
+        EXPECT_EQ(statuses("out/summary.json"), expected);
+    };
+    const Result r = envmis(with({"compare", "tables", "--out-dir", "out", "--jobs", "2"}, kStudy));
+    ASSERT_EQ(r.exit_code, 0) << r;
+    expect_tables("written");
+    // The per-map JSON and the summary name the same hash: the table file's, not its image's.
+    const json written = summary("out/summary.json");
+    ASSERT_EQ(written["results"].size(), kStems.size());
+    for (const json& entry : written["results"]) {
+        const json run = json::parse(read_file(file(entry["output"])));
+        EXPECT_EQ(run["inputs"]["source_hash"], entry["source_hash"]) << entry;
+    }
+    envmis(with({"compare", "tables", "--out-dir", "out"}, kStudy));
+    expect_tables("up-to-date");
+    // The same images built with another alpha: other tables, studied again.
+    ASSERT_EQ(envmis({"precompute", "maps", "-o", "tables", "--alpha", "0.5"}).exit_code, 0);
+    envmis(with({"compare", "tables", "--out-dir", "out"}, kStudy));
+    expect_tables("written");
+}
+
+TEST_F(Library, ACsvFolderThatCannotBeMadeStopsTheRunBeforeAnyMap) {
+    make_maps(false);
+    write_text(file("csv"), "a file where the folder should be\n");
+    expect_one_line_error(envmis(with({"compare", "maps", "--out-dir", "out", "--csv", "csv"}, kStudy)), "--csv csv",
+                          "cannot make the folder");
+    EXPECT_FALSE(fs::exists(file("out/summary.json")));
+    for (const std::string& stem : kStems) EXPECT_FALSE(fs::exists(file("out/" + stem + ".json"))) << stem;
+}
+
 TEST_F(Library, SeveralInputsWithoutAnOutputFolderAreRefused) {
     make_maps(false);
     expect_one_line_error(envmis(with({"compare", "maps/city.exr", "maps/studio.exr"}, kStudy)), "--out-dir",

@@ -95,6 +95,29 @@ TEST_F(Report, SummarisesCasesWithGeometricMeansAndNamesTheBestMisTechnique) {
     EXPECT_NE(md.find("## a (8x4)"), std::string::npos);
 }
 
+TEST_F(Report, EachRunsTableListsItsFiguresAndNoTimingLeavesOutOnlyTheTimedOnes) {
+    const fs::path a = write_run("a", {{"mis-balance", 1}, {"mis-optimal", 0.5}});
+    ASSERT_EQ(run(a.string() + " -o " + (dir_ / "timed.md").string()), 0);
+    ASSERT_EQ(run(a.string() + " -o " + (dir_ / "untimed.md").string() + " --no-timing"), 0);
+    const std::string timed = read(dir_ / "timed.md");
+    const std::string untimed = read(dir_ / "untimed.md");
+    EXPECT_NE(timed.find("| bsdf | technique | mean | reference | variance | std_error | rel_mse | ns/estimate | "
+                         "efficiency | var/mis |"),
+              std::string::npos)
+        << timed;
+    // variance 0.5, ns/estimate 100, efficiency 1e7 / 0.5, var/mis 0.5.
+    EXPECT_NE(timed.find("| lambert | mis-optimal | 1 | 1 | 0.5 | 0.01 | 0.1 | 100 | 2e+07 | 0.500 |"),
+              std::string::npos)
+        << timed;
+    EXPECT_NE(untimed.find("| bsdf | technique | mean | reference | variance | std_error | rel_mse | var/mis |"),
+              std::string::npos)
+        << untimed;
+    EXPECT_NE(untimed.find("| lambert | mis-optimal | 1 | 1 | 0.5 | 0.01 | 0.1 | 0.500 |"), std::string::npos)
+        << untimed;
+    EXPECT_EQ(untimed.find("ns/estimate"), std::string::npos) << untimed;
+    EXPECT_EQ(untimed.find("efficiency"), std::string::npos) << untimed;
+}
+
 TEST_F(Report, RejectsFilesThatAreNotCompareResults) {
     std::ofstream(dir_ / "text.json") << "not json";
     std::ofstream(dir_ / "other.json") << R"({"samplers": []})";

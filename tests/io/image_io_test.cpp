@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -300,6 +301,25 @@ TEST_F(ImageIo, ContentHashIsTheHashOfTheFileBytes) {
     const uint64_t a = load_image(file("a.exr")).content_hash;
     EXPECT_EQ(a, hash64(file_bytes(file("a.exr"))));
     EXPECT_NE(a, load_image(file("b.exr")).content_hash);
+}
+
+TEST_F(ImageIo, HashFileIsHash64OfAnyFilesBytesOverSeveralBlocksAndTheLoadsContentHash) {
+    // 1.5 MiB: more than one of the 1 MiB blocks it reads.
+    std::string bytes(size_t{3} << 19, '\0');
+    for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<char>(i * 2654435761u >> 13);
+    std::ofstream(file("table.envmis"), std::ios::binary) << bytes;
+    EXPECT_EQ(hash_file(file("table.envmis")), hash64(file_bytes(file("table.envmis"))));
+    write_pattern(file("a.exr"), "openexr", 7, 3, 3);
+    EXPECT_EQ(hash_file(file("a.exr")), load_image(file("a.exr")).content_hash);
+}
+
+TEST_F(ImageIo, HashFileNamesAMissingFileOrAFolderAndStopsWhenAsked) {
+    expect_image_error([&] { hash_file(file("nothing.envmis")); }, {"nothing.envmis", "no such file"});
+    fs::create_directories(file("folder.envmis"));
+    expect_image_error([&] { hash_file(file("folder.envmis")); }, {"folder.envmis", "not a regular file"});
+    std::ofstream(file("x.envmis")) << "bytes\n";
+    const std::atomic<bool> stop{true};
+    EXPECT_THROW(hash_file(file("x.envmis"), &stop), Interrupted);
 }
 
 // --- colour spaces

@@ -30,6 +30,12 @@ TEST(CanonicalOptions, EveryFieldThatChangesTheTableChangesTheString) {
     EXPECT_NE(changed([](BuildRequest& r) { r.compact = true; }), text);
     EXPECT_NE(changed([](BuildRequest& r) { r.bins = 9; }), text);
     EXPECT_NE(changed([](BuildRequest& r) { r.colorspace = "ACEScg"; }), text);
+    EXPECT_NE(changed([](BuildRequest& r) { r.mapping = "equal-area"; }), text);
+    EXPECT_NE(changed([](BuildRequest& r) { r.working_space = "ACEScg"; }), text);
+    EXPECT_NE(changed([](BuildRequest& r) { r.cell_columns = 64; }), text);
+    // Each field is a field of its own: the same value in another is another string.
+    EXPECT_NE(changed([](BuildRequest& r) { r.colorspace = "ACEScg"; }),
+              changed([](BuildRequest& r) { r.working_space = "ACEScg"; }));
 }
 
 TEST(CanonicalOptions, RecordTheEffectiveAlphaNotHowItWasAskedFor) {

@@ -149,20 +149,6 @@ RgbImage read_pixels(const fs::path& path, OIIO::ImageInput& in, std::vector<std
     return image;
 }
 
-uint64_t hash_file(const fs::path& path, StopFlag stop) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) fail(path, "cannot open to hash");
-    Hasher hasher;
-    std::vector<char> chunk(size_t{1} << 20);
-    do {
-        throw_if_stopped(stop);
-        in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
-        hasher.update(std::as_bytes(std::span(chunk.data(), static_cast<size_t>(in.gcount()))));
-    } while (in);
-    if (in.bad()) fail(path, "read error while hashing");
-    return hasher.digest();
-}
-
 // `elements` is the length of the image's pixel vector, `per_pixel` its elements per pixel.
 void check_writable(const fs::path& path, uint32_t width, uint32_t height, size_t elements, size_t per_pixel) {
     const size_t expected = size_t{width} * height * per_pixel;
@@ -211,6 +197,25 @@ void write_atomically(const fs::path& path, const char* format, const OIIO::Imag
 }
 
 }  // namespace
+
+uint64_t hash_file(const fs::path& path, StopFlag stop) {
+    std::error_code ec;
+    const fs::file_status status = fs::status(path, ec);
+    if (status.type() == fs::file_type::not_found) fail(path, "no such file");
+    if (ec) fail(path, ec.message());
+    if (!fs::is_regular_file(status)) fail(path, "not a regular file");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) fail(path, "cannot open to hash");
+    Hasher hasher;
+    std::vector<char> chunk(size_t{1} << 20);
+    do {
+        throw_if_stopped(stop);
+        in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+        hasher.update(std::as_bytes(std::span(chunk.data(), static_cast<size_t>(in.gcount()))));
+    } while (in);
+    if (in.bad()) fail(path, "read error while hashing");
+    return hasher.digest();
+}
 
 LoadedImage load_image(const fs::path& path, const LoadOptions& options) {
     const auto in = open_image(path);

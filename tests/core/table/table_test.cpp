@@ -330,6 +330,35 @@ TEST_F(TableTest, TheHeaderAloneGivesSizeOptionsAndSource) {
     EXPECT_THROW(read_table_header(dir_ / "missing.envmis"), TableError);
 }
 
+// read_table_header opens and checks a file as read_table does: the same message for
+// every file whose header it cannot read.
+TEST_F(TableTest, TheHeaderAloneFailsWithReadTablesMessages) {
+    const auto message = [](auto&& read) -> std::string {
+        try {
+            read();
+        } catch (const TableError& e) {
+            return e.what();
+        }
+        return "accepted";
+    };
+    const fs::path path = saved_table();
+    const std::vector<char> good = bytes_of(path);
+    const auto expect_same = [&](const fs::path& p, const std::string& problem) {
+        const std::string header = message([&] { read_table_header(p); });
+        EXPECT_NE(header.find(problem), std::string::npos) << header;
+        EXPECT_EQ(header, message([&] { read_table(p, TableLoading::copy); }));
+        EXPECT_EQ(header, message([&] { read_table(p, TableLoading::map); }));
+    };
+    expect_same(dir_ / "missing.envmis", "no such file");
+    expect_same(dir_, "not a regular file");
+    write_bytes(path, {good.begin(), good.begin() + 20});
+    expect_same(path, "truncated");
+    write_bytes(path, {good.begin(), good.end() - 1});
+    expect_same(path, "truncated");
+    write_bytes(path, {'#', '?', 'R', 'A', 'D', 'I', 'A', 'N', 'C', 'E', '\n'});
+    expect_same(path, "not an envmis table");
+}
+
 // Version 3 pads the metadata block with zeros to a multiple of 8 bytes, so that the
 // payload's arrays are aligned; anything else there is an error.
 TEST_F(TableTest, MetadataPaddingIsZerosToAMultipleOfEight) {

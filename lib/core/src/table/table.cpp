@@ -640,6 +640,27 @@ Table copy_payload(Header header, std::span<const std::byte> bytes, std::string_
         name);
 }
 
+// Throws naming `path` where it is missing or not a regular file.
+void require_regular_file(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw TableError(path.string() + ": no such file");
+    if (!std::filesystem::is_regular_file(path, ec)) throw TableError(path.string() + ": not a regular file");
+}
+
+// Opens `path` into `file` and parses its header, reading at most the preamble, 64 KiB of
+// metadata and its checksum whatever the file's size; `file` is left open for the payload.
+Header read_file_header(const std::filesystem::path& path, std::ifstream& file) {
+    file.open(path, std::ios::binary | std::ios::ate);
+    if (!file) throw TableError(describe_errno(path, "open"));
+    const std::streamoff size = file.tellg();
+    if (size < 0) throw TableError(path.string() + ": cannot determine the file size");
+    std::vector<std::byte> head(std::min<size_t>(static_cast<size_t>(size), kPreambleSize + kMaxMetadataSize + 8));
+    file.seekg(0);
+    if (!file.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size())))
+        throw TableError(describe_errno(path, "read"));
+    return parse_header(head, static_cast<uint64_t>(size), path.string());
+}
+
 }  // namespace
 
 Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
@@ -647,9 +668,7 @@ Table parse_table(std::span<const std::byte> bytes, std::string_view name) {
 }
 
 Table read_table(const std::filesystem::path& path, TableLoading loading) {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw TableError(path.string() + ": no such file");
-    if (!std::filesystem::is_regular_file(path, ec)) throw TableError(path.string() + ": not a regular file");
+    require_regular_file(path);
     if (loading == TableLoading::map)
         if (const std::shared_ptr<const detail::MappedFile> file = detail::MappedFile::map(path)) {
             const std::span<const std::byte> bytes = file->bytes();
@@ -657,16 +676,9 @@ Table read_table(const std::filesystem::path& path, TableLoading loading) {
             if (std::optional<Table> table = read_mapped_payload(header, file, path.string())) return std::move(*table);
             return copy_payload(std::move(header), bytes, path.string());
         }
-    std::ifstream file(path, std::ios::binary | std::ios::ate);
-    if (!file) throw TableError(describe_errno(path, "open"));
-    const std::streamoff size = file.tellg();
-    if (size < 0) throw TableError(path.string() + ": cannot determine the file size");
-    // The header is at most 32 + 64 KiB + 8 bytes; the payload goes straight to its place.
-    std::vector<std::byte> head(std::min<size_t>(static_cast<size_t>(size), kPreambleSize + kMaxMetadataSize + 8));
-    file.seekg(0);
-    if (!file.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size())))
-        throw TableError(describe_errno(path, "read"));
-    Header header = parse_header(head, static_cast<uint64_t>(size), path.string());
+    std::ifstream file;
+    Header header = read_file_header(path, file);
+    // The payload goes straight to its place.
     file.seekg(static_cast<std::streamoff>(header.payload_offset));
     return read_payload(
         std::move(header),
@@ -688,18 +700,9 @@ BinnedEnvMap binned_map(Table&& table) {
 }
 
 TableHeader read_table_header(const std::filesystem::path& path) {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw TableError(path.string() + ": no such file");
-    if (!std::filesystem::is_regular_file(path, ec)) throw TableError(path.string() + ": not a regular file");
-    std::ifstream file(path, std::ios::binary | std::ios::ate);
-    if (!file) throw TableError(describe_errno(path, "open"));
-    const std::streamoff size = file.tellg();
-    if (size < 0) throw TableError(path.string() + ": cannot determine the file size");
-    std::vector<std::byte> head(std::min<size_t>(static_cast<size_t>(size), kPreambleSize + kMaxMetadataSize + 8));
-    file.seekg(0);
-    if (!file.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size())))
-        throw TableError(describe_errno(path, "read"));
-    Header h = parse_header(head, static_cast<uint64_t>(size), path.string());
+    require_regular_file(path);
+    std::ifstream file;
+    Header h = read_file_header(path, file);
     return {h.version, h.w, h.h, h.options, h.stats, std::move(h.source), h.compact, h.bins_size != 0};
 }
 

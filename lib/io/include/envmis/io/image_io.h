@@ -59,6 +59,13 @@ struct LoadedImage {
 
 LoadedImage load_image(const std::filesystem::path& path, const LoadOptions& options = {});
 
+// envmis::hash64 (math/hash.h) of a file's bytes, any file: LoadedImage::content_hash, the
+// source hash a table records, and library mode's key for an up-to-date output. Reads the
+// file once in 1 MiB blocks (about a second per GB, mostly the disk's); once `stop` is
+// set, throws Interrupted before the next block. Throws ImageError naming the file where
+// it is missing, not a regular file, or cannot be read.
+uint64_t hash_file(const std::filesystem::path& path, StopFlag stop = nullptr);
+
 // 8-bit sRGB-encoded RGB pixels, row-major, row 0 at the top (pictures for people).
 struct Image8 {
     uint32_t width = 0, height = 0;
