@@ -1,10 +1,11 @@
 // Specification of library mode: `envmis precompute` and `envmis compare` over several
 // maps or a folder, in parallel (--jobs), with up-to-date outputs skipped and one summary.
-// The maps are the three bundled ones made 32x16 (envmis convert), once for the suite.
+// The maps are the three bundled ones made 32x16 (envmis convert), once per ctest run.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -28,8 +29,19 @@ class Library : public envmis::test::TempFolder {
 public:
     Library() : TempFolder("envmis_library_test_") {}
 
-    // The small maps, made once for all the tests.
+    // The small maps: under ctest, made once per run by the fixture library_test.maps
+    // (tests/apps/library_maps.cmake; each test runs in a process of its own); otherwise
+    // made here, once for all the tests of this process.
     static void SetUpTestSuite() {
+#ifdef ENVMIS_LIBRARY_MAPS
+        const fs::path shared = ENVMIS_LIBRARY_MAPS;
+        if (std::all_of(kStems.begin(), kStems.end(),
+                        [&](const std::string& stem) { return fs::is_regular_file(shared / (stem + ".exr")); })) {
+            small_ = shared;
+            return;
+        }
+#endif
+        owned_ = true;
         small_ = fs::temp_directory_path() / ("envmis_library_maps_" + std::to_string(::getpid()));
         fs::create_directories(small_);
         for (const char* name : {"city.exr", "rooitou_park_1k.hdr", "studio.exr"}) {
@@ -43,7 +55,7 @@ public:
     }
     static void TearDownTestSuite() {
         std::error_code ignored;
-        fs::remove_all(small_, ignored);
+        if (owned_) fs::remove_all(small_, ignored);
     }
 
     Result envmis(const std::vector<std::string>& args) const {
@@ -75,6 +87,7 @@ public:
     }
 
     static inline fs::path small_;
+    static inline bool owned_ = false;  // small_ was made here (and is removed here)
 };
 
 const std::vector<std::string> kStudy = {"--spp",  "16",      "--points",     "2",
