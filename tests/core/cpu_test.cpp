@@ -16,14 +16,14 @@ CpuInfo cpu(const char* vendor, uint32_t family, bool avx2) {
 }
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-TEST(Cpu, GatherKernelsRunOnlyWhereGathersWereMeasuredFast) {
+TEST(Cpu, EachKernelTakesThePathMeasuredFasterOnItsCpuFamily) {
     const BatchPaths intel = choose_batch_paths(cpu("GenuineIntel", 6, true), "");
     EXPECT_EQ(intel.lookup, BatchPath::avx2);
     EXPECT_EQ(intel.sample, BatchPath::avx2);
     EXPECT_EQ(intel.lanes, BatchPath::avx2);
     for (const uint32_t family : {0x17u, 0x19u, 0x1au}) {
         const BatchPaths amd = choose_batch_paths(cpu("AuthenticAMD", family, true), "");
-        EXPECT_EQ(amd.lookup, BatchPath::scalar) << family;
+        EXPECT_EQ(amd.lookup, BatchPath::avx2) << family;
         EXPECT_EQ(amd.sample, BatchPath::scalar) << family;
         EXPECT_EQ(amd.lanes, BatchPath::avx2) << family;
         EXPECT_FALSE(amd.unavailable);
@@ -52,7 +52,10 @@ TEST(Cpu, AForcedPathTheCpuLacksRunsScalarAndSaysSo) {
         EXPECT_EQ(p.lanes, BatchPath::scalar) << forced;
         EXPECT_EQ(p.forced, forced);
     }
-    EXPECT_FALSE(choose_batch_paths(cpu("GenuineIntel", 6, false), "").unavailable);
+    const BatchPaths without = choose_batch_paths(cpu("GenuineIntel", 6, false), "");
+    EXPECT_FALSE(without.unavailable);
+    EXPECT_EQ(without.lookup, BatchPath::scalar);
+    EXPECT_EQ(without.lanes, BatchPath::scalar);
 }
 
 // The paths.* tests run this with ENVMIS_SIMD set: the process takes the forced path.

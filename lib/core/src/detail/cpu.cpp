@@ -109,8 +109,8 @@ BatchPaths choose_batch_paths(const CpuInfo& cpu, std::string_view forced) {
         return paths;
     }
     const bool fast_gathers = cpu.vendor == "GenuineIntel";
-    paths.lanes = avx2 ? BatchPath::avx2 : BatchPath::scalar;
-    paths.lookup = paths.sample = avx2 && fast_gathers ? BatchPath::avx2 : BatchPath::scalar;
+    paths.lanes = paths.lookup = avx2 ? BatchPath::avx2 : BatchPath::scalar;
+    paths.sample = avx2 && fast_gathers ? BatchPath::avx2 : BatchPath::scalar;
     return paths;
 }
 
