@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "envmis/cpu.h"
 #include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"
 #include "envmis/study/comparison/comparison.h"
@@ -272,4 +273,14 @@ BENCHMARK_CAPTURE(estimate, mis_balance_ggx, "mis-balance", envmis::Bsdf::ggx(0.
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// BENCHMARK_MAIN, with the CPU and the batch kernels' paths in the context that heads
+// the output (text and JSON), so that every figure names the machine it was measured on.
+int main(int argc, char** argv) {
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+    benchmark::AddCustomContext("cpu", envmis::cpu_name());
+    benchmark::AddCustomContext("batch_paths", envmis::batch_paths_summary());
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
+#include "envmis/cpu.h"
 #include "reference.h"
 
 namespace envmis::cli {
@@ -209,6 +210,7 @@ BenchPoints bench_points(uint32_t n, bool normals, uint32_t samples_per_normal) 
 struct BenchResult {
     std::vector<Timing> timings;
     double build = 0, sample = 0, pdf = 0, batch_sample = 0, batch_pdf = 0;  // speedups
+    double batch_over_single_sample = 0, batch_over_single_pdf = 0;          // the batch calls' speedups
 };
 
 // Sampling and pdf times of the two samplers, back to back in each repeat, so that the
@@ -217,9 +219,10 @@ struct BenchResult {
 // read once, not rebuilt from the map at every call); guided-batch is the same sampler
 // through sample_many and lookup_many (the latter finds the radiance too), as a
 // wavefront renderer would call it. times: guided sample, textbook sample, guided pdf,
-// textbook pdf, batch sample, batch lookup; ratios: textbook over the others.
+// textbook pdf, batch sample, batch lookup; ratios: textbook over the others, then the
+// batch calls' speedups over the single calls (sample, and lookup over pdf).
 struct CallTimes {
-    std::vector<double> times[6], ratios[4];
+    std::vector<double> times[6], ratios[6];
 };
 
 CallTimes time_calls(const EnvMap& guided, const reference::TextbookEnvMap& textbook, const BenchPoints& points,
@@ -245,6 +248,8 @@ CallTimes time_calls(const EnvMap& guided, const reference::TextbookEnvMap& text
         c.ratios[1].push_back(t[3] / t[2]);
         c.ratios[2].push_back(t[1] / t[4]);
         c.ratios[3].push_back(t[3] / t[5]);
+        c.ratios[4].push_back(t[0] / t[4]);
+        c.ratios[5].push_back(t[2] / t[5]);
         progress.update(++step);
     }
     return c;
@@ -271,6 +276,8 @@ BenchResult measure(const RgbImage& image, const EnvMapOptions& options, const B
     result.pdf = median(c.ratios[1]);
     result.batch_sample = median(c.ratios[2]);
     result.batch_pdf = median(c.ratios[3]);
+    result.batch_over_single_sample = median(c.ratios[4]);
+    result.batch_over_single_pdf = median(c.ratios[5]);
     return result;
 }
 
@@ -286,6 +293,7 @@ struct BinnedResult {
     double build_ms[3] = {}, bytes[3] = {};  // plain, compensated, bins (bins alone)
     double ns[3][4] = {};                    // per sampler and kind of call
     double ratio[2][4] = {};                 // binned over plain, over compensated
+    double batch_speedup[3][2] = {};         // per sampler: single sample / batch, single pdf / batch lookup
 };
 
 // ns per call of the three samplers, back to back in each repeat; lobe class 0.
@@ -298,7 +306,7 @@ void time_binned_calls(const EnvMapView (&today)[2], const BinnedEnvMapView& bin
             pdfs.emplace_back(points.directions[i], points.normals[i]);
     const auto sum = [](const EnvSample& s) { return s.pdf + s.direction.x + s.radiance.r; };
     BatchInputs batch(points.us, points.directions, points.normals);
-    std::vector<double> ns[3][4], ratio[2][4];
+    std::vector<double> ns[3][4], ratio[2][4], speedup[3][2];
     for (int r = 0; r < repeats; ++r) {
         throw_if_interrupted();
         double t[3][4];
@@ -316,12 +324,16 @@ void time_binned_calls(const EnvMapView (&today)[2], const BinnedEnvMapView& bin
             for (int k = 0; k < 3; ++k) ns[k][c].push_back(t[k][c]);
             for (int k = 0; k < 2; ++k) ratio[k][c].push_back(t[2][c] / t[k][c]);
         }
+        for (int k = 0; k < 3; ++k)
+            speedup[k][0].push_back(t[k][0] / t[k][2]), speedup[k][1].push_back(t[k][1] / t[k][3]);
         progress.update(++step);
     }
     for (int c = 0; c < 4; ++c) {
         for (int k = 0; k < 3; ++k) result.ns[k][c] = median(ns[k][c]);
         for (int k = 0; k < 2; ++k) result.ratio[k][c] = median(ratio[k][c]);
     }
+    for (int k = 0; k < 3; ++k)
+        for (int c = 0; c < 2; ++c) result.batch_speedup[k][c] = median(speedup[k][c]);
 }
 
 BinnedResult measure_binned(const RgbImage& image, uint32_t bins, const BenchPoints& points, int repeats) {
@@ -369,6 +381,7 @@ nlohmann::json binned_json(const BinnedResult& b) {
     for (int k = 0; k < 3; ++k) {
         nlohmann::json s = {{"sampler", kBinnedSamplers[k]}, {"build_ms", b.build_ms[k]}, {"bytes", b.bytes[k]}};
         for (int c = 0; c < 4; ++c) s[std::string("ns_per_") + kCallNames[c]] = b.ns[k][c];
+        s["batch_over_single"] = {{"sample", b.batch_speedup[k][0]}, {"lookup_over_pdf", b.batch_speedup[k][1]}};
         j["samplers"].push_back(s);
     }
     for (int k = 0; k < 2; ++k)
@@ -386,8 +399,9 @@ void print_binned_text(const BinnedResult& b) {
     for (int k = 0; k < 3; ++k)
         std::printf(
             "sampler=%s build_ms=%.1f ns_per_sample=%.1f ns_per_pdf=%.1f ns_per_batch_sample=%.1f "
-            "ns_per_batch_lookup=%.1f bytes=%.0f\n",
-            kBinnedSamplers[k], b.build_ms[k], b.ns[k][0], b.ns[k][1], b.ns[k][2], b.ns[k][3], b.bytes[k]);
+            "ns_per_batch_lookup=%.1f bytes=%.0f batch_over_single sample=%.2fx lookup_over_pdf=%.2fx\n",
+            kBinnedSamplers[k], b.build_ms[k], b.ns[k][0], b.ns[k][1], b.ns[k][2], b.ns[k][3], b.bytes[k],
+            b.batch_speedup[k][0], b.batch_speedup[k][1]);
     for (int k = 0; k < 2; ++k) {
         std::printf("binned_over_%s sample=%.2fx pdf=%.2fx batch_sample=%.2fx batch_lookup=%.2fx", kBinnedSamplers[k],
                     b.ratio[k][0], b.ratio[k][1], b.ratio[k][2], b.ratio[k][3]);
@@ -407,7 +421,14 @@ void print_bench_json(const BenchArgs& args, const BenchMap& map, const BenchRes
                         {"height", map.image.height},
                         {"compensated", !args.no_compensate},
                         {"repeats", args.repeats},
-                        {"samples", args.samples}};
+                        {"samples", args.samples},
+                        {"cpu", cpu_name()},
+                        {"batch_paths",
+                         {{"lookup_many", std::string(to_string(batch_paths().lookup))},
+                          {"sample_many", std::string(to_string(batch_paths().sample))},
+                          {"lanes", std::string(to_string(batch_paths().lanes))},
+                          {"forced", batch_paths().forced},
+                          {"unavailable", batch_paths().unavailable}}}};
     for (const Timing& t : result.timings)
         j["samplers"].push_back({{"sampler", t.sampler},
                                  {"build_ms", t.build_ms},
@@ -419,12 +440,15 @@ void print_bench_json(const BenchArgs& args, const BenchMap& map, const BenchRes
                                 {"pdf", result.pdf},
                                 {"batch_sample", result.batch_sample},
                                 {"batch_pdf", result.batch_pdf}};
+    j["batch_over_single"] = {{"sample", result.batch_over_single_sample},
+                              {"lookup_over_pdf", result.batch_over_single_pdf}};
     if (binned) j["binned"] = binned_json(*binned);
     std::cout << j.dump(2) << "\n";
 }
 
 void print_bench_text(const BenchArgs& args, const BenchMap& map, const BenchResult& result,
                       const std::optional<BinnedResult>& binned) {
+    std::printf("cpu=%s\nbatch_paths %s\n", cpu_name().c_str(), batch_paths_summary().c_str());
     std::printf("map=%s size=%ux%u compensated=%d repeats=%d samples=%u (medians)\n", map.name.c_str(), map.image.width,
                 map.image.height, !args.no_compensate, args.repeats, args.samples);
     for (const Timing& t : result.timings)
@@ -434,6 +458,10 @@ void print_bench_text(const BenchArgs& args, const BenchMap& map, const BenchRes
         "speedup_vs_textbook build=%.2fx sample=%.2fx pdf=%.2fx batch_sample=%.2fx "
         "batch_pdf=%.2fx (sample, pdf: median of the ratios within each repeat)\n",
         result.build, result.sample, result.pdf, result.batch_sample, result.batch_pdf);
+    std::printf(
+        "batch_over_single sample=%.2fx lookup_over_pdf=%.2fx (guided-batch against guided: single sample over "
+        "sample_many, single pdf over lookup_many; median of the ratios within each repeat)\n",
+        result.batch_over_single_sample, result.batch_over_single_pdf);
     if (binned) print_binned_text(*binned);
 }
 

@@ -8,6 +8,7 @@
 
 #include "envmis/sampling/envmap.h"
 #include "errors.h"
+#include "forced_path.h"
 #include "maps.h"
 #include "stats.h"
 
@@ -366,6 +367,7 @@ uint32_t bits(float f) { return bit_cast<uint32_t>(f); }
 // lookup_many's SIMD path repeats lookup's arithmetic: every lane must give lookup's
 // exact bits, on every path.
 TEST(EnvMap, LookupManyIsBitIdenticalToLookup) {
+    ENVMIS_SKIP_IF_FORCED_PATH_UNAVAILABLE();
     std::vector<Vec3> directions = {{0, 0, 1},      {0, 0, -1},       {1, 0, 0},        {-1, 0, 0},
                                     {0, 1, 0},      {0, -1, 0},       {1, -0.0f, 0},    {-1, -0.0f, 0},
                                     {1e-20f, 0, 1}, {0, -1e-20f, -1}, {0.6f, -0.8f, 0}, {0, 0, 0}};
@@ -397,6 +399,7 @@ TEST(EnvMap, LookupManyIsBitIdenticalToLookup) {
 // sample_many's SIMD path repeats sample's search and arithmetic likewise, for points
 // at the ends of [0,1), on the random generator's grid and off it; the image points too.
 TEST(EnvMap, SampleManyIsBitIdenticalToSample) {
+    ENVMIS_SKIP_IF_FORCED_PATH_UNAVAILABLE();
     const float edges[] = {0.0f, 0x1p-24f, 0.5f, 0.25f, 1 - 0x1p-24f, kOneMinusEpsilon};
     std::vector<Vec2> points;
     for (const float a : edges)
@@ -426,6 +429,43 @@ TEST(EnvMap, SampleManyIsBitIdenticalToSample) {
                     << map.width() << "x" << map.height() << " point " << i << " (" << points[i].x << ", "
                     << points[i].y << ") output " << k;
         }
+    }
+}
+
+// The pipelines' start and end: batches shorter than, as long as and just longer than
+// the prefetch distance and the SIMD width, each call on its own output arrays.
+TEST(EnvMap, ManyCallsOfEveryLengthAreBitIdenticalToSingleCalls) {
+    ENVMIS_SKIP_IF_FORCED_PATH_UNAVAILABLE();
+    const EnvMap map(test::sun_sky_map(64, 32), options(false));
+    const EnvMapView view = map.view();
+    Rng rng(23);
+    constexpr uint32_t kMax = 70;
+    float ux[kMax], uy[kMax], dx[kMax], dy[kMax], dz[kMax];
+    for (uint32_t i = 0; i < kMax; ++i) {
+        ux[i] = rng.uniform(), uy[i] = rng.uniform();
+        const Vec3 d = map.sample(rng.uniform2()).direction;
+        dx[i] = d.x, dy[i] = d.y, dz[i] = d.z;
+    }
+    for (uint32_t n = 0; n <= kMax; ++n) {
+        std::vector<float> o(7 * kMax, -1.0f);  // a write past lane n - 1 shows
+        float* p = o.data();
+        sample_many(view, {ux, uy}, {p, p + kMax, p + 2 * kMax, p + 3 * kMax, p + 4 * kMax, p + 5 * kMax, p + 6 * kMax},
+                    n);
+        for (uint32_t i = 0; i < n; ++i) {
+            const EnvSample e = view.sample({ux[i], uy[i]});
+            ASSERT_EQ(bits(p[i]), bits(e.direction.x)) << n << " " << i;
+            ASSERT_EQ(bits(p[kMax + i]), bits(e.direction.y)) << n << " " << i;
+            ASSERT_EQ(bits(p[3 * kMax + i]), bits(e.pdf)) << n << " " << i;
+            ASSERT_EQ(bits(p[5 * kMax + i]), bits(e.radiance.g)) << n << " " << i;
+        }
+        for (uint32_t i = n; i < kMax; ++i) ASSERT_EQ(p[i], -1.0f) << n << " " << i;
+        lookup_many(view, {dx, dy, dz}, {p, p + kMax, p + 2 * kMax, p + 3 * kMax}, n);
+        for (uint32_t i = 0; i < n; ++i) {
+            const EnvMapView::Lookup e = view.lookup({dx[i], dy[i], dz[i]});
+            ASSERT_EQ(bits(p[3 * kMax + i]), bits(e.pdf)) << n << " " << i;
+            ASSERT_EQ(bits(p[2 * kMax + i]), bits(e.radiance.b)) << n << " " << i;
+        }
+        for (uint32_t i = n; i < kMax; ++i) ASSERT_EQ(p[3 * kMax + i], -1.0f) << n << " " << i;
     }
 }
 

@@ -1,12 +1,18 @@
 // lookup_many and sample_many (envmap.h): EnvMapView::lookup and EnvMapView::sample
-// for many directions or random points, eight at a time with AVX2 where the CPU has it.
+// for many directions or random points, on the path envmis/cpu.h chooses for the CPU.
 //
-// The AVX2 paths repeat the scalar arithmetic operation for operation (equirect_uv,
-// fast_atan2, detail::cell_of, CdfView::width and invert, detail::point_in_cell,
-// Distribution2DView::pdf_of, sincos_turns, sincos_half_turns, solid_angle_pdf): the
-// same IEEE operations in the same order, no fused multiply-add, so every lane's result
-// is bit-identical to the scalar call (tests/envmap_test.cpp checks it on maps of
-// several sizes, at the poles, the seam and the last column). If one of those functions
+// The scalar paths call the single calls' own functions, split into stages: a lane's
+// first stage finds what it will read and prefetches it, its last runs a fixed number of
+// lanes later, so that that many lanes' cache misses are in flight at once. The results
+// are bit-identical to the single calls by construction.
+//
+// The AVX2 paths (eight lanes at a time, hardware gathers) repeat the scalar arithmetic
+// operation for operation (equirect_uv, fast_atan2, detail::cell_of, CdfView::width and
+// invert, detail::point_in_cell, Distribution2DView::pdf_of, sincos_turns,
+// sincos_half_turns, solid_angle_pdf): the same IEEE operations in the same order, no
+// fused multiply-add, so every lane's result is bit-identical to the scalar call
+// (tests/core/sampling/envmap_test.cpp checks it on maps of several sizes, at the poles,
+// the seam and the last column, on every path the CPU has). If one of those functions
 // changes, this file must change with it; the tests fail until it does. GCC 12's
 // auto-vectoriser does not vectorise the scalar loops in a target("avx2") function
 // (docs/performance-log.md), hence the intrinsics.
@@ -15,27 +21,100 @@
 #include <algorithm>
 
 #include "detail/simd.h"
+#include "envmis/cpu.h"
 
 namespace envmis {
 namespace {
 
-// Lanes first..n one at a time, in chunks whose texels are all prefetched before the
-// first is read, so that their cache misses overlap.
-void lookup_one_by_one(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t first,
-                       uint32_t n) noexcept {
-    constexpr uint32_t kChunk = 32;
-    Vec2 uv[kChunk];
-    for (uint32_t begin = first; begin < n; begin += kChunk) {
-        const uint32_t end = n - begin < kChunk ? n : begin + kChunk;
-        for (uint32_t l = begin; l < end; ++l) {
-            uv[l - begin] = env.uv_of({in.x[l], in.y[l], in.z[l]});
-            env.prefetch_uv(uv[l - begin]);
-        }
-        for (uint32_t l = begin; l < end; ++l) {
-            const Rgb c = env.eval_uv(uv[l - begin]);
-            out.r[l] = c.r, out.g[l] = c.g, out.b[l] = c.b, out.pdf[l] = env.pdf_uv(uv[l - begin]);
-        }
+// How many lanes ahead the first stage of the scalar paths runs: the misses in flight.
+// 32 measured best for lookups on the plain 8k sky (AMD EPYC family 0x1a; 16 and 64
+// slower), 16 for samples, whose second stage's misses are fewer and nearer the first's.
+constexpr uint32_t kLookupDistance = 32, kSampleDistance = 16;
+
+// Lanes first..n of a two-stage pipeline: start(l) for lane l (it returns what finish
+// needs), finish(started, l) kDistance lanes later.
+template <uint32_t kDistance, class Start, class Finish>
+void pipelined(uint32_t first, uint32_t n, Start&& start, Finish&& finish) noexcept {
+    static_assert((kDistance & (kDistance - 1)) == 0);
+    decltype(start(first)) started[kDistance];
+    const uint32_t primed = std::min(n - first, kDistance);
+    for (uint32_t k = 0; k < primed; ++k) started[k] = start(first + k);
+    for (uint32_t l = first, slot = 0; l < n; ++l, slot = (slot + 1) & (kDistance - 1)) {
+        const auto s = started[slot];
+        if (l + kDistance < n) started[slot] = start(l + kDistance);
+        finish(s, l);
     }
+}
+
+// What eval_uv and pdf_uv read at uv: the radiance (both ends: a texel may straddle two
+// cache lines), the texel's CDF entry and the next (its width), the row's marginal entry.
+void prefetch_texel(const EnvMapView& env, Vec2 uv) noexcept {
+    const Distribution2DView& d = env.distribution;
+    const uint32_t x = detail::cell_of(uv.x, d.w), y = detail::cell_of(uv.y, d.h);
+    const size_t i = static_cast<size_t>(y) * d.w + x;
+    ENVMIS_PREFETCH(env.radiance + i);
+    ENVMIS_PREFETCH(&env.radiance[i].b);
+    ENVMIS_PREFETCH(d.start + i);
+    ENVMIS_PREFETCH(d.start + i + 1);  // one past the table at most: the prefetch does not fault
+    ENVMIS_PREFETCH(d.marginal.start + y);
+}
+
+void lookup_scalar(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t first, uint32_t n) noexcept {
+    pipelined<kLookupDistance>(
+        first, n,
+        [&](uint32_t l) noexcept {
+            const Vec2 uv = env.uv_of({in.x[l], in.y[l], in.z[l]});
+            prefetch_texel(env, uv);
+            return uv;
+        },
+        [&](Vec2 uv, uint32_t l) noexcept {
+            const Rgb c = env.eval_uv(uv);
+            out.r[l] = c.r, out.g[l] = c.g, out.b[l] = c.b, out.pdf[l] = env.pdf_uv(uv);
+        });
+}
+
+// Distribution2DView::sample and EnvMapView::sample in two stages: the row (the marginal
+// is small and stays in cache) and prefetches of what the column search reads first (the
+// guide entry and CDF at u.x's bucket) and of the radiance near it; then the column and
+// the rest.
+struct RowFound {
+    CellHit r;
+    size_t row_start = 0;
+};
+
+RowFound find_row(const EnvMapView& env, Vec2 u) noexcept {
+    const Distribution2DView& d = env.distribution;
+    const CellHit r = d.marginal.invert(u.y);
+    const size_t row_start = static_cast<size_t>(r.index) * d.w;
+    const auto t = static_cast<uint32_t>(u.x * static_cast<float>(kCdfUnits));
+    const size_t near = row_start + static_cast<uint32_t>((static_cast<uint64_t>(t) * d.w) >> 31);
+    ENVMIS_PREFETCH(d.guide + near);
+    ENVMIS_PREFETCH(d.start + near);
+    ENVMIS_PREFETCH(env.radiance + near);
+    return {r, row_start};
+}
+
+EnvSample sample_in_row(const EnvMapView& env, const RowFound& f, Vec2 u) noexcept {
+    const Distribution2DView& d = env.distribution;
+    const CdfView cdf = d.row(f.r.index);
+    const CellHit c = cdf.invert(u.x, [&](uint32_t x) { ENVMIS_PREFETCH(env.radiance + f.row_start + x); });
+    const Vec2 p{detail::point_in_cell(c.index, c.offset, d.w), detail::point_in_cell(f.r.index, f.r.offset, d.h)};
+    return env.at(p, d.pdf_of(d.marginal.width(f.r.index), cdf.width(c.index)), f.row_start + c.index);
+}
+
+void sample_scalar(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t first, uint32_t n) noexcept {
+    pipelined<kSampleDistance>(
+        first, n,
+        [&](uint32_t l) noexcept {
+            return find_row(env, {in.x[l], in.y[l]});
+        },
+        [&](const RowFound& f, uint32_t l) noexcept {
+            const EnvSample e = sample_in_row(env, f, {in.x[l], in.y[l]});
+            out.x[l] = e.direction.x, out.y[l] = e.direction.y, out.z[l] = e.direction.z, out.pdf[l] = e.pdf;
+            out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b;
+            if (out.u) out.u[l] = e.uv.x;
+            if (out.v) out.v[l] = e.uv.y;
+        });
 }
 
 #ifdef ENVMIS_AVX2_BATCHES
@@ -336,25 +415,20 @@ ENVMIS_AVX2 uint32_t sample_avx2(const EnvMapView& env, PointArrays in, SampleAr
 void lookup_many(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
     uint32_t done = 0;
 #ifdef ENVMIS_AVX2_BATCHES
-    if (avx2_applies(env) && simd::avx2_available()) done = lookup_avx2(env, in, out, n);
+    if (batch_paths().lookup == BatchPath::avx2 && avx2_applies(env)) done = lookup_avx2(env, in, out, n);
 #endif
-    lookup_one_by_one(env, in, out, done, n);
+    lookup_scalar(env, in, out, done, n);
 }
 
 void sample_many(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t n) noexcept {
     uint32_t done = 0;
 #ifdef ENVMIS_AVX2_BATCHES
     // The guide pairs of search8 need two cells in each dimension.
-    if (avx2_applies(env) && env.distribution.w > 1 && env.distribution.h > 1 && simd::avx2_available())
+    if (batch_paths().sample == BatchPath::avx2 && avx2_applies(env) && env.distribution.w > 1 &&
+        env.distribution.h > 1)
         done = sample_avx2(env, in, out, n);
 #endif
-    for (uint32_t l = done; l < n; ++l) {
-        const EnvSample e = env.sample({in.x[l], in.y[l]});
-        out.x[l] = e.direction.x, out.y[l] = e.direction.y, out.z[l] = e.direction.z, out.pdf[l] = e.pdf;
-        out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b;
-        if (out.u) out.u[l] = e.uv.x;
-        if (out.v) out.v[l] = e.uv.y;
-    }
+    sample_scalar(env, in, out, done, n);
 }
 
 }  // namespace envmis

@@ -5,6 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "envmis/cpu.h"
 #include "envmis/study/shading/frame.h"
 #include "estimator_simd.h"
 
@@ -159,7 +160,7 @@ template <uint32_t kMaxLanes, BsdfKind K, class Env>
     const uint32_t lanes = static_cast<uint32_t>(out.size());
 #ifdef ENVMIS_AVX2_BATCHES
     constexpr uint32_t kWidth = detail::kSimdWidth;
-    const bool simd = kMaxLanes % kWidth == 0 && simd::avx2_available();
+    const bool simd = kMaxLanes % kWidth == 0 && batch_paths().lanes == BatchPath::avx2;
     const bool simd_lambert = simd && K == BsdfKind::lambert && wo.z > 0;
     const uint32_t padded = simd ? (lanes + kWidth - 1) / kWidth * kWidth : lanes;
 #else

@@ -1,0 +1,56 @@
+// The processor the library runs on, and the path each family of batch kernels takes
+// on it: lookup_many and sample_many (envmap.h, binned.h) and the estimator's lanes
+// (envmis::study). Chosen once per process by rules measured per CPU family
+// (docs/performance.md), or forced with the environment variable ENVMIS_SIMD=scalar or
+// avx2 (tests, benchmarks). Every path gives bit-identical results; only speed differs.
+//
+// Cost: cpu_info() and batch_paths() run cpuid and read the environment once, on their
+// first call; later calls return the same immutable value.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace envmis {
+
+// How a batch kernel runs: one lane at a time, software-pipelined with prefetches
+// (scalar), or eight lanes at a time in AVX2 with hardware gathers (avx2).
+enum class BatchPath : uint8_t { scalar, avx2 };
+std::string_view to_string(BatchPath p) noexcept;
+
+// What cpuid says, and what of it the operating system lets a program use.
+struct CpuInfo {
+    std::string vendor;              // "GenuineIntel", "AuthenticAMD", ...; empty off x86-64
+    std::string brand;               // the brand string, as the (virtual) machine reports it
+    uint32_t family = 0, model = 0;  // display family and model (base plus extended fields)
+    bool avx2 = false;               // AVX2 present and its registers saved by the OS
+    bool avx512 = false;             // AVX-512 F, BW, DQ and VL likewise (no kernel uses it yet)
+};
+const CpuInfo& cpu_info() noexcept;
+// "<brand> (<vendor> family 0x1a model 0x2, AVX2, AVX-512)": for benchmark output.
+std::string cpu_name();
+
+// The path of each kernel family; `forced` is ENVMIS_SIMD's value (empty when unset),
+// `unavailable` true when it names a path this CPU or build lacks, which then runs
+// scalar instead (a test of that path must skip, not pass).
+struct BatchPaths {
+    BatchPath lookup = BatchPath::scalar;  // lookup_many
+    BatchPath sample = BatchPath::scalar;  // sample_many
+    BatchPath lanes = BatchPath::scalar;   // the estimator's lanes
+    std::string forced;
+    bool unavailable = false;
+};
+// The rules, measured (envmis bench, 8k sky, ratios within one run): lookup_many's AVX2
+// kernel wherever AVX2 is usable (on AMD family 0x1a it beat the scalar pipeline, 0.96-1.33x
+// against 0.31-0.63x of single pdf calls); sample_many's AVX2 kernel only on Intel (8.5x on
+// the Xeon), the scalar pipeline elsewhere (AMD 0x1a, plain sky: 2.6x over single calls
+// against AVX2's 1.4x; compensated: both 0.85x); the estimator's lanes (arithmetic, no
+// gathers of their own) wherever AVX2 is usable.
+BatchPaths choose_batch_paths(const CpuInfo& cpu, std::string_view forced);
+// choose_batch_paths(cpu_info(), ENVMIS_SIMD), once.
+const BatchPaths& batch_paths() noexcept;
+// "lookup_many=scalar sample_many=scalar lanes=avx2" (and the forcing, if any).
+std::string batch_paths_summary();
+
+}  // namespace envmis
