@@ -227,14 +227,14 @@ struct GgxLobe {
         const F8 p1 = mul(r, phi.cos), rest1 = sub(splat(1.0f), mul(p1, p1));
         const F8 p2 = add(mul(splat(1 - s), sqrt8(max0(rest1))), mul(mul(splat(s), r), phi.sin));
         const F8 h = sqrt8(max0(sub(rest1, mul(p2, p2))));
-        const auto nh = [&](float a, float b, float c) ENVMIS_AVX2 {
-            return add(add(mul(splat(a), p1), mul(splat(b), p2)), mul(splat(c), h));
-        };
+        const auto nh = [&](float a, float b, float c)
+                            ENVMIS_AVX2 { return add(add(mul(splat(a), p1), mul(splat(b), p2)), mul(splat(c), h)); };
         const F8 floor = splat(1e-7f), nz = nh(t1.z, t2.z, vh.z);
         const Dir8 m = normalize8({mul(splat(alpha), nh(t1.x, t2.x, vh.x)), mul(splat(alpha), nh(t1.y, t2.y, vh.y)),
                                    select(less(floor, nz), nz, floor)});
         const F8 twice = mul(splat(2.0f), dot8(m, wo));
-        return {sub(mul(m.x, twice), splat(wo.x)), sub(mul(m.y, twice), splat(wo.y)), sub(mul(m.z, twice), splat(wo.z))};
+        return {sub(mul(m.x, twice), splat(wo.x)), sub(mul(m.y, twice), splat(wo.y)),
+                sub(mul(m.z, twice), splat(wo.z))};
     }
 };
 
