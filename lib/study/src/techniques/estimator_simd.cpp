@@ -109,12 +109,14 @@ ENVMIS_AVX2 Dir8 normalize8(Dir8 v) noexcept {
     const F8 inverse = div(splat(1.0f), sqrt8(dot8(v, v)));
     return {mul(v.x, inverse), mul(v.y, inverse), mul(v.z, inverse)};
 }
+// a x + b y + c z, in that order: a component of a vector sum such as Frame::to_world's.
+ENVMIS_AVX2 F8 combine8(float a, F8 x, float b, F8 y, float c, F8 z) noexcept {
+    return add(add(mul(splat(a), x), mul(splat(b), y)), mul(splat(c), z));
+}
 // Frame::to_world: x v.x + y v.y + z v.z, component by component.
 ENVMIS_AVX2 Dir8 to_world8(const Frame& f, Dir8 v) noexcept {
-    const auto row = [&](float fx, float fy, float fz) ENVMIS_AVX2 {
-        return add(add(mul(splat(fx), v.x), mul(splat(fy), v.y)), mul(splat(fz), v.z));
-    };
-    return {row(f.x.x, f.y.x, f.z.x), row(f.x.y, f.y.y, f.z.y), row(f.x.z, f.y.z, f.z.z)};
+    return {combine8(f.x.x, v.x, f.y.x, v.y, f.z.x, v.z), combine8(f.x.y, v.x, f.y.y, v.y, f.z.y, v.z),
+            combine8(f.x.z, v.x, f.y.z, v.y, f.z.z, v.z)};
 }
 ENVMIS_AVX2 Dir8 to_local8(const Frame& f, Dir8 v) noexcept { return {dot8(v, f.x), dot8(v, f.y), dot8(v, f.z)}; }
 
@@ -161,9 +163,9 @@ struct PhongLobe {
     Frame lobe;   // Frame::from_normal(mirror)
     float n, pdf_scale, eval_scale, sample_power;
 
-    PhongLobe(const Bsdf& bsdf, Vec3 wo) noexcept
+    PhongLobe(const Bsdf& bsdf, Vec3 view) noexcept
         : albedo(bsdf.reflectance),
-          mirror(reflect_z(wo)),
+          mirror(reflect_z(view)),
           lobe(Frame::from_normal(mirror)),
           n(bsdf.exponent),
           pdf_scale((n + 1) / (2 * kPiF)),
@@ -187,9 +189,9 @@ struct GgxLobe {
     ggx::VisibleNormalFrame visible;
     float alpha, a2, one_plus_lambda_wo, g1, four_wo_z, s;
 
-    GgxLobe(const Bsdf& bsdf, Vec3 wo) noexcept
+    GgxLobe(const Bsdf& bsdf, Vec3 view) noexcept
         : f0(bsdf.reflectance),
-          wo(wo),
+          wo(view),
           visible(ggx::visible_normal_frame(wo, bsdf.alpha)),
           alpha(bsdf.alpha),
           a2(alpha * alpha),
@@ -227,11 +229,11 @@ struct GgxLobe {
         const F8 p1 = mul(r, phi.cos), rest1 = sub(splat(1.0f), mul(p1, p1));
         const F8 p2 = add(mul(splat(1 - s), sqrt8(max0(rest1))), mul(mul(splat(s), r), phi.sin));
         const F8 h = sqrt8(max0(sub(rest1, mul(p2, p2))));
-        const auto nh = [&](float a, float b, float c)
-                            ENVMIS_AVX2 { return add(add(mul(splat(a), p1), mul(splat(b), p2)), mul(splat(c), h)); };
-        const F8 floor = splat(1e-7f), nz = nh(t1.z, t2.z, vh.z);
-        const Dir8 m = normalize8({mul(splat(alpha), nh(t1.x, t2.x, vh.x)), mul(splat(alpha), nh(t1.y, t2.y, vh.y)),
-                                   select(less(floor, nz), nz, floor)});
+        // nh = t1 p1 + t2 p2 + vh h, stretched back by alpha, its z at least 1e-7
+        const F8 least = splat(1e-7f), nz = combine8(t1.z, p1, t2.z, p2, vh.z, h);
+        const Dir8 m =
+            normalize8({mul(splat(alpha), combine8(t1.x, p1, t2.x, p2, vh.x, h)),
+                        mul(splat(alpha), combine8(t1.y, p1, t2.y, p2, vh.y, h)), select(less(least, nz), nz, least)});
         const F8 twice = mul(splat(2.0f), dot8(m, wo));
         return {sub(mul(m.x, twice), splat(wo.x)), sub(mul(m.y, twice), splat(wo.y)),
                 sub(mul(m.z, twice), splat(wo.z))};
