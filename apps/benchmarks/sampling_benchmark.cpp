@@ -270,6 +270,10 @@ BENCHMARK_CAPTURE(estimate, mis_balance_ggx, "mis-balance", envmis::Bsdf::ggx(0.
     ->Name("estimate/mis-balance/ggx:0.1")
     ->Args({1024, 1})
     ->Args({1024, 64});
+BENCHMARK_CAPTURE(estimate, mis_balance_phong, "mis-balance", envmis::Bsdf::phong(20))
+    ->Name("estimate/mis-balance/phong:20")
+    ->Args({1024, 1})
+    ->Args({1024, 64});
 
 }  // namespace
 

@@ -146,8 +146,8 @@ bool runs_in_lanes(const Technique& t, const Allocation& a) noexcept {
 // kind K and flattened (everything it calls inlined), so that the kind's own code runs
 // with no branch on the kind and no call: the generic Bsdf::sample, eval and pdf are
 // too large for GCC to inline into the loops by itself. With AVX2, the batch functions
-// sample and look up eight lanes at a time, and for a Lambertian surface (seen from
-// above) so do the BSDF's sampling, pdf, value and the weighted sums
+// sample and look up eight lanes at a time, and so do the weighted sums and, for a
+// surface seen from above (wo.z > 0; every kind), the BSDF's sampling, pdf and value
 // (estimator_simd.h): the lanes are then padded to a multiple of eight with valid
 // points, whose results are dropped. See docs/performance-log.md for what each step
 // gained. kMaxLanes sizes the working arrays, which one estimate alone must not pay for.
@@ -161,10 +161,10 @@ template <uint32_t kMaxLanes, BsdfKind K, class Env>
 #ifdef ENVMIS_AVX2_BATCHES
     constexpr uint32_t kWidth = detail::kSimdWidth;
     const bool simd = kMaxLanes % kWidth == 0 && batch_paths().lanes == BatchPath::avx2;
-    const bool simd_lambert = simd && K == BsdfKind::lambert && wo.z > 0;
+    const bool simd_bsdf = simd && wo.z > 0;
     const uint32_t padded = simd ? (lanes + kWidth - 1) / kWidth * kWidth : lanes;
 #else
-    const bool simd = false, simd_lambert = false;
+    const bool simd = false, simd_bsdf = false;
     const uint32_t padded = lanes;
 #endif
     float u_x[kMaxLaneSamples][kMaxLanes], u_y[kMaxLaneSamples][kMaxLanes];
@@ -200,9 +200,9 @@ template <uint32_t kMaxLanes, BsdfKind K, class Env>
         } else {
             sample_lanes(env, {u_x[j], u_y[j]}, {x, y, z, pdf, r, g, bl}, padded);
         }
-        if (simd_lambert) {
+        if (simd_bsdf) {
 #ifdef ENVMIS_AVX2_BATCHES
-            detail::eval_lambert(frame, bsdf.reflectance, {x, y, z}, {b_pdf, v_r, v_g, v_b}, padded);
+            detail::eval_bsdf(frame, bsdf, wo, {x, y, z}, {b_pdf, v_r, v_g, v_b}, padded);
 #endif
         } else {
             for (uint32_t l = 0; l < padded; ++l) {
@@ -214,9 +214,9 @@ template <uint32_t kMaxLanes, BsdfKind K, class Env>
         add_lanes(0);
     }
     for (uint32_t j = n_env; j < n_env + n_bsdf; ++j) {
-        if (simd_lambert) {
+        if (simd_bsdf) {
 #ifdef ENVMIS_AVX2_BATCHES
-            detail::sample_lambert(frame, bsdf.reflectance, {u_x[j], u_y[j]}, {x, y, z, b_pdf, v_r, v_g, v_b}, padded);
+            detail::sample_bsdf(frame, bsdf, wo, {u_x[j], u_y[j]}, {x, y, z, b_pdf, v_r, v_g, v_b}, padded);
 #endif
         } else {
             for (uint32_t l = 0; l < padded; ++l) {

@@ -1,7 +1,8 @@
 // Internal: steps of the estimator's side-by-side lanes (estimator.cpp) eight lanes at a
 // time with AVX2 (estimator_simd.cpp). Each repeats the scalar code it stands for
 // operation by operation, so that a lane's result is bit-identical to an estimate made
-// alone (tests/estimator_test.cpp, ManyEstimatesAtOnceEqualTheSameEstimatesOneAtATime).
+// alone (the tests of tests/study/techniques/estimator_test.cpp that compare estimates
+// made at once and one at a time, for Lambert, Phong and GGX).
 // Lane counts are multiples of kSimdWidth: callers pad their arrays with valid inputs.
 // The functions are declared on x86-64 only (ENVMIS_AVX2_BATCHES); call them where
 // simd::avx2_available().
@@ -11,6 +12,7 @@
 
 #include "detail/simd.h"
 #include "envmis/sampling/envmap.h"
+#include "envmis/study/shading/bsdf.h"
 #include "envmis/study/shading/frame.h"
 
 namespace envmis::detail {
@@ -26,17 +28,19 @@ namespace envmis::detail {
 
 inline constexpr uint32_t kSimdWidth = 8;
 
-// Bsdf::sample of a Lambertian BSDF for a view direction above the surface, then
-// Frame::to_world of the sampled direction, for n points u: the world direction, the
-// pdf and the value (f cos, in the r, g, b arrays).
-void sample_lambert(const Frame& frame, Rgb albedo, PointArrays u, SampleArrays out, uint32_t n) noexcept;
+// Bsdf::sample for a view direction wo above the surface (wo.z > 0; below it, every
+// kind's sample is empty and the caller stays scalar), then Frame::to_world of the
+// sampled direction, for n points u: the world direction, the pdf and the value (f cos,
+// in the r, g, b arrays). Every kind: Lambert, Phong, GGX.
+void sample_bsdf(const Frame& frame, const Bsdf& bsdf, Vec3 wo, PointArrays u, SampleArrays out, uint32_t n) noexcept;
 
-// Bsdf::pdf and Bsdf::eval of a Lambertian BSDF (view direction above the surface) at n
-// world directions wi, through Frame::to_local.
+// Bsdf::pdf and Bsdf::eval (view direction wo above the surface) at n world directions
+// wi, through Frame::to_local.
 struct BsdfValueArrays {
     float *pdf, *r, *g, *b;
 };
-void eval_lambert(const Frame& frame, Rgb albedo, DirectionArrays wi, BsdfValueArrays out, uint32_t n) noexcept;
+void eval_bsdf(const Frame& frame, const Bsdf& bsdf, Vec3 wo, DirectionArrays wi, BsdfValueArrays out,
+               uint32_t n) noexcept;
 
 // One sample per lane of technique k (0: environment, 1: BSDF), added to the lanes'
 // sums as the scalar add_lanes (estimator.cpp) adds it: value L v per channel, weight

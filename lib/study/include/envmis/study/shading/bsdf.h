@@ -12,6 +12,12 @@
 // above the surface; sample returns eval(wo, wi) with it, so value / pdf is the
 // sampling weight.
 //
+// Phong's powers are fast_pow (fast_math.h: relative error within 1.5e-7 + 1.5e-7 |n log2 c|),
+// not std::pow: the estimator's AVX2 lanes (estimator_simd.cpp) repeat sample, pdf and
+// eval operation for operation, bit for bit, which std::pow's double-precision
+// internals would not allow. Everything else here is IEEE-exact arithmetic, sqrt and
+// fast_sincos, which the lanes repeat as they are.
+//
 // A Bsdf is a small value type (a kind and its parameters) with branch-on-kind methods:
 // no virtual calls, usable on the device.
 #pragma once
@@ -86,18 +92,29 @@ ENVMIS_HD inline Rgb schlick(Rgb f0, float cos_theta) noexcept {
     const float m = 1 - clamp(cos_theta, 0.0f, 1.0f), m5 = m * m * m * m * m;
     return {f0.r + (1 - f0.r) * m5, f0.g + (1 - f0.g) * m5, f0.b + (1 - f0.b) * m5};
 }
-// A visible normal for wo (Heitz 2018): sampled proportionally to G1(wo) max(0, wo.m) D(m) / wo.z.
-ENVMIS_HD inline Vec3 sample_visible_normal(Vec3 wo, float alpha, Vec2 u) noexcept {
+// What sample_visible_normal's hemisphere depends on besides u: wo stretched by alpha
+// (vh) and two tangents to it. The estimator's lanes (one wo, many u) compute it once.
+struct VisibleNormalFrame {
+    Vec3 vh, t1, t2;
+};
+ENVMIS_HD inline VisibleNormalFrame visible_normal_frame(Vec3 wo, float alpha) noexcept {
     const Vec3 vh = normalize(Vec3{alpha * wo.x, alpha * wo.y, wo.z});
     const float len2 = vh.x * vh.x + vh.y * vh.y;
     const Vec3 t1 = len2 > 0 ? Vec3{-vh.y, vh.x, 0} * (1 / std::sqrt(len2)) : Vec3{1, 0, 0};
-    const Vec3 t2 = cross(vh, t1);
+    return {vh, t1, cross(vh, t1)};
+}
+// A visible normal for wo (Heitz 2018): sampled proportionally to G1(wo) max(0, wo.m) D(m) / wo.z.
+ENVMIS_HD inline Vec3 sample_visible_normal(const VisibleNormalFrame& frame, float alpha, Vec2 u) noexcept {
+    const auto [vh, t1, t2] = frame;
     const float r = std::sqrt(u.x);
     const SinCos phi = fast_sincos(2 * kPiF * u.y);
     const float p1 = r * phi.cos, s = 0.5f * (1 + vh.z);
     const float p2 = (1 - s) * std::sqrt(max(0.0f, 1 - p1 * p1)) + s * r * phi.sin;
     const Vec3 nh = t1 * p1 + t2 * p2 + vh * std::sqrt(max(0.0f, 1 - p1 * p1 - p2 * p2));
     return normalize(Vec3{alpha * nh.x, alpha * nh.y, max(1e-7f, nh.z)});
+}
+ENVMIS_HD inline Vec3 sample_visible_normal(Vec3 wo, float alpha, Vec2 u) noexcept {
+    return sample_visible_normal(visible_normal_frame(wo, alpha), alpha, u);
 }
 
 }  // namespace ggx
@@ -110,7 +127,7 @@ ENVMIS_HD inline Rgb Bsdf::eval(Vec3 wo, Vec3 wi) const noexcept {
         case BsdfKind::lambert: return scale(reflectance, wi.z / kPiF);
         case BsdfKind::phong: {
             const float c = dot(wi, reflect_z(wo));
-            return c > 0 ? scale(reflectance, (exponent + 2) / (2 * kPiF) * std::pow(c, exponent) * wi.z) : Rgb{};
+            return c > 0 ? scale(reflectance, (exponent + 2) / (2 * kPiF) * fast_pow(c, exponent) * wi.z) : Rgb{};
         }
         case BsdfKind::ggx: {
             const Vec3 m = normalize(wo + wi);
@@ -129,7 +146,7 @@ ENVMIS_HD inline float Bsdf::pdf(Vec3 wo, Vec3 wi) const noexcept {
             // The lobe around the mirror direction, below the surface too: such samples
             // are drawn (and carry no value), so their density is part of the pdf.
             const float c = dot(wi, reflect_z(wo));
-            return c > 0 ? (exponent + 1) / (2 * kPiF) * std::pow(c, exponent) : 0.0f;
+            return c > 0 ? (exponent + 1) / (2 * kPiF) * fast_pow(c, exponent) : 0.0f;
         }
         case BsdfKind::ggx: {
             // Reflections of wo about a visible normal; those that go below the surface
@@ -149,7 +166,7 @@ ENVMIS_HD inline BsdfSample Bsdf::sample(Vec3 wo, Vec2 u) const noexcept {
     switch (kind) {
         case BsdfKind::lambert: wi = sample_cosine_hemisphere(u); break;
         case BsdfKind::phong: {
-            const float cos_a = std::pow(u.x, 1 / (exponent + 1)), sin_a = std::sqrt(max(0.0f, 1 - cos_a * cos_a));
+            const float cos_a = fast_pow(u.x, 1 / (exponent + 1)), sin_a = std::sqrt(max(0.0f, 1 - cos_a * cos_a));
             const SinCos phi = fast_sincos(2 * kPiF * u.y);
             wi = Frame::from_normal(reflect_z(wo)).to_world({sin_a * phi.cos, sin_a * phi.sin, cos_a});
             break;
