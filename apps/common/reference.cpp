@@ -39,7 +39,7 @@ float TextbookEnvMap::pdf(Vec3 direction) const noexcept {
     return EnvMapView::solid_angle_pdf(distribution_.pdf(uv), std::sin(kPiF * uv.y));
 }
 
-RgbImage synthetic_sky(uint32_t w, uint32_t h) {
+RgbImage synthetic_sky(uint32_t w, uint32_t h, Mapping mapping) {
     RgbImage sky{w, h, std::vector<Rgb>(size_t{w} * h)};
     const double sun_theta = kPi / 4, sun_phi = kPi / 3, sun_radius = 0.25 * kPi / 180;
     const Vec3 sun{static_cast<float>(std::sin(sun_theta) * std::cos(sun_phi)),
@@ -48,7 +48,7 @@ RgbImage synthetic_sky(uint32_t w, uint32_t h) {
     const float cos_radius = static_cast<float>(std::cos(sun_radius));
     for (uint32_t y = 0; y < h; ++y)
         for (uint32_t x = 0; x < w; ++x) {
-            const Vec3 d = equirect_direction({(x + 0.5f) / w, (y + 0.5f) / h});
+            const Vec3 d = image_direction(mapping, {(x + 0.5f) / w, (y + 0.5f) / h});
             const float up = std::max(d.z, 0.0f);
             const float sky_level = d.z >= 0 ? 0.3f + 0.7f * up : 0.05f;
             Rgb& p = sky.pixels[size_t{y} * w + x];
@@ -56,7 +56,7 @@ RgbImage synthetic_sky(uint32_t w, uint32_t h) {
             if (dot(d, sun) >= cos_radius) p = {1e5f, 0.95e5f, 0.9e5f};
         }
     // On small maps no texel centre may fall inside the sun: keep at least its own texel.
-    const Vec2 uv = equirect_uv(sun);
+    const Vec2 uv = image_uv(mapping, sun);
     sky.pixels[size_t{detail::cell_of(uv.y, h)} * w + detail::cell_of(uv.x, w)] = {1e5f, 0.95e5f, 0.9e5f};
     return sky;
 }

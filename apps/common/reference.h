@@ -31,6 +31,7 @@ private:
 
 // A w x h sky: blue, brighter towards the zenith, with a sun of ~0.5 degrees (radiance
 // 1e5) at 45 degrees elevation: the shape of a typical outdoor map, 8192x4096 by default.
-RgbImage synthetic_sky(uint32_t w, uint32_t h);
+// Equal-area (a square w x w) for timing that mapping against equirect on the same sky.
+RgbImage synthetic_sky(uint32_t w, uint32_t h, Mapping mapping = Mapping::equirect);
 
 }  // namespace envmis::reference

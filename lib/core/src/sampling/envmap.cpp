@@ -67,12 +67,13 @@ struct RowStats {
     BadPixels bad;
     float max = 0;
     float min_positive = std::numeric_limits<float>::infinity();
+    uint32_t positive = 0;  // texels with L > 0
     uint64_t zeroed = 0;
 };
 
 // Pass 1 over a row, reading its pixels once: the row sum of luminance, and each
 // texel's luminance, as float bits into `bits` (the memory pass 2 reads it from), with
-// its extremes (exact in any order: luminance is never NaN). Returns false, with nothing
+// its extremes and the count of positive values (exact in any order: luminance is never NaN). Returns false, with nothing
 // usable computed, if a channel is negative, NaN or infinite: the caller repairs the row
 // and scans it again.
 //
@@ -93,7 +94,7 @@ bool scan_row(const Rgb* pixels, uint32_t w, const LumaCoefficients& luma, uint3
     auto flush = [&] {
         for (uint32_t j = 0; j < kLanes; ++j) channel_sum[j % 3] += lane[j], lane[j] = 0;
     };
-    uint32_t dirty = 0;
+    uint32_t dirty = 0, positive = 0;
     float high = 0, low = kInf;  // low: the smallest positive luminance
     auto take = [&](uint32_t x, uint32_t first_lane) {
         const float channel[3] = {pixels[x].r, pixels[x].g, pixels[x].b};
@@ -106,6 +107,7 @@ bool scan_row(const Rgb* pixels, uint32_t w, const LumaCoefficients& luma, uint3
         bits[x] = std::bit_cast<uint32_t>(l);
         high = std::max(high, l);
         low = std::min(low, l > 0 ? l : kInf);
+        positive += l > 0;
     };
     uint32_t x = 0;
 #if defined(__SSE2__)
@@ -113,7 +115,7 @@ bool scan_row(const Rgb* pixels, uint32_t w, const LumaCoefficients& luma, uint3
     const __m128 top = _mm_set1_ps(std::numeric_limits<float>::max()), zero = _mm_setzero_ps(), inf = _mm_set1_ps(kInf);
     const __m128i clean_limit = _mm_set1_epi32(0x7f7fffff);
     __m128 lanes[3] = {zero, zero, zero}, highs = zero, lows = inf;
-    __m128i dirt = _mm_setzero_si128();
+    __m128i dirt = _mm_setzero_si128(), positives = _mm_setzero_si128();  // minus the count, per lane
     for (uint32_t group = 1; x + 4 <= w; x += 4, ++group) {
         const float* c = &pixels[x].r;
         const __m128 v[3] = {_mm_loadu_ps(c), _mm_loadu_ps(c + 4), _mm_loadu_ps(c + 8)};  // r0g0b0r1 g1b1r2g2 b2r3g3b3
@@ -138,15 +140,19 @@ bool scan_row(const Rgb* pixels, uint32_t w, const LumaCoefficients& luma, uint3
         highs = _mm_max_ps(l, highs);
         const __m128 positive = _mm_cmpgt_ps(l, zero);
         lows = _mm_min_ps(_mm_or_ps(_mm_and_ps(positive, l), _mm_andnot_ps(positive, inf)), lows);
+        positives = _mm_add_epi32(positives, _mm_castps_si128(positive));
     }
     for (uint32_t k = 0; k < 3; ++k) _mm_storeu_ps(lane + 4 * k, lanes[k]);
     float lane_high[4], lane_low[4];
-    uint32_t lane_dirt[4];
+    uint32_t lane_dirt[4], lane_positives[4];
     _mm_storeu_ps(lane_high, highs);
     _mm_storeu_ps(lane_low, lows);
     _mm_storeu_si128(reinterpret_cast<__m128i*>(lane_dirt), dirt);
-    for (uint32_t j = 0; j < 4; ++j)
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(lane_positives), positives);
+    for (uint32_t j = 0; j < 4; ++j) {
         high = std::max(high, lane_high[j]), low = std::min(low, lane_low[j]), dirty |= lane_dirt[j];
+        positive -= lane_positives[j];
+    }
 #else
     for (uint32_t group = 1; x + 4 <= w; x += 4, ++group) {
         for (uint32_t p = 0; p < 4; ++p) take(x + p, 3 * p);
@@ -158,6 +164,7 @@ bool scan_row(const Rgb* pixels, uint32_t w, const LumaCoefficients& luma, uint3
     r.sum = luma.r * channel_sum[0] + luma.g * channel_sum[1] + luma.b * channel_sum[2];
     r.max = high;
     r.min_positive = low;
+    r.positive = positive;
     return !(dirty >> 31);
 }
 
@@ -240,9 +247,17 @@ EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options, StopFlag stop) : op
     if (!(stats_.mean_luminance > 0)) stats_.fallback = DensityFallback::uniform;
     if (options_.compensation.enabled && stats_.fallback == DensityFallback::none)
         stats_.threshold = compensation_threshold(stats_.mean_luminance, options_.compensation.alpha);
+    // A row whose brightest texel is at or below the threshold compensates to +0 whole:
+    // its luminance is not read again (most of a sky with a sun: the build's largest saving).
     const auto density = [&](uint32_t y, std::span<const uint32_t> cells, std::span<float> row) {
+        const bool uniform = stats_.fallback == DensityFallback::uniform;
+        if (!uniform && rows[y].max <= stats_.threshold) {
+            std::fill(row.begin(), row.end(), 0.0f);
+            rows[y].zeroed = rows[y].positive;
+            return;
+        }
         rows[y].zeroed = fill_density_row(cells.data(), w, row_weight(options_.mapping, y, h), stats_.threshold,
-                                          stats_.fallback == DensityFallback::uniform, row.data());
+                                          uniform, row.data());
     };
     distribution_ = Distribution2D(w, h, std::move(luminance_bits), density);
     throw_if_stopped(stop);
