@@ -2,7 +2,8 @@
 // floats or 32-bit integers in a register, and the scalar idioms of the sampling code
 // (ternaries, clamp, abs) as lane-by-lane operations with the same IEEE results.
 // Functions that use them are compiled for AVX2 one by one (ENVMIS_AVX2) and called only
-// where avx2_available(): the rest of the library stays runnable on any x86-64 CPU.
+// where batch_paths() (envmis/cpu.h) chose AVX2: the rest of the library stays runnable on
+// any x86-64 CPU.
 #pragma once
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -12,8 +13,6 @@
 #define ENVMIS_AVX2 __attribute__((target("avx2")))
 
 namespace envmis::simd {
-
-inline bool avx2_available() noexcept { return __builtin_cpu_supports("avx2"); }
 
 using F8 = __m256;
 using I8 = __m256i;

@@ -5,7 +5,7 @@
 // made at once and one at a time, for Lambert, Phong and GGX).
 // Lane counts are multiples of kSimdWidth: callers pad their arrays with valid inputs.
 // The functions are declared on x86-64 only (ENVMIS_AVX2_BATCHES); call them where
-// simd::avx2_available().
+// batch_paths().lanes is AVX2 (envmis/cpu.h).
 #pragma once
 
 #include <cstdint>
