@@ -73,9 +73,8 @@ struct RowStats {
 
 // Pass 1 over a row, reading its pixels once: the row sum of luminance, and each
 // texel's luminance, as float bits into `bits` (the memory pass 2 reads it from), with
-// its extremes and the count of positive values (exact in any order: luminance is never NaN). Returns false, with nothing
-// usable computed, if a channel is negative, NaN or infinite: the caller repairs the row
-// and scans it again.
+// its extremes and the count of positive values (exact in any order: luminance is never NaN). Returns false, with
+// nothing usable computed, if a channel is negative, NaN or infinite: the caller repairs the row and scans it again.
 //
 // Luminance is linear, so the row sum is the luma-weighted sum of the channel sums,
 // accumulated in twelve float lanes (the channels of four pixels) flushed into doubles
