@@ -43,10 +43,11 @@ struct BatchPaths {
 };
 // The rules, measured (envmis bench, 8k sky, ratios within one run): lookup_many's AVX2
 // kernel wherever AVX2 is usable (on AMD family 0x1a it beat the scalar pipeline, 0.96-1.33x
-// against 0.31-0.63x of single pdf calls); sample_many's AVX2 kernel only on Intel (8.5x on
-// the Xeon), the scalar pipeline elsewhere (AMD 0x1a, plain sky: 2.6x over single calls
-// against AVX2's 1.4x; compensated: both 0.85x); the estimator's lanes (arithmetic, no
-// gathers of their own) wherever AVX2 is usable.
+// against 0.31-0.63x of single pdf calls); sample_many's AVX2 kernel on Intel (8.5x on the
+// Xeon) and AMD from family 0x1a on (there, over single calls: compensated sky about 1.5x
+// against the scalar pipeline's 0.95x, plain about 4x against 2.6x), the scalar pipeline
+// on older AMD families, whose gathers are slower (not measured); the estimator's lanes
+// (arithmetic, no gathers of their own) wherever AVX2 is usable.
 BatchPaths choose_batch_paths(const CpuInfo& cpu, std::string_view forced);
 // choose_batch_paths(cpu_info(), ENVMIS_SIMD), once.
 const BatchPaths& batch_paths() noexcept;

@@ -159,14 +159,18 @@ ENVMIS_AVX2 I8 gather(const uint32_t* a, I8 i) noexcept {
     return _mm256_i32gather_epi32(reinterpret_cast<const int*>(a), i, 4);
 }
 
-// CdfView::width of cell i of the CDF at `start`, n cells: the next start (kCdfUnits
-// after the last cell) minus this one.
-ENVMIS_AVX2 I8 width8(const uint32_t* start, I8 base, I8 i, uint32_t n) noexcept {
+// Cell i of the CDF at `start`, n cells: its first unit and CdfView::width, the next
+// start (kCdfUnits after the last cell) minus this one.
+struct Span8 {
+    I8 start, width;
+};
+ENVMIS_AVX2 Span8 span8(const uint32_t* start, I8 base, I8 i, uint32_t n) noexcept {
     const I8 last = _mm256_cmpeq_epi32(i, _mm256_set1_epi32(static_cast<int>(n - 1)));
     const I8 at = _mm256_add_epi32(base, i);
     const I8 next = gather(start, _mm256_sub_epi32(at, _mm256_andnot_si256(last, _mm256_set1_epi32(-1))));
     const I8 end = _mm256_blendv_epi8(next, _mm256_set1_epi32(static_cast<int>(kCdfUnits)), last);
-    return _mm256_sub_epi32(end, gather(start, at));
+    const I8 first = gather(start, at);
+    return {first, _mm256_sub_epi32(end, first)};
 }
 
 // Widths to float, as static_cast<float>(uint32_t): a width is at most 2^31, which as a
@@ -202,15 +206,19 @@ ENVMIS_AVX2 SinCos8 sincos_half_turns8(const SinCos* turns, F8 t) noexcept {
     return sincos_steps8(turns, _mm256_mul_ps(t, splat(static_cast<float>(kTurnSteps / 2))));
 }
 
-// EnvMapView::solid_angle_pdf of the density of cell (x, y), row = y w, from its row's
-// and its own widths (Distribution2DView::pdf_of).
-ENVMIS_AVX2 F8 solid_angle_pdf8(const Distribution2DView& d, I8 x, I8 y, I8 row, F8 sin_theta) noexcept {
-    const I8 row_width = width8(d.marginal.start, _mm256_setzero_si256(), y, d.h);
-    const I8 cell_width = width8(d.start, row, x, d.w);
+// EnvMapView::solid_angle_pdf of a cell's density from its row's and its own widths
+// (Distribution2DView::pdf_of).
+ENVMIS_AVX2 F8 widths_pdf8(const Distribution2DView& d, I8 row_width, I8 cell_width, F8 sin_theta) noexcept {
     const F8 image_pdf =
         _mm256_mul_ps(_mm256_mul_ps(width_to_float(row_width), width_to_float(cell_width)), splat(d.pdf_scale));
     const F8 pdf = _mm256_div_ps(image_pdf, _mm256_mul_ps(splat(kTwoPiSquared), sin_theta));
     return select(_mm256_cmp_ps(sin_theta, splat(0.0f), _CMP_GT_OQ), pdf, splat(0.0f));
+}
+
+// The same for cell (x, y), row = y w, reading the widths.
+ENVMIS_AVX2 F8 solid_angle_pdf8(const Distribution2DView& d, I8 x, I8 y, I8 row, F8 sin_theta) noexcept {
+    const I8 row_width = span8(d.marginal.start, _mm256_setzero_si256(), y, d.h).width;
+    return widths_pdf8(d, row_width, span8(d.start, row, x, d.w).width, sin_theta);
 }
 
 // The radiance of eight texels (row-major indices), stored from lane l on.
@@ -303,6 +311,7 @@ ENVMIS_AVX2 Unit8 unit8(F8 u, uint32_t n) noexcept {
 struct Hit8 {
     I8 index;
     F8 offset;
+    I8 width;  // of the cell
 };
 ENVMIS_AVX2 Hit8 search8(const uint32_t* start, const uint16_t* guide, I8 base, uint32_t n,
                          const Unit8& unit) noexcept {
@@ -327,10 +336,11 @@ ENVMIS_AVX2 Hit8 search8(const uint32_t* start, const uint16_t* guide, I8 base, 
         lo = _mm256_blendv_epi8(lo, mid, at_most_t);
         hi = _mm256_blendv_epi8(_mm256_sub_epi32(mid, one), hi, at_most_t);
     }
-    const I8 before = _mm256_sub_epi32(t, gather(start, _mm256_add_epi32(base, lo)));  // < 2^31
+    const Span8 cell = span8(start, base, lo, n);
+    const I8 before = _mm256_sub_epi32(t, cell.start);  // < 2^31
     const F8 offset = _mm256_div_ps(_mm256_add_ps(_mm256_cvtepi32_ps(before), _mm256_sub_ps(x, _mm256_cvtepi32_ps(t))),
-                                    width_to_float(width8(start, base, lo, n)));
-    return {lo, select(less(splat(kOneMinusEpsilon), offset), splat(kOneMinusEpsilon), offset)};
+                                    width_to_float(cell.width));
+    return {lo, select(less(splat(kOneMinusEpsilon), offset), splat(kOneMinusEpsilon), offset), cell.width};
 }
 
 // (index + offset) / n in double, rounded to float, for four lanes.
@@ -366,8 +376,16 @@ struct Rows8 {
     Unit8 column;
 };
 
+// A row holding more than this share of the CDF's units draws so many of the samples
+// that its data stays in cache: prefetching it again costs load slots and saves nothing
+// (compensated 8k sky, whose samples crowd onto the sun's rows: 1.3x to 1.5x of single
+// calls with every lane's prefetches, 1.5x to 2.5x without; AMD EPYC family 0x1a). An
+// 8k sky's other rows hold about 2^-12 each.
+constexpr uint32_t kHotRowUnits = kCdfUnits >> 10;
+
 // The rows of the eight points from lane l on; starts loading what the column search
-// reads first (the guide entry and CDF around the bucket) and the radiance near it.
+// reads first (the guide entry and CDF around the bucket) and the radiance near it, in
+// the lanes whose rows are not hot.
 ENVMIS_AVX2 Rows8 rows8(const EnvMapView& env, PointArrays in, uint32_t l) noexcept {
     const Distribution2DView& d = env.distribution;
     const I8 zero = _mm256_setzero_si256();
@@ -376,7 +394,10 @@ ENVMIS_AVX2 Rows8 rows8(const EnvMapView& env, PointArrays in, uint32_t l) noexc
                      unit8(_mm256_loadu_ps(in.x + l), d.w)};
     alignas(32) uint32_t near[8];
     _mm256_store_si256(reinterpret_cast<I8*>(near), _mm256_add_epi32(rows.row, rows.column.k));
-    for (const uint32_t i : near) {
+    const I8 cap = _mm256_set1_epi32(static_cast<int>(kHotRowUnits));
+    const I8 cold = _mm256_cmpeq_epi32(_mm256_min_epu32(r.width, cap), r.width);  // unsigned width <= cap
+    for (auto m = static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(cold))); m != 0; m &= m - 1) {
+        const uint32_t i = near[__builtin_ctz(m)];
         ENVMIS_PREFETCH(d.guide + i);
         ENVMIS_PREFETCH(d.start + i);
         ENVMIS_PREFETCH(env.radiance + i);
@@ -397,7 +418,7 @@ ENVMIS_AVX2 void sample8(const EnvMapView& env, const Rows8& rows, SampleArrays 
     _mm256_storeu_ps(out.x + l, _mm256_mul_ps(theta.sin, phi.cos));
     _mm256_storeu_ps(out.y + l, _mm256_mul_ps(theta.sin, phi.sin));
     _mm256_storeu_ps(out.z + l, theta.cos);
-    _mm256_storeu_ps(out.pdf + l, solid_angle_pdf8(d, c.index, r.index, row, theta.sin));
+    _mm256_storeu_ps(out.pdf + l, widths_pdf8(d, r.width, c.width, theta.sin));
     store_radiance8(env.radiance, _mm256_add_epi32(row, c.index), out.r, out.g, out.b, l);
 }
 
