@@ -40,7 +40,7 @@ float TextbookEnvMap::pdf(Vec3 direction) const noexcept {
 }
 
 RgbImage synthetic_sky(uint32_t w, uint32_t h, Mapping mapping) {
-    RgbImage sky{w, h, std::vector<Rgb>(size_t{w} * h)};
+    RgbImage sky{w, h, RgbPixels(size_t{w} * h)};
     const double sun_theta = kPi / 4, sun_phi = kPi / 3, sun_radius = 0.25 * kPi / 180;
     const Vec3 sun{static_cast<float>(std::sin(sun_theta) * std::cos(sun_phi)),
                    static_cast<float>(std::sin(sun_theta) * std::sin(sun_phi)),

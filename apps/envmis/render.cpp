@@ -35,7 +35,7 @@ struct Scene {
 // Renders one technique: each pixel the mean of `spp` estimates, rows shared among threads.
 RgbImage render(const Scene& scene, const DirectLightingEstimator& estimator, const std::vector<Bsdf>& bsdfs,
                 uint32_t spp, uint64_t seed, uint32_t threads, StopFlag stop) {
-    RgbImage image{scene.w, scene.h, std::vector<Rgb>(size_t{scene.w} * scene.h)};
+    RgbImage image{scene.w, scene.h, RgbPixels(size_t{scene.w} * scene.h)};
     std::atomic<uint32_t> next_row{0};
     auto work = [&] {
         for (uint32_t y; (y = next_row.fetch_add(1)) < scene.h;)
@@ -106,7 +106,7 @@ io::Image8 tonemap_together(const RgbImage& reference, const std::vector<std::pa
                             LumaCoefficients luma) {
     const uint32_t w = reference.width, h = reference.height;
     const uint32_t panels = static_cast<uint32_t>(renders.size()) + 1;
-    RgbImage wide{w * panels, h, std::vector<Rgb>(size_t{w} * panels * h)};
+    RgbImage wide{w * panels, h, RgbPixels(size_t{w} * panels * h)};
     auto place = [&](const RgbImage& image, uint32_t panel) {
         for (uint32_t y = 0; y < h; ++y)
             for (uint32_t i = 0; i < w; ++i) wide.pixels[size_t{y} * wide.width + panel * w + i] = image.at(i, y);

@@ -219,7 +219,7 @@ struct Options {
 envmis::RgbImage render(const Environment& env, const Scene& scene, const Options& o) {
     const Camera camera({0, -7.5f, 2.2f}, {0, 0, 0.55f}, 30,
                         static_cast<float>(o.width) / static_cast<float>(o.height));
-    envmis::RgbImage image{o.width, o.height, std::vector<Rgb>(size_t{o.width} * o.height)};
+    envmis::RgbImage image{o.width, o.height, envmis::RgbPixels(size_t{o.width} * o.height)};
     std::atomic<uint32_t> next_row{0};
     auto work = [&] {
         for (uint32_t y; (y = next_row.fetch_add(1)) < o.height;)

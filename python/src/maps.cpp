@@ -196,7 +196,7 @@ std::shared_ptr<EnvMap> from_array(const py::object& radiance, const BuildReques
     if (array.shape(0) > UINT32_MAX || array.shape(1) > UINT32_MAX)
         throw std::invalid_argument("envmis.EnvMap: radiance: more than 2^32 - 1 rows or columns");
     RgbImage image{static_cast<uint32_t>(array.shape(1)), static_cast<uint32_t>(array.shape(0)),
-                   std::vector<Rgb>(static_cast<size_t>(array.shape(0)) * array.shape(1))};
+                   RgbPixels(static_cast<size_t>(array.shape(0)) * array.shape(1))};
     std::memcpy(static_cast<void*>(image.pixels.data()), array.data(), image.pixels.size() * sizeof(Rgb));
     Built built;
     {

@@ -274,7 +274,7 @@ TEST_F(ImageIo, WriteExrThenLoadIsBitExact) {
 }
 
 TEST_F(ImageIo, WritesZipCompressedFloatExr) {
-    write_exr(file("out.exr"), RgbImage{2, 2, std::vector<Rgb>(4, Rgb{1, 2, 3})});
+    write_exr(file("out.exr"), RgbImage{2, 2, RgbPixels(4, Rgb{1, 2, 3})});
     const auto in = OIIO::ImageInput::open(file("out.exr").string());
     ASSERT_TRUE(in) << OIIO::geterror();
     EXPECT_EQ(in->spec().format, OIIO::TypeDesc::FLOAT);
@@ -353,7 +353,7 @@ TEST_F(ImageIo, ConvertsToTheWorkingSpaceAndReportsItsLuma) {
     options.working_space = "lin_ap1";
     const LoadedImage loaded = load_image(file("a.exr"), options);
     const ColourConfig colour(fs::path(ENVMIS_DATA_DIR) / "ocio" / "config.ocio");
-    std::vector<Rgb> expected = load_image(file("a.exr")).image.pixels;
+    RgbPixels expected = load_image(file("a.exr")).image.pixels;
     colour.convert(expected, "lin_rec709", "ACEScg");
     EXPECT_EQ(loaded.working_colorspace, "ACEScg");
     for (size_t i = 0; i < expected.size(); ++i) expect_same(loaded.image.pixels[i], expected[i], i);
@@ -430,7 +430,7 @@ TEST_F(ImageIo, AFailedRenameRemovesTheTemporaryFile) {
 }
 
 TEST_F(ImageIo, WritingAnImageWhosePixelsDoNotMatchItsSizeFails) {
-    EXPECT_THROW(write_exr(file("a.exr"), RgbImage{2, 2, std::vector<Rgb>(3)}), ImageError);
+    EXPECT_THROW(write_exr(file("a.exr"), RgbImage{2, 2, RgbPixels(3)}), ImageError);
     EXPECT_THROW(write_exr(file("a.exr"), RgbImage{0, 0, {}}), ImageError);
     EXPECT_THROW(write_png(file("a.png"), {2, 1, {1, 2, 3}}), ImageError);
     EXPECT_TRUE(folder_entries(dir_).empty());

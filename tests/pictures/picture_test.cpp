@@ -263,7 +263,7 @@ TEST(Drawing, BlitCopiesAndClips) {
 }
 
 TEST(Resize, ConstantStaysConstant) {
-    RgbImage image{100, 60, std::vector<Rgb>(6000, Rgb{0.25f, 2, 7})};
+    RgbImage image{100, 60, RgbPixels(6000, Rgb{0.25f, 2, 7})};
     for (auto [w, h] : {std::pair{37u, 11u}, std::pair{16u, 8u}, std::pair{230u, 97u}}) {
         const RgbImage out = resize(image, w, h);
         ASSERT_EQ(out.pixels.size(), size_t(w) * h);

@@ -9,7 +9,7 @@ namespace envmis {
 namespace {
 
 RgbImage grey(uint32_t width, uint32_t height) {
-    return {width, height, std::vector<Rgb>(size_t{width} * height, Rgb{0.5f, 0.5f, 0.5f})};
+    return {width, height, RgbPixels(size_t{width} * height, Rgb{0.5f, 0.5f, 0.5f})};
 }
 
 TEST(CanonicalOptions, EveryFieldThatChangesTheTableChangesTheString) {

@@ -10,7 +10,7 @@
 
 namespace envmis::test {
 
-inline RgbImage constant_map(uint32_t w, uint32_t h, Rgb c) { return {w, h, std::vector<Rgb>(size_t{w} * h, c)}; }
+inline RgbImage constant_map(uint32_t w, uint32_t h, Rgb c) { return {w, h, RgbPixels(size_t{w} * h, c)}; }
 
 // A sky that brightens towards the zenith, with a small, very bright sun.
 inline RgbImage sun_sky_map(uint32_t w, uint32_t h, float sun_radiance = 5e4f) {

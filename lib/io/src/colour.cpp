@@ -117,7 +117,7 @@ LumaCoefficients ColourConfig::luma(const std::string& space) const {
     return {primaries[1], primaries[4], primaries[7]};
 }
 
-void ColourConfig::convert(std::vector<Rgb>& pixels, const std::string& from, const std::string& to) const {
+void ColourConfig::convert(std::span<Rgb> pixels, const std::string& from, const std::string& to) const {
     const std::string source = impl_->space(from)->getName(), target = impl_->space(to)->getName();
     if (source != target) impl_->apply(reinterpret_cast<float*>(pixels.data()), pixels.size(), source, target);
 }

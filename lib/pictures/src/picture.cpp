@@ -167,7 +167,7 @@ void blit(Image8& dst, const Image8& src, int x, int y) {
 RgbImage resize(RgbImageView image, uint32_t new_width, uint32_t new_height) {
     const auto values = resample(reinterpret_cast<const float*>(image.pixels.data()), image.width, image.height, 3,
                                  new_width, new_height);
-    RgbImage out{new_width, new_height, std::vector<Rgb>(values.size() / 3)};
+    RgbImage out{new_width, new_height, RgbPixels(values.size() / 3)};
     for (size_t i = 0; i < out.pixels.size(); ++i)
         out.pixels[i] = {values[3 * i], values[3 * i + 1], values[3 * i + 2]};
     return out;

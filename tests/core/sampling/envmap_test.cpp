@@ -471,7 +471,7 @@ TEST(EnvMap, ManyCallsOfEveryLengthAreBitIdenticalToSingleCalls) {
 
 TEST(EnvMap, RejectsInvalidConstruction) {
     EXPECT_THROW(EnvMap(RgbImage{}), std::invalid_argument);
-    EXPECT_THROW(EnvMap(RgbImage{4, 4, std::vector<Rgb>(15)}), std::invalid_argument);
+    EXPECT_THROW(EnvMap(RgbImage{4, 4, RgbPixels(15)}), std::invalid_argument);
     EXPECT_THROW(EnvMap(test::constant_map(4, 2, {1, 1, 1}), options(true, -1.0f)), std::invalid_argument);
     EXPECT_THROW(EnvMap(test::constant_map(4, 2, {1, 1, 1}), options(true, NAN)), std::invalid_argument);
 }

@@ -7,7 +7,8 @@
 //   sampling/      2D distributions and the environment-map sampler, with batch calls;
 //                  binned.h: normal-aware bins (a density per bin of shading normals)
 //   table/         table files (written atomically, read or memory-mapped)
-// interrupt.h, used by every stage, lets a caller stop the long builds.
+// interrupt.h, used by every stage, lets a caller stop the long builds; large_vector.h
+// holds the large buffers (pixels, tables) on huge pages.
 #pragma once
 
 #include "envmis/compensation/compensation.h"
@@ -19,7 +20,7 @@
 #include "envmis/math/hash.h"
 #include "envmis/math/math.h"
 #include "envmis/math/random.h"
-#include "envmis/sampling/allocator.h"
+#include "envmis/large_vector.h"
 #include "envmis/sampling/binned.h"
 #include "envmis/sampling/distribution.h"
 #include "envmis/sampling/envmap.h"

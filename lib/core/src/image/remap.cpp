@@ -165,7 +165,7 @@ RemapResult remap(const RgbImage& in, Mapping from, Mapping to, uint32_t width, 
         }
     }
     const std::array<double, 3> sent = total_power(in, from);
-    result.image = {width, height, std::vector<Rgb>(size_t{width} * height)};
+    result.image = {width, height, RgbPixels(size_t{width} * height)};
     for (size_t i = 0; i < result.image.pixels.size(); ++i) {
         const double* p = &power[4 * i];
         const auto scaled = [&](int c) {

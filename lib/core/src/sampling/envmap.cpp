@@ -287,8 +287,8 @@ EnvMap::EnvMap(RgbImageView radiance, std::shared_ptr<const void> owner, LargeVe
     rebuild(std::move(density_bits));
 }
 
-std::vector<Rgb>& EnvMap::adopt(RgbImage image) {
-    auto owned = std::make_shared<std::vector<Rgb>>(std::move(image.pixels));
+RgbPixels& EnvMap::adopt(RgbImage image) {
+    auto owned = std::make_shared<RgbPixels>(std::move(image.pixels));
     radiance_ = {image.width, image.height, *owned};
     radiance_owner_ = owned;
     return *owned;

@@ -549,7 +549,7 @@ template <class Read>
 Table read_payload(Header header, Read&& read, std::string_view name) {
     const uint64_t texels = uint64_t{header.w} * header.h;
     LargeVector<uint32_t> density(texels);
-    RgbImage radiance{header.w, header.h, std::vector<Rgb>(texels)};
+    RgbImage radiance{header.w, header.h, RgbPixels(texels)};
     uint64_t digest = 0;
     Hasher payload_hash;
     read(density.data(), texels * sizeof(uint32_t));

@@ -18,7 +18,7 @@ RgbImage halve(RgbImageView in, Mapping mapping) {
     std::vector<double> sin_theta(in.height, 1.0);
     if (mapping == Mapping::equirect)
         for (uint32_t y = 0; y < in.height; ++y) sin_theta[y] = std::sin(kPi * (y + 0.5) / in.height);
-    RgbImage out{w, h, std::vector<Rgb>(size_t{w} * h)};
+    RgbImage out{w, h, RgbPixels(size_t{w} * h)};
     detail::parallel_for(h, 8, [&](uint32_t lo, uint32_t hi) {
         for (uint32_t row = lo; row < hi; ++row) {
             const uint32_t y0 = 2 * row, y1 = row + 1 == h ? in.height : y0 + 2;

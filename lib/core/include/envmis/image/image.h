@@ -9,8 +9,8 @@
 #include <cstdint>
 #include <limits>
 #include <span>
-#include <vector>
 
+#include "envmis/large_vector.h"
 #include "envmis/math/math.h"
 
 namespace envmis {
@@ -26,10 +26,14 @@ struct RgbImageView {
     const Rgb& at(uint32_t x, uint32_t y) const { return pixels[static_cast<size_t>(y) * width + x]; }
 };
 
+// An image's pixel buffer: a std::vector whose large blocks live on huge pages
+// (large_vector.h), as the lookups into a map's radiance are random.
+using RgbPixels = LargeVector<Rgb>;
+
 // Linear RGB pixels, row-major, row 0 at the top.
 struct RgbImage {
     uint32_t width = 0, height = 0;
-    std::vector<Rgb> pixels;  // width * height
+    RgbPixels pixels;  // width * height
 
     const Rgb& at(uint32_t x, uint32_t y) const { return pixels[static_cast<size_t>(y) * width + x]; }
     operator RgbImageView() const noexcept { return {width, height, pixels}; }
@@ -37,7 +41,7 @@ struct RgbImage {
 
 // A copy that owns its pixels.
 inline RgbImage to_image(RgbImageView view) {
-    return {view.width, view.height, std::vector<Rgb>(view.pixels.begin(), view.pixels.end())};
+    return {view.width, view.height, RgbPixels(view.pixels.begin(), view.pixels.end())};
 }
 
 // Counts of channel values replaced by 0.

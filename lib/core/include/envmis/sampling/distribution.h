@@ -32,7 +32,7 @@
 #include <vector>
 
 #include "envmis/math/math.h"
-#include "envmis/sampling/allocator.h"
+#include "envmis/large_vector.h"
 
 namespace envmis {
 

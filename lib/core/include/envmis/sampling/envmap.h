@@ -240,7 +240,7 @@ public:
 private:
     // Makes the image's pixels the map's own radiance; returns them, still writable for
     // the build's repair of bad values.
-    std::vector<Rgb>& adopt(RgbImage image);
+    RgbPixels& adopt(RgbImage image);
     // The table constructors' common part: checks the radiance, builds the distribution.
     void rebuild(LargeVector<uint32_t> density_bits);
 

@@ -13,6 +13,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -38,7 +39,7 @@ public:
     std::string resolve(const std::string& name) const;
     LumaCoefficients luma(const std::string& space) const;
     // Converts pixels in place. Throws ImageError naming an unknown space.
-    void convert(std::vector<Rgb>& pixels, const std::string& from, const std::string& to) const;
+    void convert(std::span<Rgb> pixels, const std::string& from, const std::string& to) const;
 
 private:
     struct Impl;

@@ -1,10 +1,14 @@
-// Allocator for the large sampling tables (hundreds of MB for 8k and 16k maps).
+// Allocator for the large buffers: sampling tables and the radiance they index (hundreds
+// of MB for 8k and 16k maps).
 //
-// Two things make building such tables slow, and this allocator removes both: zero-
-// filling memory that is overwritten anyway (it default-initialises, so a new
-// std::vector<uint32_t> is left unwritten), and faulting it in 4 KiB pages (on Linux,
-// blocks of 4 MiB or more are 2 MiB-aligned and advised to use transparent huge pages).
-// The builders then touch the memory first from all cores, in parallel.
+// Two things make such buffers slow, and this allocator removes both: zero-filling
+// memory that is overwritten anyway (it default-initialises, so a new
+// std::vector<uint32_t> is left unwritten; a type with member initialisers, such as
+// Rgb, is still initialised), and 4 KiB pages (on Linux, blocks of 4 MiB or more are
+// 2 MiB-aligned and advised to use transparent huge pages before anything touches them,
+// so they fault in as huge pages where the system allows it). Random lookups into an
+// 8k map's radiance and tables miss the TLB on almost every access with 4 KiB pages.
+// The table builders then touch the memory first from all cores, in parallel.
 #pragma once
 
 #include <cstddef>
