@@ -316,9 +316,10 @@ TEST_F(Cli, BenchWithBinsAddsTheBinnedSamplerAgainstTodaysMaps) {
     const std::string number = "[0-9]+(\\.[0-9]+)?";
     EXPECT_TRUE(contains(r.out, "\\nbinned bins=16 cells=8x4 lobe_class=0 ")) << r;
     for (const char* sampler : {"plain", "compensated", "binned"})
-        EXPECT_TRUE(contains(r.out, std::string("\\nsampler=") + sampler + " build_ms=" + number + " ns_per_sample=" +
-                                        number + " ns_per_pdf=" + number + " ns_per_batch_sample=" + number +
-                                        " ns_per_batch_lookup=" + number + " bytes=[0-9]+\\n"))
+        EXPECT_TRUE(contains(
+            r.out, std::string("\\nsampler=") + sampler + " build_ms=" + number + " ns_per_sample=" + number +
+                       " ns_per_pdf=" + number + " ns_per_batch_sample=" + number + " ns_per_batch_lookup=" + number +
+                       " bytes=[0-9]+ batch_over_single sample=" + number + "x lookup_over_pdf=" + number + "x\\n"))
             << sampler << r;
     EXPECT_TRUE(contains(r.out, "\\nbinned_over_compensated sample=" + number + "x pdf=" + number +
                                     "x batch_sample=" + number + "x batch_lookup=" + number + "x build=" + number +
