@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <numeric>
 #include <stdexcept>
 
@@ -467,6 +468,13 @@ TEST(EnvMap, ManyCallsOfEveryLengthAreBitIdenticalToSingleCalls) {
         }
         for (uint32_t i = n; i < kMax; ++i) ASSERT_EQ(p[3 * kMax + i], -1.0f) << n << " " << i;
     }
+}
+
+// Lookups read the radiance at random texels: on 4 KiB pages most of those reads of a
+// large map miss the TLB, so its pixels are allocated for huge pages (large_vector.h).
+TEST(EnvMap, TheRadianceOfALargeMapStartsOnAHugePageBoundary) {
+    const EnvMap map(test::constant_map(1024, 512, {1, 1, 1}));  // 6 MiB of pixels
+    EXPECT_EQ(reinterpret_cast<uintptr_t>(map.radiance().pixels.data()) % (size_t{2} << 20), 0u);
 }
 
 TEST(EnvMap, RejectsInvalidConstruction) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -371,6 +372,15 @@ TEST_F(TableTest, MetadataPaddingIsZerosToAMultipleOfEight) {
     reseal(bytes);
     write_bytes(path, bytes);
     expect_rejected(path, "unexpected bytes");
+}
+
+// A radiance read into memory is allocated for huge pages, as a built map's is
+// (large_vector.h): lookups read it at random texels.
+TEST_F(TableTest, ACopiedLoadOfALargeMapHoldsItsRadianceFromAHugePageBoundary) {
+    const fs::path path = dir_ / "large.envmis";
+    write_table(path, EnvMap(test::constant_map(1024, 512, {1, 1, 1})), source_);  // 6 MiB of pixels
+    const Table copied = read_table(path, TableLoading::copy);
+    EXPECT_EQ(reinterpret_cast<uintptr_t>(copied.map.radiance().pixels.data()) % (size_t{2} << 20), 0u);
 }
 
 // By default a full table's radiance is used in place from a mapping of the file (where

@@ -6,8 +6,9 @@
 // std::vector<uint32_t> is left unwritten; a type with member initialisers, such as
 // Rgb, is still initialised), and 4 KiB pages (on Linux, blocks of 4 MiB or more are
 // 2 MiB-aligned and advised to use transparent huge pages before anything touches them,
-// so they fault in as huge pages where the system allows it). Random lookups into an
-// 8k map's radiance and tables miss the TLB on almost every access with 4 KiB pages.
+// so they fault in as huge pages where the system allows it). Lookups read an 8k map's
+// radiance and tables at random texels; on 4 KiB pages nearly every such read also
+// misses the TLB.
 // The table builders then touch the memory first from all cores, in parallel.
 #pragma once
 

@@ -31,8 +31,8 @@
 #include <span>
 #include <vector>
 
-#include "envmis/math/math.h"
 #include "envmis/large_vector.h"
+#include "envmis/math/math.h"
 
 namespace envmis {
 
