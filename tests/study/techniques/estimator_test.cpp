@@ -14,6 +14,7 @@
 #include "envmis/study/statistics/statistics.h"
 #include "envmis/study/techniques/estimator.h"
 #include "estimates.h"
+#include "forced_path.h"
 #include "maps.h"
 
 namespace envmis {
@@ -276,6 +277,7 @@ TEST(Estimator, FixedWeightEstimatesUseTheRandomNumbersInTheirDocumentedOrder) {
 // and those that do not), for allocations within and beyond what runs side by side, and
 // across the groups of 32 a request is split into. Adaptive techniques learn the same.
 TEST(Estimator, ManyEstimatesAtOnceEqualTheSameEstimatesOneAtATime) {
+    ENVMIS_SKIP_IF_FORCED_PATH_UNAVAILABLE();
     const Maps maps = make_maps("sun", test::sun_sky_map(128, 64));
     const ShadingPoint point{normalize(Vec3{0.3f, -0.2f, 1}), normalize(Vec3{-0.5f, 0.4f, 1})};
     for (const Bsdf& bsdf : {Bsdf::lambert(), Bsdf::phong(20), Bsdf::ggx(0.2f)})
@@ -297,6 +299,7 @@ TEST(Estimator, ManyEstimatesAtOnceEqualTheSameEstimatesOneAtATime) {
 // that a lane one bit off changes an estimate; the 100 estimates are three full groups
 // of 32 and one of 4, padded to 8.
 TEST(Estimator, GlossyEstimatesAtOnceEqualTheSameEstimatesOneAtATimeForEveryLobeAndView) {
+    ENVMIS_SKIP_IF_FORCED_PATH_UNAVAILABLE();
     const Maps maps = make_maps("sun", test::sun_sky_map(128, 64));
     const Vec3 up{0, 0, 1}, tilted = normalize(Vec3{0.3f, -0.2f, 1});
     const std::vector<ShadingPoint> views = {{up, up},

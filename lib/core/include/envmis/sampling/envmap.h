@@ -152,9 +152,10 @@ struct EnvMapView {
 // EnvMapView::lookup for n directions at once, for code that holds many (an estimator's
 // or a wavefront renderer's BSDF samples): directions in, one array per world
 // coordinate; radiance and solid-angle pdf out, likewise. Bit-identical to n calls of
-// lookup. On x86-64 CPUs with AVX2, an equirectangular map in the default axes is looked
-// up eight directions at a time with SIMD instructions (envmap_many.cpp); other maps
-// and CPUs take one direction at a time. Host only; noexcept and allocation-free.
+// lookup. An equirectangular map in the default axes is looked up eight directions at a
+// time with AVX2 where batch_paths() chose it for this CPU (envmis/cpu.h); otherwise one
+// direction at a time, software-pipelined with prefetches so that the misses of many
+// lookups overlap (envmap_many.cpp). Host only; noexcept and allocation-free.
 struct DirectionArrays {
     const float *x, *y, *z;
 };
@@ -166,8 +167,8 @@ void lookup_many(const EnvMapView& env, DirectionArrays in, LookupArrays out, ui
 // EnvMapView::sample for n random points at once, likewise: the points' two coordinates
 // in [0,1) in, one array each; direction, solid-angle pdf and radiance out, and the
 // image point (EnvSample::uv) where u and v are given (null: not written). Bit-identical
-// to n calls of sample; SIMD on the same maps and CPUs as lookup_many, when the map is
-// at least 2x2.
+// to n calls of sample; AVX2 on the same maps as lookup_many, at least 2x2, where
+// batch_paths() chose it for sampling; otherwise one point at a time, pipelined.
 struct PointArrays {
     const float *x, *y;
 };
