@@ -11,7 +11,6 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
-#include <vector>
 
 #include "envmis/core.h"
 #ifdef ENVMIS_CONSUMER_IO
@@ -28,7 +27,7 @@ void check(bool ok, const std::string& what) {
 // A sky brightening towards the zenith with a small bright sun: compensation zeroes
 // part of it, so the sampler's density is far from uniform.
 envmis::RgbImage sky(uint32_t w, uint32_t h) {
-    envmis::RgbImage image{w, h, std::vector<envmis::Rgb>(size_t{w} * h)};
+    envmis::RgbImage image{w, h, envmis::RgbPixels(size_t{w} * h)};
     for (uint32_t y = 0; y < h; ++y)
         for (uint32_t x = 0; x < w; ++x) {
             const float l = 0.2f + 0.8f * (1.0f - static_cast<float>(y) / static_cast<float>(h));

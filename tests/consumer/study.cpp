@@ -7,13 +7,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <vector>
 
 #include "envmis/study.h"
 
 int main() {
     const uint32_t w = 32, h = 16;
-    const envmis::EnvMap plain(envmis::RgbImage{w, h, std::vector<envmis::Rgb>(size_t{w} * h, {1, 1, 1})});
+    const envmis::EnvMap plain(envmis::RgbImage{w, h, envmis::RgbPixels(size_t{w} * h, {1, 1, 1})});
     const envmis::DirectLightingEstimator estimator(plain, envmis::Technique::parse("mis-balance"));
     const envmis::Bsdf bsdf = envmis::Bsdf::parse("lambert");
     envmis::Pcg32 rng(7, 0);
