@@ -11,7 +11,6 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
-#include <vector>
 
 #include "envmis/core.h"
 #ifdef ENVMIS_CONSUMER_IO

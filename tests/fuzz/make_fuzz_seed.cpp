@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <vector>
 
 #include "envmis/table/table.h"
 
@@ -12,7 +11,7 @@ namespace {
 
 // A gradient with one bright texel, so that compensation zeroes part of the map.
 envmis::RgbImage sky(uint32_t w, uint32_t h) {
-    envmis::RgbImage image{w, h, std::vector<envmis::Rgb>(size_t{w} * h)};
+    envmis::RgbImage image{w, h, envmis::RgbPixels(size_t{w} * h)};
     for (uint32_t y = 0; y < h; ++y)
         for (uint32_t x = 0; x < w; ++x) {
             const float l = 0.1f + static_cast<float>(x + 2 * y) / static_cast<float>(w + 2 * h);
@@ -50,7 +49,7 @@ int main(int argc, char** argv) {
         envmis::write_table(dir / "binned_compact_16x8.envmis", binned, source, envmis::TableEncoding::compact);
 
         // A black map: the uniform fallback.
-        envmis::RgbImage black{8, 4, std::vector<envmis::Rgb>(32)};
+        envmis::RgbImage black{8, 4, envmis::RgbPixels(32)};
         envmis::write_table(dir / "black_8x4.envmis", envmis::EnvMap(black), source);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "envmis_make_fuzz_seed: %s\n", e.what());
