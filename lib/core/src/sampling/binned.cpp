@@ -12,6 +12,7 @@
 
 #include "binned_choice.h"
 #include "detail/parallel.h"
+#include "detail/pipeline.h"
 
 namespace envmis {
 
@@ -279,10 +280,7 @@ Located locate(const BinnedEnvMapView& env, uint32_t lobe, Vec3 normal, Vec3 dir
     const uint32_t x = detail::cell_of(at.uv.x, d.w), y = detail::cell_of(at.uv.y, d.h);
     const uint32_t cx = env.cell_column(x), cy = env.cell_row(y);
     const size_t texel = static_cast<size_t>(y) * d.w + x, row = static_cast<size_t>(y) * d.w;
-    ENVMIS_PREFETCH(env.plain.radiance + texel);
-    ENVMIS_PREFETCH(&env.plain.radiance[texel].b);  // a texel may straddle two lines
-    ENVMIS_PREFETCH(d.start + texel);
-    ENVMIS_PREFETCH(d.start + texel + 1);  // one past the table at most: prefetches do not fault
+    detail::prefetch_texel(env.plain, texel);
     ENVMIS_PREFETCH(d.start + row + env.column_edges[cx]);
     ENVMIS_PREFETCH(d.start + row + env.column_edges[cx + 1]);
     ENVMIS_PREFETCH(at.bin.cells.start + cy * env.cells_w + cx);
@@ -292,25 +290,21 @@ Located locate(const BinnedEnvMapView& env, uint32_t lobe, Vec3 normal, Vec3 dir
 
 }  // namespace
 
-// Software-pipelined as EnvMap's lookup_many (envmap_many.cpp): each direction located
+// Software-pipelined (detail/pipeline.h) as EnvMap's lookup_many: each direction located
 // and its data prefetched 32 directions before its pdf is computed from them, so that
 // the misses of 32 directions are in flight at once. Bit-identical to BinView::lookup,
 // whose functions it calls.
 void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays normals, DirectionArrays in,
                  LookupArrays out, uint32_t n) noexcept {
-    constexpr uint32_t kDistance = 32;
-    Located located[kDistance];
-    const auto start = [&](uint32_t i) noexcept {
-        return locate(env, lobe, {normals.x[i], normals.y[i], normals.z[i]}, {in.x[i], in.y[i], in.z[i]});
-    };
-    const uint32_t primed = std::min(n, kDistance);
-    for (uint32_t k = 0; k < primed; ++k) located[k] = start(k);
-    for (uint32_t i = 0, slot = 0; i < n; ++i, slot = (slot + 1) % kDistance) {
-        const Located l = located[slot];
-        if (i + kDistance < n) located[slot] = start(i + kDistance);
-        const Rgb c = env.plain.eval_uv(l.uv);
-        out.r[i] = c.r, out.g[i] = c.g, out.b[i] = c.b, out.pdf[i] = l.bin.pdf_uv(l.uv);
-    }
+    detail::pipelined<32>(
+        0, n,
+        [&](uint32_t i) noexcept {
+            return locate(env, lobe, {normals.x[i], normals.y[i], normals.z[i]}, {in.x[i], in.y[i], in.z[i]});
+        },
+        [&](const Located& l, uint32_t i) noexcept {
+            const Rgb c = env.plain.eval_uv(l.uv);
+            out.r[i] = c.r, out.g[i] = c.g, out.b[i] = c.b, out.pdf[i] = l.bin.pdf_uv(l.uv);
+        });
 }
 
 // Software-pipelined: a block of samples goes through each stage of BinView::sample in
@@ -331,8 +325,7 @@ void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays nor
             const uint32_t i = first + j;
             bins[j] = env.bin({normals.x[i], normals.y[i], normals.z[i]}, lobe);
             const CdfView& c = bins[j].cells;
-            const auto k =
-                static_cast<uint32_t>((static_cast<uint64_t>(in.x[i] * static_cast<float>(kCdfUnits)) * c.n) >> 31);
+            const uint32_t k = c.bucket(in.x[i]);
             ENVMIS_PREFETCH(c.guide + k);
             ENVMIS_PREFETCH(c.start + k);
         }

@@ -1,10 +1,8 @@
 // lookup_many and sample_many (envmap.h): EnvMapView::lookup and EnvMapView::sample
 // for many directions or random points, on the path envmis/cpu.h chooses for the CPU.
 //
-// The scalar paths call the single calls' own functions, split into stages: a lane's
-// first stage finds what it will read and prefetches it, its last runs a fixed number of
-// lanes later, so that that many lanes' cache misses are in flight at once. The results
-// are bit-identical to the single calls by construction.
+// The scalar paths call the single calls' own functions, split into the stages of
+// detail/pipeline.h: bit-identical to the single calls by construction.
 //
 // The AVX2 paths (eight lanes at a time, hardware gathers) repeat the scalar arithmetic
 // operation for operation (equirect_uv, fast_atan2, detail::cell_of, CdfView::width and
@@ -20,6 +18,7 @@
 
 #include <algorithm>
 
+#include "detail/pipeline.h"
 #include "detail/simd.h"
 #include "envmis/cpu.h"
 
@@ -31,40 +30,20 @@ namespace {
 // slower), 16 for samples, whose second stage's misses are fewer and nearer the first's.
 constexpr uint32_t kLookupDistance = 32, kSampleDistance = 16;
 
-// Lanes first..n of a two-stage pipeline: start(l) for lane l (it returns what finish
-// needs), finish(started, l) kDistance lanes later.
-template <uint32_t kDistance, class Start, class Finish>
-void pipelined(uint32_t first, uint32_t n, Start&& start, Finish&& finish) noexcept {
-    static_assert((kDistance & (kDistance - 1)) == 0);
-    decltype(start(first)) started[kDistance];
-    const uint32_t primed = std::min(n - first, kDistance);
-    for (uint32_t k = 0; k < primed; ++k) started[k] = start(first + k);
-    for (uint32_t l = first, slot = 0; l < n; ++l, slot = (slot + 1) & (kDistance - 1)) {
-        const auto s = started[slot];
-        if (l + kDistance < n) started[slot] = start(l + kDistance);
-        finish(s, l);
-    }
-}
-
-// What eval_uv and pdf_uv read at uv: the radiance (both ends: a texel may straddle two
-// cache lines), the texel's CDF entry and the next (its width), the row's marginal entry.
-void prefetch_texel(const EnvMapView& env, Vec2 uv) noexcept {
+// What eval_uv and pdf_uv read at uv: the texel's data and its row's marginal entry.
+void prefetch_uv(const EnvMapView& env, Vec2 uv) noexcept {
     const Distribution2DView& d = env.distribution;
     const uint32_t x = detail::cell_of(uv.x, d.w), y = detail::cell_of(uv.y, d.h);
-    const size_t i = static_cast<size_t>(y) * d.w + x;
-    ENVMIS_PREFETCH(env.radiance + i);
-    ENVMIS_PREFETCH(&env.radiance[i].b);
-    ENVMIS_PREFETCH(d.start + i);
-    ENVMIS_PREFETCH(d.start + i + 1);  // one past the table at most: the prefetch does not fault
+    detail::prefetch_texel(env, static_cast<size_t>(y) * d.w + x);
     ENVMIS_PREFETCH(d.marginal.start + y);
 }
 
 void lookup_scalar(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t first, uint32_t n) noexcept {
-    pipelined<kLookupDistance>(
+    detail::pipelined<kLookupDistance>(
         first, n,
         [&](uint32_t l) noexcept {
             const Vec2 uv = env.uv_of({in.x[l], in.y[l], in.z[l]});
-            prefetch_texel(env, uv);
+            prefetch_uv(env, uv);
             return uv;
         },
         [&](Vec2 uv, uint32_t l) noexcept {
@@ -73,43 +52,33 @@ void lookup_scalar(const EnvMapView& env, DirectionArrays in, LookupArrays out, 
         });
 }
 
-// Distribution2DView::sample and EnvMapView::sample in two stages: the row (the marginal
-// is small and stays in cache) and prefetches of what the column search reads first (the
-// guide entry and CDF at u.x's bucket) and of the radiance near it; then the column and
-// the rest.
-struct RowFound {
-    CellHit r;
-    size_t row_start = 0;
-};
-
-RowFound find_row(const EnvMapView& env, Vec2 u) noexcept {
+// EnvMapView::sample in the two stages of Distribution2DView::sample: the row (the
+// marginal is small and stays in cache) with prefetches of what the column search reads
+// first (the guide entry and CDF at u.x's bucket) and of the radiance near it; then the
+// column and the rest.
+CellHit find_row(const EnvMapView& env, Vec2 u) noexcept {
     const Distribution2DView& d = env.distribution;
     const CellHit r = d.marginal.invert(u.y);
-    const size_t row_start = static_cast<size_t>(r.index) * d.w;
-    const auto t = static_cast<uint32_t>(u.x * static_cast<float>(kCdfUnits));
-    const size_t near = row_start + static_cast<uint32_t>((static_cast<uint64_t>(t) * d.w) >> 31);
+    const size_t near = static_cast<size_t>(r.index) * d.w + d.row(r.index).bucket(u.x);
     ENVMIS_PREFETCH(d.guide + near);
     ENVMIS_PREFETCH(d.start + near);
     ENVMIS_PREFETCH(env.radiance + near);
-    return {r, row_start};
+    return r;
 }
 
-EnvSample sample_in_row(const EnvMapView& env, const RowFound& f, Vec2 u) noexcept {
-    const Distribution2DView& d = env.distribution;
-    const CdfView cdf = d.row(f.r.index);
-    const CellHit c = cdf.invert(u.x, [&](uint32_t x) { ENVMIS_PREFETCH(env.radiance + f.row_start + x); });
-    const Vec2 p{detail::point_in_cell(c.index, c.offset, d.w), detail::point_in_cell(f.r.index, f.r.offset, d.h)};
-    return env.at(p, d.pdf_of(d.marginal.width(f.r.index), cdf.width(c.index)), f.row_start + c.index);
+EnvSample sample_in_row(const EnvMapView& env, CellHit r, Vec2 u) noexcept {
+    const auto s = env.distribution.sample_in_row(r, u.x, [&](size_t i) { ENVMIS_PREFETCH(env.radiance + i); });
+    return env.at(s.p, s.pdf, static_cast<size_t>(s.y) * env.distribution.w + s.x);
 }
 
 void sample_scalar(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t first, uint32_t n) noexcept {
-    pipelined<kSampleDistance>(
+    detail::pipelined<kSampleDistance>(
         first, n,
         [&](uint32_t l) noexcept {
             return find_row(env, {in.x[l], in.y[l]});
         },
-        [&](const RowFound& f, uint32_t l) noexcept {
-            const EnvSample e = sample_in_row(env, f, {in.x[l], in.y[l]});
+        [&](CellHit r, uint32_t l) noexcept {
+            const EnvSample e = sample_in_row(env, r, {in.x[l], in.y[l]});
             out.x[l] = e.direction.x, out.y[l] = e.direction.y, out.z[l] = e.direction.z, out.pdf[l] = e.pdf;
             out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b;
             if (out.u) out.u[l] = e.uv.x;

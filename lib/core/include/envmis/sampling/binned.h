@@ -300,7 +300,7 @@ ENVMIS_HD inline BinView::Cell BinView::find_cell(float ux) const noexcept {
 // alike): they overlap the row CDF's misses with the plain row's.
 ENVMIS_HD inline void prefetch_row(const BinnedEnvMapView& m, const BinView::Cell& c, float uy) noexcept {
     const CdfView rows = m.cell_rows(c.cx, c.cy);
-    const auto k = static_cast<uint32_t>((static_cast<uint64_t>(uy * static_cast<float>(kCdfUnits)) * rows.n) >> 31);
+    const uint32_t k = rows.bucket(uy);
     ENVMIS_PREFETCH(rows.guide + k);
     ENVMIS_PREFETCH(rows.start + k);
     const uint32_t* start = m.plain.distribution.row(m.row_edges[c.cy] + k).start;

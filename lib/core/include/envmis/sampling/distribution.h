@@ -71,7 +71,7 @@ struct CdfView {
     ENVMIS_HD CellHit invert(float u, Hint near_answer = {}) const noexcept {
         const float x = u * static_cast<float>(kCdfUnits);
         const auto t = static_cast<uint32_t>(x);
-        const auto k = static_cast<uint32_t>((static_cast<uint64_t>(t) * n) >> 31);
+        const uint32_t k = bucket(t);
         ENVMIS_PREFETCH(start + k);
         near_answer(k);
         uint32_t lo = guide[k], hi = k + 1 < n ? guide[k + 1] : n - 1;
@@ -87,6 +87,15 @@ struct CdfView {
         // Both terms are >= 0 (t >= start[lo], t <= x) and the found cell is not empty,
         // so only the rounding up to 1 needs a clamp.
         return {lo, min(offset, kOneMinusEpsilon)};
+    }
+
+    // The guide bucket of unit t (of u: t = u 2^31, truncated): where invert starts, for
+    // callers that prefetch its first reads (sample_many).
+    ENVMIS_HD uint32_t bucket(uint32_t t) const noexcept {
+        return static_cast<uint32_t>((static_cast<uint64_t>(t) * n) >> 31);
+    }
+    ENVMIS_HD uint32_t bucket(float u) const noexcept {
+        return bucket(static_cast<uint32_t>(u * static_cast<float>(kCdfUnits)));
     }
 
     // The u that `invert` maps to (index, offset).
@@ -230,10 +239,15 @@ struct Distribution2DView {
     // CdfView::invert), for the caller to prefetch its data.
     template <class Hint = NoHint>
     ENVMIS_HD Sample sample(Vec2 u, Hint near_answer = {}) const noexcept {
-        const CellHit r = marginal.invert(u.y);
+        return sample_in_row(marginal.invert(u.y), u.x, near_answer);
+    }
+    // The second stage of sample: the column in row r (marginal.invert(u.y)) and the
+    // point. Batch callers find many rows first and prefetch the columns' data meanwhile.
+    template <class Hint = NoHint>
+    ENVMIS_HD Sample sample_in_row(CellHit r, float ux, Hint near_answer = {}) const noexcept {
         const CdfView cdf = row(r.index);
         const size_t row_start = static_cast<size_t>(r.index) * w;
-        const CellHit c = cdf.invert(u.x, [&](uint32_t x) { near_answer(row_start + x); });
+        const CellHit c = cdf.invert(ux, [&](uint32_t x) { near_answer(row_start + x); });
         const Vec2 p{detail::point_in_cell(c.index, c.offset, w), detail::point_in_cell(r.index, r.offset, h)};
         return {p, pdf_of(marginal.width(r.index), cdf.width(c.index)), c.index, r.index};
     }

@@ -1,0 +1,40 @@
+// Internal: the software pipeline of the scalar batch paths (envmap_many.cpp, binned.cpp).
+// A lane's first stage finds what it will read and prefetches it; its last stage runs a
+// fixed number of lanes later, so that that many lanes' cache misses are in flight at
+// once. The stages are the single calls' own functions, so the results stay
+// bit-identical to them.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+
+#include "envmis/sampling/envmap.h"
+
+namespace envmis::detail {
+
+// Lanes first..n of a two-stage pipeline: start(l) for lane l (it returns what finish
+// needs), finish(started, l) kDistance lanes later.
+template <uint32_t kDistance, class Start, class Finish>
+void pipelined(uint32_t first, uint32_t n, Start&& start, Finish&& finish) noexcept {
+    static_assert((kDistance & (kDistance - 1)) == 0);
+    decltype(start(first)) started[kDistance];
+    const uint32_t primed = std::min(n - first, kDistance);
+    for (uint32_t k = 0; k < primed; ++k) started[k] = start(first + k);
+    for (uint32_t l = first, slot = 0; l < n; ++l, slot = (slot + 1) & (kDistance - 1)) {
+        const auto s = started[slot];
+        if (l + kDistance < n) started[slot] = start(l + kDistance);
+        finish(s, l);
+    }
+}
+
+// What EnvMapView::eval_uv and the pdf read of texel i (row-major): its radiance (both
+// ends: a texel may straddle two cache lines), its CDF entry and the next (its width).
+inline void prefetch_texel(const EnvMapView& env, size_t i) noexcept {
+    ENVMIS_PREFETCH(env.radiance + i);
+    ENVMIS_PREFETCH(&env.radiance[i].b);
+    ENVMIS_PREFETCH(env.distribution.start + i);
+    ENVMIS_PREFETCH(env.distribution.start + i + 1);  // one past the table at most: the prefetch does not fault
+}
+
+}  // namespace envmis::detail
