@@ -25,7 +25,7 @@ struct CpuInfo {
     std::string brand;               // the brand string, as the (virtual) machine reports it
     uint32_t family = 0, model = 0;  // display family and model (base plus extended fields)
     bool avx2 = false;               // AVX2 present and its registers saved by the OS
-    bool avx512 = false;             // AVX-512 F, BW, DQ and VL likewise (no kernel uses it yet)
+    bool avx512 = false;             // AVX-512 F, BW, DQ and VL likewise (no kernel uses it: see below)
 };
 const CpuInfo& cpu_info() noexcept;
 // "<brand> (<vendor> family 0x1a model 0x2, AVX2, AVX-512)": for benchmark output.
@@ -47,7 +47,10 @@ struct BatchPaths {
 // Xeon) and AMD from family 0x1a on (there, over single calls: compensated sky about 1.5x
 // against the scalar pipeline's 0.95x, plain about 4x against 2.6x), the scalar pipeline
 // on older AMD families, whose gathers are slower (not measured); the estimator's lanes
-// (arithmetic, no gathers of their own) wherever AVX2 is usable.
+// (arithmetic, no gathers of their own) wherever AVX2 is usable. No AVX-512 path: much of
+// the kernels' time goes to gathers, and on AMD family 0x1a one 16-lane gather of eight
+// 64-bit pairs took 1.7x the time of the two 8-lane AVX2 gathers of the same pairs
+// (docs/performance-log.md, 2026-12-02).
 BatchPaths choose_batch_paths(const CpuInfo& cpu, std::string_view forced);
 // choose_batch_paths(cpu_info(), ENVMIS_SIMD), once.
 const BatchPaths& batch_paths() noexcept;
