@@ -59,6 +59,7 @@ void lookup_scalar(const EnvMapView& env, DirectionArrays in, LookupArrays out, 
 CellHit find_row(const EnvMapView& env, Vec2 u) noexcept {
     const Distribution2DView& d = env.distribution;
     const CellHit r = d.marginal.invert(u.y);
+    if (d.hot_row(r.index)) return r;
     const size_t near = static_cast<size_t>(r.index) * d.w + d.row(r.index).bucket(u.x);
     ENVMIS_PREFETCH(d.guide + near);
     ENVMIS_PREFETCH(d.start + near);
@@ -373,16 +374,9 @@ struct Rows8 {
     Unit8 column;
 };
 
-// A row holding more than this share of the CDF's units draws so many of the samples
-// that its data stays in cache: prefetching it again costs load slots and saves nothing
-// (compensated 8k sky, whose samples crowd onto the sun's rows: 1.3x to 1.5x of single
-// calls with every lane's prefetches, 1.5x to 2.5x without; AMD EPYC family 0x1a). An
-// 8k sky's other rows hold about 2^-12 each.
-constexpr uint32_t kHotRowUnits = kCdfUnits >> 10;
-
 // The rows of the eight points from lane l on; starts loading what the column search
 // reads first (the guide entry and CDF around the bucket) and the radiance near it, in
-// the lanes whose rows are not hot.
+// the lanes whose rows are not hot (kHotRowUnits, distribution.h).
 ENVMIS_AVX2 Rows8 rows8(const EnvMapView& env, PointArrays in, uint32_t l) noexcept {
     const Distribution2DView& d = env.distribution;
     const I8 zero = _mm256_setzero_si256();

@@ -39,6 +39,14 @@ namespace envmis {
 inline constexpr uint32_t kCdfUnits = 1u << 31;    // total of a fixed-point CDF
 inline constexpr uint32_t kMaxCells1D = 1u << 16;  // per dimension (uint16 guide entries)
 
+// A row holding more than this share of a 2D distribution's units draws so many of the
+// samples that its data stays in cache: the samplers skip their prefetches in it, which
+// cost load slots there and save nothing (compensated 8k sky, whose samples crowd onto the
+// sun's rows: single samples 8% faster without them; the AVX2 batch 1.5x to 2.5x of single
+// calls without, 1.3x to 1.5x with; AMD EPYC family 0x1a). An 8k sky's other rows hold
+// about 2^-12 each.
+inline constexpr uint32_t kHotRowUnits = kCdfUnits >> 10;
+
 // A point found by inverting a CDF: the cell and the position inside it, in [0,1).
 struct CellHit {
     uint32_t index = 0;
@@ -66,14 +74,18 @@ struct CdfView {
     // names, then on the caller's data for the cell found. The answer is usually near
     // cell k of the guide bucket (for a smooth function, within a cache line of it), so
     // the CDF around k is prefetched and `near_answer(k)` lets the caller prefetch its
-    // own: the three loads overlap instead of waiting for each other.
-    template <class Hint = NoHint>
+    // own: the three loads overlap instead of waiting for each other. A caller that knows
+    // the data is in cache passes kPrefetch = false: the prefetches would only take load
+    // slots.
+    template <bool kPrefetch = true, class Hint = NoHint>
     ENVMIS_HD CellHit invert(float u, Hint near_answer = {}) const noexcept {
         const float x = u * static_cast<float>(kCdfUnits);
         const auto t = static_cast<uint32_t>(x);
         const uint32_t k = bucket(t);
-        ENVMIS_PREFETCH(start + k);
-        near_answer(k);
+        if constexpr (kPrefetch) {
+            ENVMIS_PREFETCH(start + k);
+            near_answer(k);
+        }
         uint32_t lo = guide[k], hi = k + 1 < n ? guide[k + 1] : n - 1;
         while (lo < hi) {  // last cell whose start is <= t
             const uint32_t mid = (lo + hi + 1) / 2;
@@ -247,10 +259,13 @@ struct Distribution2DView {
     ENVMIS_HD Sample sample_in_row(CellHit r, float ux, Hint near_answer = {}) const noexcept {
         const CdfView cdf = row(r.index);
         const size_t row_start = static_cast<size_t>(r.index) * w;
-        const CellHit c = cdf.invert(ux, [&](uint32_t x) { near_answer(row_start + x); });
+        const auto near = [&](uint32_t x) { near_answer(row_start + x); };
+        const CellHit c = hot_row(r.index) ? cdf.invert<false>(ux) : cdf.invert(ux, near);
         const Vec2 p{detail::point_in_cell(c.index, c.offset, w), detail::point_in_cell(r.index, r.offset, h)};
         return {p, pdf_of(marginal.width(r.index), cdf.width(c.index)), c.index, r.index};
     }
+    // True if row y holds more than kHotRowUnits: its data stays in cache.
+    ENVMIS_HD bool hot_row(uint32_t y) const noexcept { return marginal.width(y) > kHotRowUnits; }
     ENVMIS_HD float pdf(Vec2 p) const noexcept {
         const uint32_t x = detail::cell_of(p.x, w), y = detail::cell_of(p.y, h);
         return pdf_of(marginal.width(y), row(y).width(x));
