@@ -6,10 +6,7 @@
 #pragma once
 
 #include <algorithm>
-#include <cstddef>
 #include <cstdint>
-
-#include "envmis/sampling/envmap.h"
 
 namespace envmis::detail {
 
@@ -26,15 +23,6 @@ void pipelined(uint32_t first, uint32_t n, Start&& start, Finish&& finish) noexc
         if (l + kDistance < n) started[slot] = start(l + kDistance);
         finish(s, l);
     }
-}
-
-// What EnvMapView::eval_uv and the pdf read of texel i (row-major): its radiance (both
-// ends: a texel may straddle two cache lines), its CDF entry and the next (its width).
-inline void prefetch_texel(const EnvMapView& env, size_t i) noexcept {
-    ENVMIS_PREFETCH(env.radiance + i);
-    ENVMIS_PREFETCH(&env.radiance[i].b);
-    ENVMIS_PREFETCH(env.distribution.start + i);
-    ENVMIS_PREFETCH(env.distribution.start + i + 1);  // one past the table at most: the prefetch does not fault
 }
 
 }  // namespace envmis::detail

@@ -280,7 +280,7 @@ Located locate(const BinnedEnvMapView& env, uint32_t lobe, Vec3 normal, Vec3 dir
     const uint32_t x = detail::cell_of(at.uv.x, d.w), y = detail::cell_of(at.uv.y, d.h);
     const uint32_t cx = env.cell_column(x), cy = env.cell_row(y);
     const size_t texel = static_cast<size_t>(y) * d.w + x, row = static_cast<size_t>(y) * d.w;
-    detail::prefetch_texel(env.plain, texel);
+    env.plain.prefetch_texel(texel);
     ENVMIS_PREFETCH(d.start + row + env.column_edges[cx]);
     ENVMIS_PREFETCH(d.start + row + env.column_edges[cx + 1]);
     ENVMIS_PREFETCH(at.bin.cells.start + cy * env.cells_w + cx);

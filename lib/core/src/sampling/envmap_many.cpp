@@ -30,20 +30,12 @@ namespace {
 // slower), 16 for samples, whose second stage's misses are fewer and nearer the first's.
 constexpr uint32_t kLookupDistance = 32, kSampleDistance = 16;
 
-// What eval_uv and pdf_uv read at uv: the texel's data and its row's marginal entry.
-void prefetch_uv(const EnvMapView& env, Vec2 uv) noexcept {
-    const Distribution2DView& d = env.distribution;
-    const uint32_t x = detail::cell_of(uv.x, d.w), y = detail::cell_of(uv.y, d.h);
-    detail::prefetch_texel(env, static_cast<size_t>(y) * d.w + x);
-    ENVMIS_PREFETCH(d.marginal.start + y);
-}
-
 void lookup_scalar(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t first, uint32_t n) noexcept {
     detail::pipelined<kLookupDistance>(
         first, n,
         [&](uint32_t l) noexcept {
             const Vec2 uv = env.uv_of({in.x[l], in.y[l], in.z[l]});
-            prefetch_uv(env, uv);
+            env.prefetch_uv(uv);
             return uv;
         },
         [&](Vec2 uv, uint32_t l) noexcept {
@@ -54,8 +46,8 @@ void lookup_scalar(const EnvMapView& env, DirectionArrays in, LookupArrays out, 
 
 // EnvMapView::sample in the two stages of Distribution2DView::sample: the row (the
 // marginal is small and stays in cache) with prefetches of what the column search reads
-// first (the guide entry and CDF at u.x's bucket) and of the radiance near it; then the
-// column and the rest.
+// first (the guide entry and CDF at u.x's bucket) and of the radiance near it (none in
+// hot rows: Distribution2DView::hot_row); then the column and the rest.
 CellHit find_row(const EnvMapView& env, Vec2 u) noexcept {
     const Distribution2DView& d = env.distribution;
     const CellHit r = d.marginal.invert(u.y);
@@ -130,12 +122,12 @@ ENVMIS_AVX2 I8 gather(const uint32_t* a, I8 i) noexcept {
 }
 
 // a[i] and a[i + 1] in eight lanes, from two gathers of 64-bit pairs: on AMD family 0x1a
-// a gather costs about by the element, and four 64-bit elements take two thirds of the
-// time of eight 32-bit ones (measured), so two values a lane come cheaper as pairs.
+// a gather's cost grows with its elements, and four 64-bit elements take two thirds of
+// the time of eight 32-bit ones (measured), so two values a lane come cheaper as pairs.
 struct Pair8 {
     I8 first, second;
 };
-// The eight lanes of a0 a1 a4 a5 | a2 a3 a6 a7 (64-bit pairs of floats) in order.
+// The eight lanes of a0 a1 a4 a5 | a2 a3 a6 a7 (64-bit pairs of 32-bit values) in order.
 ENVMIS_AVX2 I8 lanes_in_order(__m256 v) noexcept {
     return _mm256_castpd_si256(_mm256_permute4x64_pd(_mm256_castps_pd(v), _MM_SHUFFLE(3, 1, 2, 0)));
 }
@@ -149,7 +141,7 @@ ENVMIS_AVX2 Pair8 gather_pairs(const void* a, I8 i) noexcept {
 }
 
 // Cell i of the CDF at `start`, n cells: its first unit and CdfView::width, the next
-// start (kCdfUnits after the last cell) minus this one; one pair gather at
+// start (kCdfUnits after the last cell) minus this one; for n >= 2 one pair gather at
 // j = min(i, n - 2), which stays inside the table (the last cell's start is then the
 // pair's second value).
 struct Span8 {
@@ -157,15 +149,15 @@ struct Span8 {
 };
 ENVMIS_AVX2 Span8 span8(const uint32_t* start, I8 base, I8 i, uint32_t n) noexcept {
     const I8 units = _mm256_set1_epi32(static_cast<int>(kCdfUnits));
-    if (n == 1) {
+    if (n == 1) {  // i = 0
         const I8 first = gather(start, base);
         return {first, _mm256_sub_epi32(units, first)};
     }
     const I8 j = _mm256_min_epu32(i, _mm256_set1_epi32(static_cast<int>(n - 2)));
     const Pair8 p = gather_pairs(start, _mm256_add_epi32(base, j));
-    const I8 last = _mm256_andnot_si256(_mm256_cmpeq_epi32(i, j), _mm256_set1_epi32(-1));
-    const I8 first = _mm256_blendv_epi8(p.first, p.second, last);
-    const I8 end = _mm256_blendv_epi8(p.second, units, last);
+    const I8 inside = _mm256_cmpeq_epi32(i, j);  // not the last cell
+    const I8 first = _mm256_blendv_epi8(p.second, p.first, inside);
+    const I8 end = _mm256_blendv_epi8(units, p.second, inside);
     return {first, _mm256_sub_epi32(end, first)};
 }
 
@@ -223,8 +215,8 @@ ENVMIS_AVX2 void store_radiance8(const Rgb* radiance, I8 texel, float* r, float*
     const I8 three = _mm256_add_epi32(texel, _mm256_add_epi32(texel, texel));
     const float* rgb = &radiance->r;
     const Pair8 rg = gather_pairs(rgb, three);
-    _mm256_storeu_si256(reinterpret_cast<I8*>(r + l), rg.first);
-    _mm256_storeu_si256(reinterpret_cast<I8*>(g + l), rg.second);
+    _mm256_storeu_ps(r + l, _mm256_castsi256_ps(rg.first));
+    _mm256_storeu_ps(g + l, _mm256_castsi256_ps(rg.second));
     _mm256_storeu_ps(b + l, _mm256_i32gather_ps(rgb + 2, three, 4));
 }
 
@@ -376,8 +368,8 @@ struct Rows8 {
 
 // The rows of the eight points from lane l on; starts loading what the column search
 // reads first (the guide entry and CDF around the bucket) and the radiance near it, in
-// the lanes whose rows are not hot (kHotRowUnits, distribution.h).
-ENVMIS_AVX2 Rows8 rows8(const EnvMapView& env, PointArrays in, uint32_t l) noexcept {
+// the lanes whose rows hold at most hot_units (Distribution2DView::hot_row_units).
+ENVMIS_AVX2 Rows8 rows8(const EnvMapView& env, PointArrays in, uint32_t l, uint32_t hot_units) noexcept {
     const Distribution2DView& d = env.distribution;
     const I8 zero = _mm256_setzero_si256();
     const Hit8 r = search8(d.marginal.start, d.marginal.guide, zero, d.h, unit8(_mm256_loadu_ps(in.y + l), d.h));
@@ -385,7 +377,7 @@ ENVMIS_AVX2 Rows8 rows8(const EnvMapView& env, PointArrays in, uint32_t l) noexc
                      unit8(_mm256_loadu_ps(in.x + l), d.w)};
     alignas(32) uint32_t near[8];
     _mm256_store_si256(reinterpret_cast<I8*>(near), _mm256_add_epi32(rows.row, rows.column.k));
-    const I8 cap = _mm256_set1_epi32(static_cast<int>(kHotRowUnits));
+    const I8 cap = _mm256_set1_epi32(static_cast<int>(hot_units));
     const I8 cold = _mm256_cmpeq_epi32(_mm256_min_epu32(r.width, cap), r.width);  // unsigned width <= cap
     for (auto m = static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(cold))); m != 0; m &= m - 1) {
         const uint32_t i = near[__builtin_ctz(m)];
@@ -416,8 +408,9 @@ ENVMIS_AVX2 void sample8(const EnvMapView& env, const Rows8& rows, SampleArrays 
 // Rows found and columns' data prefetched for up to four groups before the first
 // group's column search.
 ENVMIS_AVX2 uint32_t sample_avx2(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t n) noexcept {
+    const uint32_t hot_units = env.distribution.hot_row_units();
     return in_staged_groups(
-        n, [&](uint32_t first) ENVMIS_AVX2 { return rows8(env, in, first); },
+        n, [&](uint32_t first) ENVMIS_AVX2 { return rows8(env, in, first, hot_units); },
         [&](const Rows8& rows, uint32_t first) ENVMIS_AVX2 { sample8(env, rows, out, first); });
 }
 #endif

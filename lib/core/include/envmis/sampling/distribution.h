@@ -39,13 +39,14 @@ namespace envmis {
 inline constexpr uint32_t kCdfUnits = 1u << 31;    // total of a fixed-point CDF
 inline constexpr uint32_t kMaxCells1D = 1u << 16;  // per dimension (uint16 guide entries)
 
-// A row holding more than this share of a 2D distribution's units draws so many of the
-// samples that its data stays in cache: the samplers skip their prefetches in it, which
-// cost load slots there and save nothing (compensated 8k sky, whose samples crowd onto the
-// sun's rows: single samples 8% faster without them; the AVX2 batch 1.5x to 2.5x of single
-// calls without, 1.3x to 1.5x with; AMD EPYC family 0x1a). An 8k sky's other rows hold
-// about 2^-12 each.
-inline constexpr uint32_t kHotRowUnits = kCdfUnits >> 10;
+// A row holding more than this many times the mean row's share of a 2D distribution
+// draws so many of the samples that its data stays in cache: the samplers skip their
+// prefetches in it, which take load slots there and save nothing. Measured on the
+// compensated 8k sky, whose samples crowd onto the sun's rows (each about 300 times the
+// mean; its other rows hold about the mean): single samples 15.4 ns without, 17.2-18.4 ns
+// with (AMD EPYC family 0x1a); on small maps, whose rows hold many times more of the
+// density each, a relative share keeps ordinary rows prefetched.
+inline constexpr uint32_t kHotRowFactor = 64;
 
 // A point found by inverting a CDF: the cell and the position inside it, in [0,1).
 struct CellHit {
@@ -81,7 +82,7 @@ struct CdfView {
     ENVMIS_HD CellHit invert(float u, Hint near_answer = {}) const noexcept {
         const float x = u * static_cast<float>(kCdfUnits);
         const auto t = static_cast<uint32_t>(x);
-        const uint32_t k = bucket(t);
+        const uint32_t k = bucket_of_unit(t);
         if constexpr (kPrefetch) {
             ENVMIS_PREFETCH(start + k);
             near_answer(k);
@@ -101,13 +102,13 @@ struct CdfView {
         return {lo, min(offset, kOneMinusEpsilon)};
     }
 
-    // The guide bucket of unit t (of u: t = u 2^31, truncated): where invert starts, for
-    // callers that prefetch its first reads (sample_many).
-    ENVMIS_HD uint32_t bucket(uint32_t t) const noexcept {
+    // The guide bucket of unit t, and of u (t = u 2^31, truncated): where invert starts,
+    // for callers that prefetch its first reads (sample_many).
+    ENVMIS_HD uint32_t bucket_of_unit(uint32_t t) const noexcept {
         return static_cast<uint32_t>((static_cast<uint64_t>(t) * n) >> 31);
     }
     ENVMIS_HD uint32_t bucket(float u) const noexcept {
-        return bucket(static_cast<uint32_t>(u * static_cast<float>(kCdfUnits)));
+        return bucket_of_unit(static_cast<uint32_t>(u * static_cast<float>(kCdfUnits)));
     }
 
     // The u that `invert` maps to (index, offset).
@@ -264,8 +265,14 @@ struct Distribution2DView {
         const Vec2 p{detail::point_in_cell(c.index, c.offset, w), detail::point_in_cell(r.index, r.offset, h)};
         return {p, pdf_of(marginal.width(r.index), cdf.width(c.index)), c.index, r.index};
     }
-    // True if row y holds more than kHotRowUnits: its data stays in cache.
-    ENVMIS_HD bool hot_row(uint32_t y) const noexcept { return marginal.width(y) > kHotRowUnits; }
+    // True if row y holds more than kHotRowFactor times the mean row's units: its data
+    // stays in cache. The same as marginal.width(y) > hot_row_units(), without a division.
+    ENVMIS_HD bool hot_row(uint32_t y) const noexcept {
+        return uint64_t{marginal.width(y)} * h > (uint64_t{kHotRowFactor} << 31);
+    }
+    ENVMIS_HD uint32_t hot_row_units() const noexcept {
+        return static_cast<uint32_t>(min((uint64_t{kHotRowFactor} << 31) / h, uint64_t{kCdfUnits}));
+    }
     ENVMIS_HD float pdf(Vec2 p) const noexcept {
         const uint32_t x = detail::cell_of(p.x, w), y = detail::cell_of(p.y, h);
         return pdf_of(marginal.width(y), row(y).width(x));

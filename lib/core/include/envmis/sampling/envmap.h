@@ -129,10 +129,16 @@ struct EnvMapView {
     // lookups to make (a batch of shading samples) overlaps their cache misses.
     ENVMIS_HD void prefetch_uv(Vec2 uv) const noexcept {
         const uint32_t x = detail::cell_of(uv.x, distribution.w), y = detail::cell_of(uv.y, distribution.h);
-        const size_t i = static_cast<size_t>(y) * distribution.w + x;
-        ENVMIS_PREFETCH(radiance + i);
-        ENVMIS_PREFETCH(distribution.start + i);
+        prefetch_texel(static_cast<size_t>(y) * distribution.w + x);
         ENVMIS_PREFETCH(distribution.marginal.start + y);
+    }
+    // The same for texel i (row-major) but its row's marginal entry: its radiance (both
+    // ends: a texel may straddle two cache lines), its CDF entry and the next (its width).
+    ENVMIS_HD void prefetch_texel(size_t i) const noexcept {
+        ENVMIS_PREFETCH(radiance + i);
+        ENVMIS_PREFETCH(&radiance[i].b);
+        ENVMIS_PREFETCH(distribution.start + i);
+        ENVMIS_PREFETCH(distribution.start + i + 1);  // one past the table at most: a prefetch does not fault
     }
     // Both at once, mapping the direction to the image once (MIS needs both).
     struct Lookup {
