@@ -253,6 +253,28 @@ TEST(PointInCell, IsTheNearestFloatInsideTheCellForEverySize) {
     }
 }
 
+// Points are placed with a multiplication by 1/n where the division would wait longer;
+// the two differ exactly when the quotient lies next to a midpoint between floats,
+// which is where the helper must fall back on the division. Quotients are aimed at
+// such midpoints (a few double ulps off), and the test checks that it met cases where
+// the product alone rounds the other way.
+TEST(QuotientToFloat, RoundsAsTheDoubleDivisionEvenNextToMidpointsBetweenFloats) {
+    Rng rng(29);
+    int product_alone_wrong = 0;
+    for (int i = 0; i < 200000; ++i) {
+        const uint32_t n = static_cast<uint32_t>(rng.engine()() % 65536) + 1;
+        const float f = rng.uniform(), next = std::nextafter(f, 2.0f);
+        double a = (static_cast<double>(f) + next) / 2 * n;
+        for (int step = static_cast<int>(rng.engine()() % 33) - 16; step != 0; step -= step > 0 ? 1 : -1)
+            a = std::nextafter(a, step > 0 ? 1e300 : -1e300);
+        if (i % 2) a = (rng.uniform() + static_cast<double>(rng.uniform()) * 0x1p-24) * n;  // anywhere
+        const float expected = static_cast<float>(a / n);
+        product_alone_wrong += static_cast<float>(a * (1.0 / n)) != expected;
+        ASSERT_EQ(detail::quotient_to_float(a, n), expected) << "a=" << a << " n=" << n;
+    }
+    EXPECT_GT(product_alone_wrong, 50);
+}
+
 TEST(Distribution1D, RejectsInvalidInput) {
     EXPECT_THROW(Distribution1D(std::vector<float>{}), std::invalid_argument);
     EXPECT_THROW(Distribution1D(std::vector<float>(65537, 1.0f)), std::invalid_argument);

@@ -131,6 +131,19 @@ ENVMIS_HD inline float offset_in_cell(float x, uint32_t i, uint32_t n) noexcept 
     return clamp(static_cast<float>(static_cast<double>(x) * n - i), 0.0f, kOneMinusEpsilon);
 }
 
+// float(a / n), the double quotient rounded to float, without the double division on
+// the sample's critical path: the product with 1/n lies within 3 double ulps of the
+// quotient, so both round to the same float unless the quotient is within a few ulps of
+// a midpoint between floats (their last 29 mantissa bits near 2^28; about one point in
+// 2^24), where the division decides.
+ENVMIS_HD inline float quotient_to_float(double a, uint32_t n) noexcept {
+    const double product = a * (1.0 / n);
+    const uint64_t below_float = bit_cast<uint64_t>(product) & ((uint64_t{1} << 29) - 1);
+    if (below_float - ((uint64_t{1} << 28) - 16) < 32) [[unlikely]]
+        return static_cast<float>(a / n);
+    return static_cast<float>(product);
+}
+
 // The float nearest (index + offset) / n that still lies in cell `index`: rounding to
 // float can step over a cell edge, and one step back always suffices because a cell is
 // many float ulps wide.
@@ -144,7 +157,7 @@ ENVMIS_HD inline float point_in_cell(uint32_t index, float offset, uint32_t n) n
         const float next_edge = (i + 1) * inv_n;
         return x < next_edge ? x : bit_cast<float>(bit_cast<uint32_t>(next_edge) - 1);
     }
-    float x = static_cast<float>((index + static_cast<double>(offset)) / n);
+    float x = quotient_to_float(index + static_cast<double>(offset), n);
     const uint32_t c = cell_of(x, n);
     if (c > index) x = ::nextafterf(x, 0.0f);
     if (c < index) x = ::nextafterf(x, 1.0f);
