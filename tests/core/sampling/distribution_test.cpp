@@ -183,6 +183,54 @@ TEST(Distribution2D, BuildDoesNotDependOnThreads) {
     }
 }
 
+// The coarse guide only steers prefetches, on tables beyond the cache; what it must hold
+// is every kCoarseGuideStep-th guide entry of each row, the last partial step included.
+// Tables of at least kCoarseGuideMinBytes (6 bytes a cell): 2057 x 1400 cells.
+constexpr uint32_t kCoarseW = 32 * kCoarseGuideStep + 9, kCoarseH = 1400;
+
+TEST(Distribution2D, LargeTablesHoldEveryStepthGuideEntryOfEachRowInTheCoarseGuide) {
+    const Distribution2D d(test::random_function(size_t{kCoarseW} * kCoarseH, 31, 6), kCoarseW, kCoarseH);
+    const Distribution2DView v = d.view();
+    ASSERT_NE(v.coarse, nullptr);
+    ASSERT_EQ(v.coarse_row_size(), 33u);
+    for (uint32_t y = 0; y < kCoarseH; ++y)
+        for (uint32_t j = 0; j < 33; ++j)
+            ASSERT_EQ(v.row(y).coarse[j], v.guide[size_t{y} * kCoarseW + j * kCoarseGuideStep]) << y << "," << j;
+    EXPECT_EQ(d.bytes(), (size_t{kCoarseW} * kCoarseH + kCoarseH) * 6 + size_t{33} * kCoarseH * 2);
+}
+
+TEST(Distribution2D, SmallTablesHaveNoCoarseGuide) {
+    const Distribution2D d(test::random_function(1000 * 500, 33), 1000, 500);
+    EXPECT_EQ(d.view().coarse, nullptr);
+    EXPECT_EQ(d.view().row(7).coarse, nullptr);
+    EXPECT_EQ(d.bytes(), (1000 * 500 + 500) * 6);
+}
+
+// Its prediction lies in the span of cells between the coarse entries around the
+// guide bucket, which holds the answer, whatever the function; where the CDF is linear
+// (a constant row) it is the answer itself, give or take one cell.
+TEST(Distribution2D, TheCoarsePredictionLiesInTheSpanThatHoldsTheAnswer) {
+    const uint32_t w = kCoarseW, h = kCoarseH;
+    std::vector<float> f = test::random_function(size_t{w} * h, 37, 8);
+    std::fill(f.begin() + w, f.begin() + 2 * w, 1.0f);  // row 1 constant
+    const Distribution2D d(f, w, h);
+    Rng rng(41);
+    for (const uint32_t y : {0u, 1u, 2u, h - 1}) {
+        const CdfView row = d.view().row(y);
+        for (int i = 0; i < 20000; ++i) {
+            const float u = i < 3 ? (i == 0 ? 0.0f : (i == 1 ? 0.5f : kOneMinusEpsilon)) : rng.uniform();
+            const uint32_t k = row.bucket(u), j = k / kCoarseGuideStep;
+            const uint32_t first = row.coarse[j], last = (j + 1) * kCoarseGuideStep < w ? row.coarse[j + 1] : w - 1;
+            const uint32_t answer = row.invert(u).index, predicted = row.predicted_cell(k);
+            ASSERT_LE(first, answer) << y << " " << u;
+            ASSERT_LE(answer, last) << y << " " << u;
+            ASSERT_LE(first, predicted) << y << " " << u;
+            ASSERT_LE(predicted, last) << y << " " << u;
+            if (y == 1) ASSERT_LE(std::max(answer, predicted) - std::min(answer, predicted), 1u) << u;
+        }
+    }
+}
+
 TEST(Distribution2D, RowFunctionExceptionsReachTheCaller) {
     EXPECT_THROW(Distribution2D(8, 64,
                                 [](uint32_t y, std::span<float>) {

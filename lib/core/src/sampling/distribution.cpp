@@ -249,6 +249,8 @@ Distribution2D::Distribution2D(uint32_t w, uint32_t h, LargeVector<uint32_t> cel
         throw std::invalid_argument("Distribution2D: " + std::to_string(start_.size()) + " cells for " +
                                     std::to_string(w) + "x" + std::to_string(h));
     guide_.resize(n);
+    const uint32_t coarse_row = n * 6 >= kCoarseGuideMinBytes ? (w + kCoarseGuideStep - 1) / kCoarseGuideStep : 0;
+    coarse_.resize(size_t{coarse_row} * h);
     marginal_start_.resize(h);
     marginal_guide_.resize(h);
     std::vector<double> row_sums(h);
@@ -266,6 +268,8 @@ Distribution2D::Distribution2D(uint32_t w, uint32_t h, LargeVector<uint32_t> cel
                 rows(y, std::span(start_).subspan(offset, w), row);
                 row_sums[y] = detail::build_cdf(row.data(), w, start_.data() + offset, guide_.data() + offset,
                                                 row_invalid[y], scratch);
+                for (uint32_t j = 0; j < coarse_row; ++j)
+                    coarse_[size_t{y} * coarse_row + j] = guide_[offset + size_t{j} * kCoarseGuideStep];
             }
         } catch (...) {
             const std::lock_guard lock(error_mutex);

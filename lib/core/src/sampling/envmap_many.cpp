@@ -44,18 +44,22 @@ void lookup_scalar(const EnvMapView& env, DirectionArrays in, LookupArrays out, 
         });
 }
 
+// What the column search in row y reads for guide bucket k: the guide entry, the CDF
+// where CdfView::invert would prefetch it, and the radiance there.
+void prefetch_column(const EnvMapView& env, uint32_t y, uint32_t k) noexcept {
+    const CdfView row = env.distribution.row(y);
+    const Rgb* radiance = env.radiance + static_cast<size_t>(y) * env.distribution.w;
+    ENVMIS_PREFETCH(row.guide + k);
+    row.prefetch_bucket(k, [radiance](uint32_t x) { ENVMIS_PREFETCH(radiance + x); });
+}
+
 // EnvMapView::sample in the two stages of Distribution2DView::sample: the row (the
-// marginal is small and stays in cache) with prefetches of what the column search reads
-// first (the guide entry and CDF at u.x's bucket) and of the radiance near it (none in
-// hot rows: Distribution2DView::hot_row); then the column and the rest.
+// marginal is small and stays in cache) with the column's prefetches (none in hot rows:
+// Distribution2DView::hot_row); then the column and the rest.
 CellHit find_row(const EnvMapView& env, Vec2 u) noexcept {
     const Distribution2DView& d = env.distribution;
     const CellHit r = d.marginal.invert(u.y);
-    if (d.hot_row(r.index)) return r;
-    const size_t near = static_cast<size_t>(r.index) * d.w + d.row(r.index).bucket(u.x);
-    ENVMIS_PREFETCH(d.guide + near);
-    ENVMIS_PREFETCH(d.start + near);
-    ENVMIS_PREFETCH(env.radiance + near);
+    if (!d.hot_row(r.index)) prefetch_column(env, r.index, d.row(r.index).bucket(u.x));
     return r;
 }
 
@@ -376,23 +380,22 @@ struct Rows8 {
 };
 
 // The rows of the eight points from lane l on; starts loading what the column search
-// reads first (the guide entry and CDF around the bucket) and the radiance near it, in
-// the lanes whose rows hold at most hot_units (Distribution2DView::hot_row_units).
+// reads (prefetch_column) in the lanes whose rows hold at most hot_units
+// (Distribution2DView::hot_row_units).
 ENVMIS_AVX2 Rows8 rows8(const EnvMapView& env, PointArrays in, uint32_t l, uint32_t hot_units) noexcept {
     const Distribution2DView& d = env.distribution;
     const I8 zero = _mm256_setzero_si256();
     const Hit8 r = search8(d.marginal.start, d.marginal.guide, zero, d.h, unit8(_mm256_loadu_ps(in.y + l), d.h));
     const Rows8 rows{r, _mm256_mullo_epi32(r.index, _mm256_set1_epi32(static_cast<int>(d.w))),
                      unit8(_mm256_loadu_ps(in.x + l), d.w)};
-    alignas(32) uint32_t near[8];
-    _mm256_store_si256(reinterpret_cast<I8*>(near), _mm256_add_epi32(rows.row, rows.column.k));
+    alignas(32) uint32_t y[8], k[8];
+    _mm256_store_si256(reinterpret_cast<I8*>(y), r.index);
+    _mm256_store_si256(reinterpret_cast<I8*>(k), rows.column.k);
     const I8 cap = _mm256_set1_epi32(static_cast<int>(hot_units));
     const I8 cold = _mm256_cmpeq_epi32(_mm256_min_epu32(r.width, cap), r.width);  // unsigned width <= cap
     for (auto m = static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(cold))); m != 0; m &= m - 1) {
-        const uint32_t i = near[__builtin_ctz(m)];
-        ENVMIS_PREFETCH(d.guide + i);
-        ENVMIS_PREFETCH(d.start + i);
-        ENVMIS_PREFETCH(env.radiance + i);
+        const int lane = __builtin_ctz(m);
+        prefetch_column(env, y[lane], k[lane]);
     }
     return rows;
 }

@@ -77,14 +77,14 @@ struct EnvMapView {
     const SinCos* turns = nullptr;  // make_turn_table() (fast_math.h)
     Mapping mapping = Mapping::equirect;
 
-    ENVMIS_HD EnvSample sample(Vec2 u) const noexcept {
+    ENVMIS_HD ENVMIS_INLINE EnvSample sample(Vec2 u) const noexcept {
         // Prefetching the radiance near the answer overlaps its load with the search's.
         const auto s = distribution.sample(u, [this](size_t i) { ENVMIS_PREFETCH(radiance + i); });
         return at(s.p, s.pdf, static_cast<size_t>(s.y) * distribution.w + s.x);
     }
     // The sample at image point p of texel `texel`, drawn with image-space density
     // image_pdf (by this map's distribution or another over the same texels: binned.h).
-    ENVMIS_HD EnvSample at(Vec2 p, float image_pdf, size_t texel) const noexcept {
+    ENVMIS_HD ENVMIS_INLINE EnvSample at(Vec2 p, float image_pdf, size_t texel) const noexcept {
         if (mapping == Mapping::equal_area) [[unlikely]]
             return at_equal_area(p, image_pdf, texel);
         const SinCos theta = sincos_half_turns(turns, p.y), phi = sincos_turns(turns, p.x);
