@@ -315,7 +315,12 @@ TEST(QuotientToFloat, RoundsAsTheDoubleDivisionEvenNextToMidpointsBetweenFloats)
         double a = (static_cast<double>(f) + next) / 2 * n;
         for (int step = static_cast<int>(rng.engine()() % 33) - 16; step != 0; step -= step > 0 ? 1 : -1)
             a = std::nextafter(a, step > 0 ? 1e300 : -1e300);
-        if (i % 2) a = (rng.uniform() + static_cast<double>(rng.uniform()) * 0x1p-24) * n;  // anywhere
+        if (i % 4 == 1) a = (rng.uniform() + static_cast<double>(rng.uniform()) * 0x1p-24) * n;  // anywhere
+        if (i % 4 == 3) {  // next to a midpoint between subnormal floats
+            const auto bits = static_cast<uint32_t>(rng.engine()() % ((1u << 23) - 1)) + 1;
+            a = (bit_cast<float>(bits) + static_cast<double>(bit_cast<float>(bits + 1))) / 2 * n;
+            a = std::nextafter(a, rng.uniform() < 0.5f ? 0.0 : 1e300);
+        }
         const float expected = static_cast<float>(a / n);
         product_alone_wrong += static_cast<float>(a * (1.0 / n)) != expected;
         ASSERT_EQ(detail::quotient_to_float(a, n), expected) << "a=" << a << " n=" << n;

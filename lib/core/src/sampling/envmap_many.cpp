@@ -339,7 +339,7 @@ ENVMIS_AVX2 Hit8 search8(const uint32_t* start, const uint16_t* guide, I8 base, 
 
 // (index + offset) / n in double, rounded to float, for four lanes: by the product with
 // 1/n, as detail::quotient_to_float, and by the division when a lane lies next to a
-// midpoint between floats.
+// midpoint between floats or below 2^-126.
 ENVMIS_AVX2 __m128 quotient4(__m128i index, __m128 offset, uint32_t n) noexcept {
     const __m256d sum = _mm256_add_pd(_mm256_cvtepi32_pd(index), _mm256_cvtps_pd(offset));
     const __m256d product = _mm256_mul_pd(sum, _mm256_set1_pd(1.0 / n));
@@ -347,7 +347,9 @@ ENVMIS_AVX2 __m128 quotient4(__m128i index, __m128 offset, uint32_t n) noexcept 
     const __m256i from_edge = _mm256_sub_epi64(below_float, _mm256_set1_epi64x((1ll << 28) - 16));
     const __m256i near_midpoint = _mm256_andnot_si256(_mm256_cmpgt_epi64(_mm256_setzero_si256(), from_edge),
                                                       _mm256_cmpgt_epi64(_mm256_set1_epi64x(32), from_edge));
-    if (!_mm256_testz_si256(near_midpoint, near_midpoint)) [[unlikely]]
+    const __m256i tiny = _mm256_castpd_si256(_mm256_cmp_pd(product, _mm256_set1_pd(0x1p-126), _CMP_LT_OQ));
+    const __m256i divide = _mm256_or_si256(near_midpoint, tiny);
+    if (!_mm256_testz_si256(divide, divide)) [[unlikely]]
         return _mm256_cvtpd_ps(_mm256_div_pd(sum, _mm256_set1_pd(static_cast<double>(n))));
     return _mm256_cvtpd_ps(product);
 }

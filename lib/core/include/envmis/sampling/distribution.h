@@ -54,7 +54,7 @@ inline constexpr uint32_t kHotRowFactor = 64;
 // in cache where the full guide (64 MiB) does not. A sample reads it to guess where in
 // the row its answer lies before the guide entry, a cache miss, says so: see
 // CdfView::invert. Built only where the tables (6 bytes a cell) reach
-// kCoarseGuideMinBytes, 4096 x 2048 cells and up: smaller ones stay in the last-level
+// kCoarseGuideMinBytes, about 2.8 million cells and up: smaller ones stay in the last-level
 // cache, where the guess costs more than it saves (a 1k map's compensated single
 // samples: 17.4-18.4 ns without, 19.5-20.2 ns with it; AMD EPYC family 0x1a).
 inline constexpr uint32_t kCoarseGuideStep = 64;
@@ -123,6 +123,9 @@ struct CdfView {
     ENVMIS_HD ENVMIS_INLINE void prefetch_bucket(uint32_t k, Hint near_answer) const noexcept {
         ENVMIS_PREFETCH(start + k);
         near_answer(k);
+#if defined(__CUDA_ARCH__)
+        return;  // no prefetches on the device: nor the coarse guide's reads for them
+#endif
         if (!coarse) return;
         const uint32_t p = predicted_cell(k);
         if (p / 16 == k / 16) return;
@@ -171,11 +174,12 @@ ENVMIS_HD inline float offset_in_cell(float x, uint32_t i, uint32_t n) noexcept 
 // the sample's critical path: the product with 1/n lies within 3 double ulps of the
 // quotient, so both round to the same float unless the quotient is within a few ulps of
 // a midpoint between floats (their last 29 mantissa bits near 2^28; about one point in
-// 2^24), where the division decides.
+// 2^24), where the division decides; so does it below 2^-126, where floats are
+// subnormal and their midpoints lie elsewhere in the bits.
 ENVMIS_HD inline float quotient_to_float(double a, uint32_t n) noexcept {
     const double product = a * (1.0 / n);
     const uint64_t below_float = bit_cast<uint64_t>(product) & ((uint64_t{1} << 29) - 1);
-    if (below_float - ((uint64_t{1} << 28) - 16) < 32) [[unlikely]]
+    if (below_float - ((uint64_t{1} << 28) - 16) < 32 || product < 0x1p-126) [[unlikely]]
         return static_cast<float>(a / n);
     return static_cast<float>(product);
 }
