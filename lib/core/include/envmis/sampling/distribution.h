@@ -54,9 +54,9 @@ inline constexpr uint32_t kHotRowFactor = 64;
 // in cache where the full guide (64 MiB) does not. A sample reads it to guess where in
 // the row its answer lies before the guide entry, a cache miss, says so: see
 // CdfView::invert. Built only where the tables (6 bytes a cell) reach
-// kCoarseGuideMinBytes, about 2.8 million cells and up: smaller ones stay in the last-level
-// cache, where the guess costs more than it saves (a 1k map's compensated single
-// samples: 17.4-18.4 ns without, 19.5-20.2 ns with it; AMD EPYC family 0x1a).
+// kCoarseGuideMinBytes, about 2.8 million cells and up: smaller ones stay in the
+// last-level cache, where it has little to hide (a 1k map, one process, with against
+// without it: compensated 0.99-1.00x, plain 1.05-1.06x; AMD EPYC family 0x1a).
 inline constexpr uint32_t kCoarseGuideStep = 64;
 inline constexpr size_t kCoarseGuideMinBytes = size_t{16} << 20;
 
