@@ -249,7 +249,7 @@ Distribution2D::Distribution2D(uint32_t w, uint32_t h, LargeVector<uint32_t> cel
         throw std::invalid_argument("Distribution2D: " + std::to_string(start_.size()) + " cells for " +
                                     std::to_string(w) + "x" + std::to_string(h));
     guide_.resize(n);
-    const uint32_t coarse_row = n * 6 >= kCoarseGuideMinBytes ? (w + kCoarseGuideStep - 1) / kCoarseGuideStep : 0;
+    const uint32_t coarse_row = n * 6 >= kCoarseGuideMinBytes ? coarse_guide_size(w) : 0;
     coarse_.resize(size_t{coarse_row} * h);
     marginal_start_.resize(h);
     marginal_guide_.resize(h);

@@ -59,6 +59,10 @@ inline constexpr uint32_t kHotRowFactor = 64;
 // without it: compensated 0.99-1.00x, plain 1.05-1.06x; AMD EPYC family 0x1a).
 inline constexpr uint32_t kCoarseGuideStep = 64;
 inline constexpr size_t kCoarseGuideMinBytes = size_t{16} << 20;
+// Coarse guide entries of a row of w cells (the last step may be shorter).
+ENVMIS_HD inline uint32_t coarse_guide_size(uint32_t w) noexcept {
+    return (w + kCoarseGuideStep - 1) / kCoarseGuideStep;
+}
 
 // A point found by inverting a CDF: the cell and the position inside it, in [0,1).
 struct CellHit {
@@ -304,7 +308,7 @@ struct Distribution2DView {
         return {start + offset, guide + offset, w,
                 coarse ? coarse + static_cast<size_t>(y) * coarse_row_size() : nullptr};
     }
-    ENVMIS_HD uint32_t coarse_row_size() const noexcept { return (w + kCoarseGuideStep - 1) / kCoarseGuideStep; }
+    ENVMIS_HD uint32_t coarse_row_size() const noexcept { return coarse_guide_size(w); }
     // u.y picks the row, u.x the column within it. `near_answer(i)` is told the
     // row-major index i = y w + x of a cell usually near the one sampled (see
     // CdfView::invert), for the caller to prefetch its data.
