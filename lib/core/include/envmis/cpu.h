@@ -41,16 +41,18 @@ struct BatchPaths {
     std::string forced;
     bool unavailable = false;
 };
-// The rules, measured (envmis bench, 8k sky, ratios within one run): lookup_many's AVX2
-// kernel wherever AVX2 is usable (on AMD family 0x1a it beat the scalar pipeline, 0.96-1.33x
-// against 0.31-0.63x of single pdf calls); sample_many's AVX2 kernel on Intel (8.5x on the
-// Xeon) and AMD from family 0x1a on (there, over single calls: compensated sky about 1.5x
-// against the scalar pipeline's 0.95x, plain about 4x against 2.6x), the scalar pipeline
-// on older AMD families, whose gathers are slower (not measured); the estimator's lanes
-// (arithmetic, no gathers of their own) wherever AVX2 is usable. No AVX-512 path: much of
-// the kernels' time goes to gathers, and on AMD family 0x1a one 16-lane gather of eight
-// 64-bit pairs took 1.7x the time of the two 8-lane AVX2 gathers of the same pairs
-// (docs/performance-log.md, 2026-12-02).
+// The rules, measured (envmis bench, 8k sky, ratios within one run; docs/performance.md):
+// - lookup_many's AVX2 kernel wherever AVX2 is usable: over single pdf calls, 0.96-1.33x
+//   against the scalar pipeline's 0.31-0.63x on AMD family 0x1a, 3.2-3.5x against 1.5-1.7x
+//   on family 0x19 model 0x11;
+// - sample_many's AVX2 kernel on Intel (8.5x the textbook on the Xeon) and AMD from
+//   family 0x19 on (over single calls, compensated sky: about 1.5x against the scalar
+//   pipeline's 0.95x on 0x1a, 1.6x against 0.78x on 0x19; plain: 4x against 2.6x, 2.0x
+//   against 1.4x); the scalar pipeline on older AMD families (not measured);
+// - the estimator's lanes (arithmetic, no gathers of their own) wherever AVX2 is usable.
+// No AVX-512 path: much of the kernels' time goes to gathers, and on AMD family 0x1a one
+// 16-lane gather of eight 64-bit pairs took 1.7x the time of the two 8-lane AVX2 gathers
+// of the same pairs (docs/performance-log.md, 2026-12-02).
 BatchPaths choose_batch_paths(const CpuInfo& cpu, std::string_view forced);
 // choose_batch_paths(cpu_info(), ENVMIS_SIMD), once.
 const BatchPaths& batch_paths() noexcept;
