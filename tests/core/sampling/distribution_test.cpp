@@ -293,7 +293,11 @@ TEST(PointInCell, IsTheNearestFloatInsideTheCellForEverySize) {
     for (uint32_t n : {1u, 2u, 3u, 7u, 64u, 1000u, 1024u, 4096u, 8191u, 8192u, 65535u, 65536u}) {
         for (int i = 0; i < 20000; ++i) {
             const uint32_t index = std::min(static_cast<uint32_t>(rng.uniform() * n), n - 1);
-            const float offset = i % 4 == 0 ? kOneMinusEpsilon : (i % 4 == 1 ? 0.0f : rng.uniform());
+            // At the edges, a few float ulps of x from them (where rounding x can cross an
+            // edge), and anywhere.
+            const float near_edge = static_cast<float>(n) * 0x1p-24f * (0.25f + 2 * rng.uniform());
+            const float offsets[5] = {kOneMinusEpsilon, 0.0f, near_edge, 1.0f - near_edge, rng.uniform()};
+            const float offset = std::min(offsets[i % 5], kOneMinusEpsilon);
             const float x = detail::point_in_cell(index, offset, n);
             ASSERT_EQ(x, reference(index, offset, n)) << "n=" << n << " index=" << index << " offset=" << offset;
             ASSERT_EQ(detail::cell_of(x, n), index);
