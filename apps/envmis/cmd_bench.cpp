@@ -49,6 +49,8 @@ double ns_per_call(const std::vector<Input>& inputs, Call&& call) {
 float every_output(const EnvSample& s) {
     return s.pdf + s.direction.x + s.direction.y + s.direction.z + s.radiance.r + s.radiance.g + s.radiance.b;
 }
+// The same for a single lookup call: what lookup_many writes for a direction.
+float every_output(const EnvMapView::Lookup& l) { return l.pdf + l.radiance.r + l.radiance.g + l.radiance.b; }
 
 // The inputs of sample_many and lookup_many: one array per coordinate, and outputs for
 // a batch of kBatch.
@@ -218,7 +220,9 @@ BenchPoints bench_points(uint32_t n, bool normals, uint32_t samples_per_normal) 
 struct BenchResult {
     std::vector<Timing> timings;
     double build = 0, sample = 0, pdf = 0, batch_sample = 0, batch_pdf = 0;  // speedups
-    double batch_over_single_sample = 0, batch_over_single_pdf = 0;          // the batch calls' speedups
+    // The batch calls' speedups: sample_many over single samples, lookup_many over single
+    // pdf calls (which leave the radiance out) and over single lookups (the same work).
+    double batch_over_single_sample = 0, batch_over_single_pdf = 0, batch_over_single_lookup = 0;
 };
 
 // Sampling and pdf times of the two samplers, back to back in each repeat, so that the
@@ -230,7 +234,7 @@ struct BenchResult {
 // textbook pdf, batch sample, batch lookup; ratios: textbook over the others, then the
 // batch calls' speedups over the single calls (sample, and lookup over pdf).
 struct CallTimes {
-    std::vector<double> times[6], ratios[6];
+    std::vector<double> times[7], ratios[7];
 };
 
 CallTimes time_calls(const EnvMap& guided, const reference::TextbookEnvMap& textbook, const BenchPoints& points,
@@ -242,19 +246,23 @@ CallTimes time_calls(const EnvMap& guided, const reference::TextbookEnvMap& text
         return ns_per_call(points.directions, [&](Vec3 d) { return sampler.pdf(d); });
     };
     const EnvMapView view = guided.view();
+    const auto lookup_cost = [&] {
+        return ns_per_call(points.directions, [&](Vec3 d) { return every_output(view.lookup(d)); });
+    };
     BatchInputs batch(points.us, points.directions);
     CallTimes c;
     for (int r = 0; r < repeats; ++r) {
         throw_if_interrupted();
-        const double t[6] = {sample_cost(view),  sample_cost(textbook),   pdf_cost(view),
-                             pdf_cost(textbook), batch.sample_cost(view), batch.lookup_cost(view)};
-        for (int k = 0; k < 6; ++k) c.times[k].push_back(t[k]);
+        const double t[7] = {sample_cost(view),       sample_cost(textbook),   pdf_cost(view), pdf_cost(textbook),
+                             batch.sample_cost(view), batch.lookup_cost(view), lookup_cost()};
+        for (int k = 0; k < 7; ++k) c.times[k].push_back(t[k]);
         c.ratios[0].push_back(t[1] / t[0]);
         c.ratios[1].push_back(t[3] / t[2]);
         c.ratios[2].push_back(t[1] / t[4]);
         c.ratios[3].push_back(t[3] / t[5]);
         c.ratios[4].push_back(t[0] / t[4]);
         c.ratios[5].push_back(t[2] / t[5]);
+        c.ratios[6].push_back(t[6] / t[5]);
         progress.update(++step);
     }
     return c;
@@ -283,6 +291,7 @@ BenchResult measure(const RgbImage& image, const EnvMapOptions& options, const B
     result.batch_pdf = median(c.ratios[3]);
     result.batch_over_single_sample = median(c.ratios[4]);
     result.batch_over_single_pdf = median(c.ratios[5]);
+    result.batch_over_single_lookup = median(c.ratios[6]);
     return result;
 }
 
@@ -298,7 +307,8 @@ struct BinnedResult {
     double build_ms[3] = {}, bytes[3] = {};  // plain, compensated, bins (bins alone)
     double ns[3][4] = {};                    // per sampler and kind of call
     double ratio[2][4] = {};                 // binned over plain, over compensated
-    double batch_speedup[3][2] = {};         // per sampler: single sample / batch, single pdf / batch lookup
+    double lookup_ns[3] = {};                // per sampler: a single lookup (pdf and radiance)
+    double batch_speedup[3][3] = {};         // per sampler: single sample, pdf, lookup / batch
 };
 
 // ns per call of the three samplers, back to back in each repeat; lobe class 0.
@@ -310,35 +320,43 @@ void time_binned_calls(const EnvMapView (&today)[2], const BinnedEnvMapView& bin
         samples.emplace_back(points.us[i], points.normals[i]),
             pdfs.emplace_back(points.directions[i], points.normals[i]);
     BatchInputs batch(points.us, points.directions, points.normals);
-    std::vector<double> ns[3][4], ratio[2][4], speedup[3][2];
+    std::vector<double> ns[3][4], ratio[2][4], lookup_ns[3], speedup[3][3];
     for (int r = 0; r < repeats; ++r) {
         throw_if_interrupted();
-        double t[3][4];
+        double t[3][4], lookup[3];
         for (int k = 0; k < 2; ++k) {
             t[k][0] = ns_per_call(samples, [&](const auto& in) { return every_output(today[k].sample(in.first)); });
             t[k][1] = ns_per_call(pdfs, [&](const auto& in) { return today[k].pdf(in.first); });
             t[k][2] = batch.sample_cost(today[k]);
             t[k][3] = batch.lookup_cost(today[k]);
+            lookup[k] = ns_per_call(pdfs, [&](const auto& in) { return every_output(today[k].lookup(in.first)); });
         }
         t[2][0] =
             ns_per_call(samples, [&](const auto& in) { return every_output(binned.sample(in.second, 0, in.first)); });
         t[2][1] = ns_per_call(pdfs, [&](const auto& in) { return binned.pdf(in.second, 0, in.first); });
         t[2][2] = batch.sample_cost(binned, 0);
         t[2][3] = batch.lookup_cost(binned, 0);
+        lookup[2] =
+            ns_per_call(pdfs, [&](const auto& in) { return every_output(binned.lookup(in.second, 0, in.first)); });
         for (int c = 0; c < 4; ++c) {
             for (int k = 0; k < 3; ++k) ns[k][c].push_back(t[k][c]);
             for (int k = 0; k < 2; ++k) ratio[k][c].push_back(t[2][c] / t[k][c]);
         }
-        for (int k = 0; k < 3; ++k)
+        for (int k = 0; k < 3; ++k) {
+            lookup_ns[k].push_back(lookup[k]);
             speedup[k][0].push_back(t[k][0] / t[k][2]), speedup[k][1].push_back(t[k][1] / t[k][3]);
+            speedup[k][2].push_back(lookup[k] / t[k][3]);
+        }
         progress.update(++step);
     }
     for (int c = 0; c < 4; ++c) {
         for (int k = 0; k < 3; ++k) result.ns[k][c] = median(ns[k][c]);
         for (int k = 0; k < 2; ++k) result.ratio[k][c] = median(ratio[k][c]);
     }
-    for (int k = 0; k < 3; ++k)
-        for (int c = 0; c < 2; ++c) result.batch_speedup[k][c] = median(speedup[k][c]);
+    for (int k = 0; k < 3; ++k) {
+        result.lookup_ns[k] = median(lookup_ns[k]);
+        for (int c = 0; c < 3; ++c) result.batch_speedup[k][c] = median(speedup[k][c]);
+    }
 }
 
 BinnedResult measure_binned(const RgbImage& image, uint32_t bins, const BenchPoints& points, int repeats) {
@@ -386,7 +404,10 @@ nlohmann::json binned_json(const BinnedResult& b) {
     for (int k = 0; k < 3; ++k) {
         nlohmann::json s = {{"sampler", kBinnedSamplers[k]}, {"build_ms", b.build_ms[k]}, {"bytes", b.bytes[k]}};
         for (int c = 0; c < 4; ++c) s[std::string("ns_per_") + kCallNames[c]] = b.ns[k][c];
-        s["batch_over_single"] = {{"sample", b.batch_speedup[k][0]}, {"lookup_over_pdf", b.batch_speedup[k][1]}};
+        s["ns_per_lookup"] = b.lookup_ns[k];
+        s["batch_over_single"] = {{"sample", b.batch_speedup[k][0]},
+                                  {"lookup_over_pdf", b.batch_speedup[k][1]},
+                                  {"lookup_over_lookup", b.batch_speedup[k][2]}};
         j["samplers"].push_back(s);
     }
     for (int k = 0; k < 2; ++k)
@@ -403,10 +424,11 @@ void print_binned_text(const BinnedResult& b) {
         b.bins, b.cells_w, b.cells_h, b.samples_per_normal);
     for (int k = 0; k < 3; ++k)
         std::printf(
-            "sampler=%s build_ms=%.1f ns_per_sample=%.1f ns_per_pdf=%.1f ns_per_batch_sample=%.1f "
-            "ns_per_batch_lookup=%.1f bytes=%.0f batch_over_single sample=%.2fx lookup_over_pdf=%.2fx\n",
-            kBinnedSamplers[k], b.build_ms[k], b.ns[k][0], b.ns[k][1], b.ns[k][2], b.ns[k][3], b.bytes[k],
-            b.batch_speedup[k][0], b.batch_speedup[k][1]);
+            "sampler=%s build_ms=%.1f ns_per_sample=%.1f ns_per_pdf=%.1f ns_per_lookup=%.1f ns_per_batch_sample=%.1f "
+            "ns_per_batch_lookup=%.1f bytes=%.0f batch_over_single sample=%.2fx lookup_over_pdf=%.2fx "
+            "lookup_over_lookup=%.2fx\n",
+            kBinnedSamplers[k], b.build_ms[k], b.ns[k][0], b.ns[k][1], b.lookup_ns[k], b.ns[k][2], b.ns[k][3],
+            b.bytes[k], b.batch_speedup[k][0], b.batch_speedup[k][1], b.batch_speedup[k][2]);
     for (int k = 0; k < 2; ++k) {
         std::printf("binned_over_%s sample=%.2fx pdf=%.2fx batch_sample=%.2fx batch_lookup=%.2fx", kBinnedSamplers[k],
                     b.ratio[k][0], b.ratio[k][1], b.ratio[k][2], b.ratio[k][3]);
@@ -446,7 +468,8 @@ void print_bench_json(const BenchArgs& args, const BenchMap& map, const BenchRes
                                 {"batch_sample", result.batch_sample},
                                 {"batch_pdf", result.batch_pdf}};
     j["batch_over_single"] = {{"sample", result.batch_over_single_sample},
-                              {"lookup_over_pdf", result.batch_over_single_pdf}};
+                              {"lookup_over_pdf", result.batch_over_single_pdf},
+                              {"lookup_over_lookup", result.batch_over_single_lookup}};
     if (binned) j["binned"] = binned_json(*binned);
     std::cout << j.dump(2) << "\n";
 }
@@ -464,9 +487,10 @@ void print_bench_text(const BenchArgs& args, const BenchMap& map, const BenchRes
         "batch_pdf=%.2fx (sample, pdf: median of the ratios within each repeat)\n",
         result.build, result.sample, result.pdf, result.batch_sample, result.batch_pdf);
     std::printf(
-        "batch_over_single sample=%.2fx lookup_over_pdf=%.2fx (guided-batch against guided: single sample over "
-        "sample_many, single pdf over lookup_many; median of the ratios within each repeat)\n",
-        result.batch_over_single_sample, result.batch_over_single_pdf);
+        "batch_over_single sample=%.2fx lookup_over_pdf=%.2fx lookup_over_lookup=%.2fx (guided-batch against guided: "
+        "single sample over sample_many, single pdf, and single lookup (pdf and radiance), over lookup_many; median "
+        "of the ratios within each repeat)\n",
+        result.batch_over_single_sample, result.batch_over_single_pdf, result.batch_over_single_lookup);
     if (binned) print_binned_text(*binned);
 }
 

@@ -293,6 +293,9 @@ TEST_F(Cli, BenchPrintsOneLinePerSamplerWithTheDocumentedFields) {
     EXPECT_TRUE(contains(r.out, "\\nspeedup_vs_textbook build=" + number + "x sample=" + number + "x pdf=" + number +
                                     "x batch_sample=" + number + "x batch_pdf=" + number + "x "))
         << r;
+    EXPECT_TRUE(contains(r.out, "\\nbatch_over_single sample=" + number + "x lookup_over_pdf=" + number +
+                                    "x lookup_over_lookup=" + number + "x "))
+        << r;
 }
 
 TEST_F(Cli, VisualizeWithANormalAddsTheBinnedPanelToTheSamePicture) {
@@ -318,8 +321,9 @@ TEST_F(Cli, BenchWithBinsAddsTheBinnedSamplerAgainstTodaysMaps) {
     for (const char* sampler : {"plain", "compensated", "binned"})
         EXPECT_TRUE(contains(
             r.out, std::string("\\nsampler=") + sampler + " build_ms=" + number + " ns_per_sample=" + number +
-                       " ns_per_pdf=" + number + " ns_per_batch_sample=" + number + " ns_per_batch_lookup=" + number +
-                       " bytes=[0-9]+ batch_over_single sample=" + number + "x lookup_over_pdf=" + number + "x\\n"))
+                       " ns_per_pdf=" + number + " ns_per_lookup=" + number + " ns_per_batch_sample=" + number +
+                       " ns_per_batch_lookup=" + number + " bytes=[0-9]+ batch_over_single sample=" + number +
+                       "x lookup_over_pdf=" + number + "x lookup_over_lookup=" + number + "x\\n"))
             << sampler << r;
     EXPECT_TRUE(contains(r.out, "\\nbinned_over_compensated sample=" + number + "x pdf=" + number +
                                     "x batch_sample=" + number + "x batch_lookup=" + number + "x build=" + number +
@@ -354,6 +358,8 @@ TEST_F(Cli, BenchJsonIsOneObjectWithTheSameFields) {
             EXPECT_TRUE(s.at(field).is_number() && s[field].get<double>() > 0) << field << r;
     for (const char* field : {"build", "sample", "pdf", "batch_sample", "batch_pdf"})
         EXPECT_TRUE(j.at("speedup_vs_textbook").at(field).is_number()) << field;
+    for (const char* field : {"sample", "lookup_over_pdf", "lookup_over_lookup"})
+        EXPECT_GT(j.at("batch_over_single").at(field).get<double>(), 0) << field << r;
 }
 
 // ---------------------------------------------------------------------------------
