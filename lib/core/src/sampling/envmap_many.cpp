@@ -18,6 +18,7 @@
 
 #include <algorithm>
 
+#include "detail/cell8.h"
 #include "detail/pipeline.h"
 #include "detail/simd.h"
 #include "envmis/cpu.h"
@@ -110,15 +111,6 @@ ENVMIS_AVX2 F8 atan2_8(F8 y, F8 x) noexcept {
     a = select(swap, _mm256_sub_ps(splat(kPiF / 2), a), a);
     a = select(less(x, splat(0.0f)), _mm256_sub_ps(splat(kPiF), a), a);
     return _mm256_or_ps(abs8(a), _mm256_and_ps(splat(-0.0f), y));  // copysign(a, y)
-}
-
-// detail::cell_of: the product in double, truncated, at most n - 1.
-ENVMIS_AVX2 I8 cell8(F8 x, uint32_t n) noexcept {
-    const F8 c = clamp8(x, 0.0f, 1.0f);
-    const __m256d dn = _mm256_set1_pd(static_cast<double>(n));
-    const __m128i lo = _mm256_cvttpd_epi32(_mm256_mul_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(c)), dn));
-    const __m128i hi = _mm256_cvttpd_epi32(_mm256_mul_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(c, 1)), dn));
-    return _mm256_min_epu32(_mm256_set_m128i(hi, lo), _mm256_set1_epi32(static_cast<int>(n - 1)));
 }
 
 ENVMIS_AVX2 I8 gather(const uint32_t* a, I8 i) noexcept {
@@ -335,42 +327,6 @@ ENVMIS_AVX2 Hit8 search8(const uint32_t* start, const uint16_t* guide, I8 base, 
     const F8 offset = _mm256_div_ps(_mm256_add_ps(_mm256_cvtepi32_ps(before), _mm256_sub_ps(x, _mm256_cvtepi32_ps(t))),
                                     width_to_float(cell.width));
     return {lo, select(less(splat(kOneMinusEpsilon), offset), splat(kOneMinusEpsilon), offset), cell.width};
-}
-
-// (index + offset) / n in double, rounded to float, for four lanes: by the product with
-// 1/n, as detail::quotient_to_float, and by the division when a lane lies next to a
-// midpoint between floats or below 2^-126.
-ENVMIS_AVX2 __m128 quotient4(__m128i index, __m128 offset, uint32_t n) noexcept {
-    const __m256d sum = _mm256_add_pd(_mm256_cvtepi32_pd(index), _mm256_cvtps_pd(offset));
-    const __m256d product = _mm256_mul_pd(sum, _mm256_set1_pd(1.0 / n));
-    const __m256i below_float = _mm256_and_si256(_mm256_castpd_si256(product), _mm256_set1_epi64x((1ll << 29) - 1));
-    const __m256i from_edge = _mm256_sub_epi64(below_float, _mm256_set1_epi64x((1ll << 28) - 16));
-    const __m256i near_midpoint = _mm256_andnot_si256(_mm256_cmpgt_epi64(_mm256_setzero_si256(), from_edge),
-                                                      _mm256_cmpgt_epi64(_mm256_set1_epi64x(32), from_edge));
-    const __m256i tiny = _mm256_castpd_si256(_mm256_cmp_pd(product, _mm256_set1_pd(0x1p-126), _CMP_LT_OQ));
-    const __m256i divide = _mm256_or_si256(near_midpoint, tiny);
-    if (!_mm256_testz_si256(divide, divide)) [[unlikely]]
-        return _mm256_cvtpd_ps(_mm256_div_pd(sum, _mm256_set1_pd(static_cast<double>(n))));
-    return _mm256_cvtpd_ps(product);
-}
-
-// detail::point_in_cell, both of its cases.
-ENVMIS_AVX2 F8 point_in_cell8(I8 index, F8 offset, uint32_t n) noexcept {
-    const F8 i = _mm256_cvtepi32_ps(index);
-    if ((n & (n - 1)) == 0) {
-        const F8 inv_n = splat(1.0f / static_cast<float>(n));
-        const F8 x = _mm256_add_ps(_mm256_mul_ps(i, inv_n), _mm256_mul_ps(offset, inv_n));
-        const F8 next_edge = _mm256_mul_ps(_mm256_add_ps(i, splat(1.0f)), inv_n);
-        const F8 below = _mm256_castsi256_ps(_mm256_sub_epi32(_mm256_castps_si256(next_edge), _mm256_set1_epi32(1)));
-        return select(less(x, next_edge), x, below);
-    }
-    const F8 x = _mm256_set_m128(quotient4(_mm256_extracti128_si256(index, 1), _mm256_extractf128_ps(offset, 1), n),
-                                 quotient4(_mm256_castsi256_si128(index), _mm256_castps256_ps128(offset), n));
-    // One float step towards the cell where rounding left it (x > 0 in the first case,
-    // x < 1 in the second, so the step is an increment of its bits).
-    const I8 c = cell8(x, n);
-    const I8 step = _mm256_sub_epi32(_mm256_cmpgt_epi32(index, c), _mm256_cmpgt_epi32(c, index));
-    return clamp8(_mm256_castsi256_ps(_mm256_sub_epi32(_mm256_castps_si256(x), step)), 0.0f, kOneMinusEpsilon);
 }
 
 // Eight points of EnvMapView::sample with their rows found (the marginal is small and
