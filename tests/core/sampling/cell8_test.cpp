@@ -110,16 +110,17 @@ TEST_F(PointInCell8, DividesWhereTheProductWithTheReciprocalRoundsTheOtherWay) {
     EXPECT_GT(wrong, 1000);  // the test met the branch it is for
 }
 
-// Quotients below 2^-126 (cell 0, offsets below 2^-126 n) round to subnormal floats, and
-// point_in_cell8 divides for them as quotient_to_float does. For these inputs the product
-// would round the same way: a float offset is a multiple of 2^-149, so the quotient either
-// lies on a subnormal midpoint exactly, where the product is exact too, or at least 2^-40
-// of its size away from one. The lanes check that the division's branch gives the scalar
-// call's bits: every offset that puts the quotient on a midpoint, (2j + 1) m 2^(s - 150)
-// for n = 2^s m, and random ones.
-TEST_F(PointInCell8, GivesTheScalarPointBelowTheSmallestNormalFloat) {
+// Quotients below 2^-126 (cell 0, offsets below 2^-126 n) round to subnormal floats, whose
+// midpoints lie elsewhere in a double's bits than where the guard of the test above looks.
+// A float offset is a multiple of 2^-149, so the quotient is either exactly on a subnormal
+// midpoint or at least 2^-40 of its size away from one: only the exact hits can round
+// the other way by the product. For n = 2^s m (s >= 1, m odd) they are the offsets
+// (2j + 1) m 2^(s - 150) with (2j + 1) m < 2^24 (odd n have none); the lanes hold all of them, and random
+// tiny offsets. For n = 98 and 246 the product alone rounds wrongly in tens of thousands.
+TEST_F(PointInCell8, DividesBelowTheSmallestNormalFloat) {
     Rng rng(47);
-    for (uint32_t n : {6u, 1000u, 5792u, 65534u}) {
+    int wrong = 0;
+    for (uint32_t n : {98u, 246u, 1000u, 5792u}) {
         const int s = __builtin_ctz(n);
         const uint32_t m = n >> s;
         Lanes lanes;
@@ -127,9 +128,10 @@ TEST_F(PointInCell8, GivesTheScalarPointBelowTheSmallestNormalFloat) {
             lanes.add(0, std::ldexp(static_cast<float>(odd * m), s - 150));
         for (int i = 0; i < 2000; ++i)  // up to 2^-101
             lanes.add(0, bit_cast<float>(static_cast<uint32_t>(rng.engine()() % (27u << 23)) + 1));
-        EXPECT_EQ(product_alone_wrong(lanes, n), 0) << n;
+        wrong += product_alone_wrong(lanes, n);
         expect_scalar_points(lanes, n);
     }
+    EXPECT_GT(wrong, 1000);  // the test met the branch it is for
 }
 
 }  // namespace

@@ -22,9 +22,7 @@ ENVMIS_AVX2 inline I8 cell8(F8 x, uint32_t n) noexcept {
 
 // (index + offset) / n in double, rounded to float, for four lanes: by the product with
 // 1/n, as detail::quotient_to_float, and by the division when a lane lies next to a
-// midpoint between floats or below 2^-126 (where, for a float offset, the product rounds
-// the same way: tests/core/sampling/cell8_test.cpp; the guard keeps this the twin of the
-// scalar helper, whose contract takes any double).
+// midpoint between floats or below 2^-126.
 ENVMIS_AVX2 inline __m128 quotient4(__m128i index, __m128 offset, uint32_t n) noexcept {
     const __m256d sum = _mm256_add_pd(_mm256_cvtepi32_pd(index), _mm256_cvtps_pd(offset));
     const __m256d product = _mm256_mul_pd(sum, _mm256_set1_pd(1.0 / n));
