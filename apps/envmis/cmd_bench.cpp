@@ -231,8 +231,9 @@ struct BenchResult {
 // read once, not rebuilt from the map at every call); guided-batch is the same sampler
 // through sample_many and lookup_many (the latter finds the radiance too), as a
 // wavefront renderer would call it. times: guided sample, textbook sample, guided pdf,
-// textbook pdf, batch sample, batch lookup; ratios: textbook over the others, then the
-// batch calls' speedups over the single calls (sample, and lookup over pdf).
+// textbook pdf, batch sample, batch lookup, guided single lookup; ratios: textbook over
+// the others, then the batch calls' speedups over the single calls (sample, lookup over
+// pdf, lookup over single lookup).
 struct CallTimes {
     std::vector<double> times[7], ratios[7];
 };

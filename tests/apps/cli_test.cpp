@@ -337,6 +337,11 @@ TEST_F(Cli, BenchWithBinsAddsTheBinnedSamplerAgainstTodaysMaps) {
     ASSERT_EQ(binned.at("samplers").size(), 3u);
     for (const char* field : {"sample", "pdf", "batch_sample", "batch_lookup", "build", "memory"})
         EXPECT_GT(binned.at("binned_over_compensated").at(field).get<double>(), 0) << field << j;
+    for (const auto& s : binned.at("samplers")) {
+        EXPECT_GT(s.at("ns_per_lookup").get<double>(), 0) << j;
+        for (const char* field : {"sample", "lookup_over_pdf", "lookup_over_lookup"})
+            EXPECT_GT(s.at("batch_over_single").at(field).get<double>(), 0) << field << j;
+    }
 }
 
 TEST_F(Cli, BenchJsonIsOneObjectWithTheSameFields) {

@@ -126,7 +126,7 @@ TEST_F(PointInCell8, DividesBelowTheSmallestNormalFloat) {
         Lanes lanes;
         for (uint32_t odd = 1; odd * m < (1u << 24); odd += 2)
             lanes.add(0, std::ldexp(static_cast<float>(odd * m), s - 150));
-        for (int i = 0; i < 2000; ++i)  // up to 2^-101
+        for (int i = 0; i < 2000; ++i)  // below 2^-100
             lanes.add(0, bit_cast<float>(static_cast<uint32_t>(rng.engine()() % (27u << 23)) + 1));
         wrong += product_alone_wrong(lanes, n);
         expect_scalar_points(lanes, n);

@@ -112,9 +112,9 @@ BatchPaths choose_batch_paths(const CpuInfo& cpu, std::string_view forced) {
     // (about 40 micro-ops each) and the AVX2 sampler still wins, its time going to memory;
     // family 0x17 (Zen 1 and 2, 256-bit work split in halves) is not measured here: the
     // scalar pipeline is the safe choice there.
-    const bool fast_gathers = cpu.vendor == "GenuineIntel" || (cpu.vendor == "AuthenticAMD" && cpu.family >= 0x19);
+    const bool gathers_pay = cpu.vendor == "GenuineIntel" || (cpu.vendor == "AuthenticAMD" && cpu.family >= 0x19);
     paths.lanes = paths.lookup = avx2 ? BatchPath::avx2 : BatchPath::scalar;
-    paths.sample = avx2 && fast_gathers ? BatchPath::avx2 : BatchPath::scalar;
+    paths.sample = avx2 && gathers_pay ? BatchPath::avx2 : BatchPath::scalar;
     return paths;
 }
 

@@ -202,9 +202,10 @@ ENVMIS_HD inline float point_in_cell(uint32_t index, float offset, uint32_t n) n
         return x < next_edge ? x : bit_cast<float>(bit_cast<uint32_t>(next_edge) - 1);
     }
     float x = quotient_to_float(index + static_cast<double>(offset), n);
-    // x lies within half a float ulp below 1, 2^-25, of the quotient: n 2^-25 cells. An
-    // offset twice that far from both edges of its cell keeps x inside, below 1, with no
-    // check on the sample's critical path.
+    // x lies within half a float ulp below 1, 2^-25, of the quotient (and 2^-54 more where
+    // the double division rounds first): about n 2^-25 cells. An offset twice that far
+    // from both edges of its cell keeps x inside, below 1, with no check on the sample's
+    // critical path.
     const float margin = static_cast<float>(n) * 0x1p-24f;
     if (offset >= margin && offset <= 1.0f - margin) [[likely]]
         return x;
