@@ -10,13 +10,14 @@ std::vector<float> textbook_density(const RgbImage& image, const EnvMapOptions& 
     const uint32_t w = image.width, h = image.height;
     std::vector<float> density(size_t{w} * h);
     for (size_t i = 0; i < density.size(); ++i) density[i] = luminance(image.pixels[i], options.luma);
-    const float threshold = options.compensation.enabled
-                                ? compensation_threshold(solid_angle_mean(density, w, h), options.compensation.alpha)
-                                : 0.0f;
+    const float threshold =
+        options.compensation.enabled
+            ? compensation_threshold(solid_angle_mean(density, w, h, options.mapping), options.compensation.alpha)
+            : 0.0f;
     for (uint32_t y = 0; y < h; ++y)
         for (uint32_t x = 0; x < w; ++x) {
             float& d = density[size_t{y} * w + x];
-            d = compensate(d, threshold) * row_sin_theta(y, h);
+            d = compensate(d, threshold) * row_weight(options.mapping, y, h);
         }
     return density;
 }
@@ -24,18 +25,26 @@ std::vector<float> textbook_density(const RgbImage& image, const EnvMapOptions& 
 }  // namespace
 
 TextbookEnvMap::TextbookEnvMap(const RgbImage& image, const EnvMapOptions& options)
-    : image_(&image), axes_(options.axes), distribution_(textbook_density(image, options), image.width, image.height) {}
+    : image_(&image),
+      axes_(options.axes),
+      mapping_(options.mapping),
+      distribution_(textbook_density(image, options), image.width, image.height) {}
 
+// Equal-area texels all cover 4 pi / (w h): the image density over 4 pi is the
+// solid-angle density; equirect ones shrink with sin(theta).
 EnvSample TextbookEnvMap::sample(Vec2 u) const noexcept {
     const auto s = distribution_.sample(u);
+    const Rgb radiance = image_->pixels[size_t{s.y} * image_->width + s.x];
+    if (mapping_ == Mapping::equal_area)
+        return {to_world(axes_, equal_area_direction(s.p)), s.pdf / kFourPi, radiance, s.p};
     float sin_theta = 0;
     const Vec3 canonical = equirect_direction(s.p, &sin_theta);
-    return {to_world(axes_, canonical), EnvMapView::solid_angle_pdf(s.pdf, sin_theta),
-            image_->pixels[size_t{s.y} * image_->width + s.x], s.p};
+    return {to_world(axes_, canonical), EnvMapView::solid_angle_pdf(s.pdf, sin_theta), radiance, s.p};
 }
 
 float TextbookEnvMap::pdf(Vec3 direction) const noexcept {
-    const Vec2 uv = equirect_uv(to_canonical(axes_, direction));
+    const Vec2 uv = image_uv(mapping_, to_canonical(axes_, direction));
+    if (mapping_ == Mapping::equal_area) return distribution_.pdf(uv) / kFourPi;
     return EnvMapView::solid_angle_pdf(distribution_.pdf(uv), std::sin(kPiF * uv.y));
 }
 

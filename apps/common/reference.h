@@ -3,8 +3,8 @@
 //
 // TextbookEnvMap is the classic pipeline written the obvious way: one serial pass for
 // luminance and compensation, then the textbook float-CDF sampler (textbook.h). It
-// samples the same density as EnvMap (up to float rounding) and returns the same
-// EnvSample, so the two are timed doing identical work.
+// samples the same density as EnvMap (up to float rounding), in either mapping, and
+// returns the same EnvSample, so the two are timed doing identical work.
 #pragma once
 
 #include <cstdint>
@@ -26,6 +26,7 @@ public:
 private:
     const RgbImage* image_;
     Axes axes_;
+    Mapping mapping_;
     TextbookDistribution2D distribution_;
 };
 

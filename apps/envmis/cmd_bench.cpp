@@ -128,7 +128,7 @@ std::pair<std::unique_ptr<Sampler>, double> build_repeatedly(const Source& sourc
 
 // The arguments of `envmis bench`.
 struct BenchArgs {
-    std::string input, size = "8192x4096";
+    std::string input, size = "8192x4096", mapping = "equirect";
     int repeats = 5;
     uint32_t samples = 1u << 20;
     uint32_t bins = 0;                // 0: no binned measurement
@@ -160,6 +160,10 @@ void add_bench_flags(CLI::App& sub, BenchArgs& args) {
         ->capture_default_str()
         ->check(in_range(uint32_t{1}, kMaxBenchSamples));
     sub.add_flag("--no-compensate", args.no_compensate, "Measure the uncompensated density");
+    sub.add_option("--mapping", args.mapping,
+                   "Mapping of the synthetic sky (equal-area: a square --size) or of an image; a table has its own")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"equirect", "equal-area"}));
     sub.add_option("--bins", args.bins,
                    "Also measure the binned sampler with K bins (square number) against today's EnvMap, plain and "
                    "compensated: build, memory, sample and pdf with a random normal per call (lobe class 0)")
@@ -174,20 +178,30 @@ void add_bench_flags(CLI::App& sub, BenchArgs& args) {
 }
 
 // The map measured: the input's radiance, or the synthetic sky of --size.
+// The map's radiance and how to sample it: its mapping and axes (a table's own, or the
+// flags'), the compensation left to the caller.
 struct BenchMap {
     RgbImage image;
     std::string name;
+    EnvMapOptions options;
 };
 
 BenchMap bench_map(const BenchArgs& args) {
+    EnvMapOptions options;
+    options.mapping = parse_mapping(args.mapping);
     if (args.input.empty()) {
         const Size size = *parse_size(args.size, false);  // the flag's validator has accepted it
+        if (options.mapping == Mapping::equal_area && size.width != size.height)
+            throw std::runtime_error("--size " + args.size + ": an equal-area sky is square, e.g. 5792x5792");
         check_image_size("--size " + args.size, size, kBytesPerTexel);
-        return {reference::synthetic_sky(size.width, size.height), "synthetic-sky"};
+        return {reference::synthetic_sky(size.width, size.height, options.mapping), "synthetic-sky", options};
     }
     MapFlags flags;
     flags.no_compensate = true;
-    return {to_image(load_map(args.input, flags).map.radiance()), args.input};
+    flags.mapping = args.mapping;
+    const LoadedMap loaded = load_map(args.input, flags);
+    options.mapping = loaded.map.options().mapping, options.axes = loaded.map.options().axes;
+    return {to_image(loaded.map.radiance()), args.input, options};
 }
 
 // The random points every sampler is timed on: u for sampling, directions for the pdf,
@@ -360,13 +374,14 @@ void time_binned_calls(const EnvMapView (&today)[2], const BinnedEnvMapView& bin
     }
 }
 
-BinnedResult measure_binned(const RgbImage& image, uint32_t bins, const BenchPoints& points, int repeats) {
+BinnedResult measure_binned(const RgbImage& image, const EnvMapOptions& mapped, uint32_t bins,
+                            const BenchPoints& points, int repeats) {
     Progress progress("bench --bins", 4 * repeats);
     int step = 0;
     BinnedResult result;
     std::unique_ptr<EnvMap> today[2];
     for (int k : {kPlain, kCompensated}) {
-        EnvMapOptions options;
+        EnvMapOptions options = mapped;
         options.compensation.enabled = k == kCompensated;
         std::tie(today[k], result.build_ms[k]) = build_repeatedly<EnvMap, RgbImage>(
             image, repeats, [&](RgbImage& copy) { return EnvMap(std::move(copy), options, &interrupted()); }, progress,
@@ -445,6 +460,7 @@ void print_binned_text(const BinnedResult& b) {
 void print_bench_json(const BenchArgs& args, const BenchMap& map, const BenchResult& result,
                       const std::optional<BinnedResult>& binned) {
     nlohmann::json j = {{"map", map.name},
+                        {"mapping", std::string(to_string(map.options.mapping))},
                         {"width", map.image.width},
                         {"height", map.image.height},
                         {"compensated", !args.no_compensate},
@@ -478,8 +494,9 @@ void print_bench_json(const BenchArgs& args, const BenchMap& map, const BenchRes
 void print_bench_text(const BenchArgs& args, const BenchMap& map, const BenchResult& result,
                       const std::optional<BinnedResult>& binned) {
     std::printf("cpu=%s\nbatch_paths %s\n", cpu_name().c_str(), batch_paths_summary().c_str());
-    std::printf("map=%s size=%ux%u compensated=%d repeats=%d samples=%u (medians)\n", map.name.c_str(), map.image.width,
-                map.image.height, !args.no_compensate, args.repeats, args.samples);
+    std::printf("map=%s size=%ux%u mapping=%s compensated=%d repeats=%d samples=%u (medians)\n", map.name.c_str(),
+                map.image.width, map.image.height, std::string(to_string(map.options.mapping)).c_str(),
+                !args.no_compensate, args.repeats, args.samples);
     for (const Timing& t : result.timings)
         std::printf("sampler=%s build_ms=%.1f ns_per_sample=%.1f ns_per_pdf=%.1f bytes_per_texel=%.2f\n",
                     t.sampler.c_str(), t.build_ms, t.ns_per_sample, t.ns_per_pdf, t.bytes_per_texel);
@@ -497,13 +514,13 @@ void print_bench_text(const BenchArgs& args, const BenchMap& map, const BenchRes
 
 void run_bench(const BenchArgs& args) {
     const BenchMap map = bench_map(args);
-    EnvMapOptions options;
+    EnvMapOptions options = map.options;
     options.compensation.enabled = !args.no_compensate;
     const BenchPoints points = bench_points(args.samples, args.bins > 0, args.samples_per_normal);
     const BenchResult result = measure(map.image, options, points, args.repeats);
     std::optional<BinnedResult> binned;
     if (args.bins > 0) {
-        binned = measure_binned(map.image, args.bins, points, args.repeats);
+        binned = measure_binned(map.image, map.options, args.bins, points, args.repeats);
         binned->samples_per_normal = args.samples_per_normal;
     }
     if (args.json)

@@ -283,7 +283,9 @@ TEST_F(Cli, VisualizeWritesAPngThatOpenImageIOReads) {
 TEST_F(Cli, BenchPrintsOneLinePerSamplerWithTheDocumentedFields) {
     const Result r = envmis({"bench", "--size", "256x128", "--repeats", "1", "--samples", "10000"});
     ASSERT_EQ(r.exit_code, 0) << r;
-    EXPECT_TRUE(contains(r.out, R"((^|\n)map=synthetic-sky size=256x128 compensated=1 repeats=1 samples=10000)")) << r;
+    EXPECT_TRUE(contains(
+        r.out, R"((^|\n)map=synthetic-sky size=256x128 mapping=equirect compensated=1 repeats=1 samples=10000)"))
+        << r;
     const std::string number = "[0-9]+(\\.[0-9]+)?";
     for (const char* sampler : {"guided", "guided-batch", "textbook"})
         EXPECT_TRUE(contains(r.out, std::string("(^|\\n)sampler=") + sampler + " build_ms=" + number +
@@ -342,6 +344,18 @@ TEST_F(Cli, BenchWithBinsAddsTheBinnedSamplerAgainstTodaysMaps) {
         for (const char* field : {"sample", "lookup_over_pdf", "lookup_over_lookup"})
             EXPECT_GT(s.at("batch_over_single").at(field).get<double>(), 0) << field << j;
     }
+}
+
+TEST_F(Cli, BenchTimesAnEqualAreaSkyOnASquareSizeOnly) {
+    const Result r = envmis(
+        {"bench", "--mapping", "equal-area", "--size", "64x64", "--repeats", "1", "--samples", "1000", "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j.at("mapping"), "equal-area");
+    EXPECT_GT(j.at("speedup_vs_textbook").at("sample").get<double>(), 0) << r;
+    const Result oblong = envmis({"bench", "--mapping", "equal-area", "--size", "128x64", "--repeats", "1"});
+    EXPECT_NE(oblong.exit_code, 0) << oblong;
+    EXPECT_TRUE(contains(oblong.err, "--size 128x64: an equal-area sky is square")) << oblong;
 }
 
 TEST_F(Cli, BenchJsonIsOneObjectWithTheSameFields) {
