@@ -177,9 +177,9 @@ void add_bench_flags(CLI::App& sub, BenchArgs& args) {
     sub.add_flag("--json", args.json, "Print one JSON object instead of text lines");
 }
 
-// The map measured: the input's radiance, or the synthetic sky of --size.
-// The map's radiance and how to sample it: its mapping and axes (a table's own, or the
-// flags'), the compensation left to the caller.
+// The map measured, the input's radiance or the synthetic sky of --size, and how to
+// sample it: its mapping and axes (a table's own, or the flags'); the compensation is
+// the caller's.
 struct BenchMap {
     RgbImage image;
     std::string name;
