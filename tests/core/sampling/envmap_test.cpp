@@ -343,13 +343,13 @@ TEST(EnvMap, AxesRotateDirectionsWithoutChangingPdfs) {
     }
 }
 
-// Maps for the batch functions' SIMD path (AVX2, equirect, default axes) and for each
-// way around it: power-of-two and odd sizes, compensated or not, 2x1 and 1x1 (whose
-// full-width cell, 2^31 units, breaks a signed conversion), y up, equal-area.
+// Maps for the batch functions' SIMD path (AVX2, default axes) and for each way around
+// it: power-of-two and odd sizes, compensated or not, in both mappings, 2x1 and 1x1
+// (whose full-width cell, 2^31 units, breaks a signed conversion), y up.
 std::vector<EnvMap> batch_maps() {
-    EnvMapOptions y_up = options(true), equal_area = options(true);
+    EnvMapOptions y_up = options(true), equal_area = options(true), equal_area_plain = options(false);
     y_up.axes = Axes::parse("y-up");
-    equal_area.mapping = Mapping::equal_area;
+    equal_area.mapping = equal_area_plain.mapping = Mapping::equal_area;
     std::vector<EnvMap> maps;
     maps.emplace_back(test::sun_sky_map(1024, 512), options(true));
     maps.emplace_back(test::sun_sky_map(1024, 512), options(false));
@@ -360,6 +360,12 @@ std::vector<EnvMap> batch_maps() {
     maps.emplace_back(test::constant_map(1, 1, {1, 2, 3}), options(false));
     maps.emplace_back(test::sun_sky_map(64, 32), y_up);
     maps.emplace_back(test::random_map(32, 32, 5), equal_area);
+    maps.emplace_back(test::random_map(37, 37, 7), equal_area_plain);
+    maps.emplace_back(test::sun_sky_map(98, 98), equal_area);
+    maps.emplace_back(test::random_map(2, 2, 8), equal_area);
+    EnvMapOptions equal_area_y_up = equal_area;
+    equal_area_y_up.axes = y_up.axes;
+    maps.emplace_back(test::random_map(16, 16, 9), equal_area_y_up);
     return maps;
 }
 

@@ -26,6 +26,9 @@ ENVMIS_AVX2 inline F8 clamp8(F8 v, float lo, float hi) noexcept {
     return select(less(v, splat(lo)), splat(lo), select(less(splat(hi), v), splat(hi), v));
 }
 ENVMIS_AVX2 inline F8 abs8(F8 v) noexcept { return _mm256_andnot_ps(splat(-0.0f), v); }
+ENVMIS_AVX2 inline F8 copysign8(F8 magnitude, F8 sign) noexcept {
+    return _mm256_or_ps(abs8(magnitude), _mm256_and_ps(splat(-0.0f), sign));
+}
 
 }  // namespace envmis::simd
 #endif

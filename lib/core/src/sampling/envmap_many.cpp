@@ -5,15 +5,15 @@
 // detail/pipeline.h: bit-identical to the single calls by construction.
 //
 // The AVX2 paths (eight lanes at a time, hardware gathers) repeat the scalar arithmetic
-// operation for operation (equirect_uv, fast_atan2, detail::cell_of, CdfView::width and
-// invert, detail::point_in_cell, Distribution2DView::pdf_of, sincos_turns,
-// sincos_half_turns, solid_angle_pdf): the same IEEE operations in the same order, no
-// fused multiply-add, so every lane's result is bit-identical to the scalar call
-// (tests/core/sampling/envmap_test.cpp checks it on maps of several sizes, at the poles,
-// the seam and the last column, on every path the CPU has). If one of those functions
-// changes, this file must change with it; the tests fail until it does. GCC 12's
-// auto-vectoriser does not vectorise the scalar loops in a target("avx2") function
-// (docs/performance-log.md), hence the intrinsics.
+// operation for operation (equirect_uv, equal_area_uv, fast_atan2, detail::cell_of,
+// CdfView::width and invert, detail::point_in_cell, Distribution2DView::pdf_of,
+// sincos_turns, sincos_half_turns, equal_area_direction, solid_angle_pdf): the same IEEE
+// operations in the same order, no fused multiply-add, so every lane's result is
+// bit-identical to the scalar call (tests/core/sampling/envmap_test.cpp checks it on maps
+// of several sizes in both mappings, at the poles, the seam and the last column, on every
+// path the CPU has). If one of those functions changes, this file must change with it;
+// the tests fail until it does. GCC 12's auto-vectoriser does not vectorise the scalar
+// loops in a target("avx2") function (docs/performance-log.md), hence the intrinsics.
 #include "envmis/sampling/envmap.h"
 
 #include <algorithm>
@@ -87,11 +87,10 @@ void sample_scalar(const EnvMapView& env, PointArrays in, SampleArrays out, uint
 #ifdef ENVMIS_AVX2_BATCHES
 using namespace simd;
 
-// The SIMD path's preconditions: the equirectangular mapping in the default axes, and
-// 32-bit gather indices for the three floats of every texel.
+// The SIMD path's preconditions: the default axes, and 32-bit gather indices for the
+// three floats of every texel.
 bool avx2_applies(const EnvMapView& env) noexcept {
-    return env.mapping == Mapping::equirect && env.axes.identity() &&
-           uint64_t{env.distribution.w} * env.distribution.h * 3 < (uint64_t{1} << 31);
+    return env.axes.identity() && uint64_t{env.distribution.w} * env.distribution.h * 3 < (uint64_t{1} << 31);
 }
 
 // fast_atan2 (fast_math.h).
@@ -110,7 +109,7 @@ ENVMIS_AVX2 F8 atan2_8(F8 y, F8 x) noexcept {
     a = _mm256_add_ps(a, select(reduce, splat(kPiF / 4), splat(0.0f)));
     a = select(swap, _mm256_sub_ps(splat(kPiF / 2), a), a);
     a = select(less(x, splat(0.0f)), _mm256_sub_ps(splat(kPiF), a), a);
-    return _mm256_or_ps(abs8(a), _mm256_and_ps(splat(-0.0f), y));  // copysign(a, y)
+    return copysign8(a, y);
 }
 
 ENVMIS_AVX2 I8 gather(const uint32_t* a, I8 i) noexcept {
@@ -191,19 +190,48 @@ ENVMIS_AVX2 SinCos8 sincos_half_turns8(const SinCos* turns, F8 t) noexcept {
     return sincos_steps8(turns, _mm256_mul_ps(t, splat(static_cast<float>(kTurnSteps / 2))));
 }
 
-// EnvMapView::solid_angle_pdf of a cell's density from its row's and its own widths
-// (Distribution2DView::pdf_of).
-ENVMIS_AVX2 F8 widths_pdf8(const Distribution2DView& d, I8 row_width, I8 cell_width, F8 sin_theta) noexcept {
-    const F8 image_pdf =
-        _mm256_mul_ps(_mm256_mul_ps(width_to_float(row_width), width_to_float(cell_width)), splat(d.pdf_scale));
+// Distribution2DView::pdf_of: a cell's image-space density from its row's and its own
+// widths.
+ENVMIS_AVX2 F8 image_pdf8(const Distribution2DView& d, I8 row_width, I8 cell_width) noexcept {
+    return _mm256_mul_ps(_mm256_mul_ps(width_to_float(row_width), width_to_float(cell_width)), splat(d.pdf_scale));
+}
+
+// EnvMapView::solid_angle_pdf.
+ENVMIS_AVX2 F8 solid_angle_pdf8(F8 image_pdf, F8 sin_theta) noexcept {
     const F8 pdf = _mm256_div_ps(image_pdf, _mm256_mul_ps(splat(kTwoPiSquared), sin_theta));
     return select(_mm256_cmp_ps(sin_theta, splat(0.0f), _CMP_GT_OQ), pdf, splat(0.0f));
 }
 
-// The same for cell (x, y), row = y w, reading the widths.
-ENVMIS_AVX2 F8 solid_angle_pdf8(const Distribution2DView& d, I8 x, I8 y, I8 row, F8 sin_theta) noexcept {
-    const I8 row_width = span8(d.marginal.start, _mm256_setzero_si256(), y, d.h).width;
-    return widths_pdf8(d, row_width, span8(d.start, row, x, d.w).width, sin_theta);
+// The equal-area solid-angle pdf (EnvMapView::at_equal_area, image_to_solid_angle).
+ENVMIS_AVX2 F8 equal_area_pdf8(F8 image_pdf) noexcept { return _mm256_mul_ps(image_pdf, splat(1 / kFourPi)); }
+
+// equal_area_direction (mapping.h).
+struct Vec8 {
+    F8 x, y, z;
+};
+ENVMIS_AVX2 Vec8 equal_area_direction8(F8 uv_x, F8 uv_y) noexcept {
+    const F8 one = splat(1.0f);
+    const F8 u = _mm256_sub_ps(_mm256_mul_ps(splat(2.0f), uv_x), one);
+    const F8 v = _mm256_sub_ps(_mm256_mul_ps(splat(2.0f), uv_y), one);
+    const F8 au = abs8(u), av = abs8(v);
+    const F8 signed_distance = _mm256_sub_ps(one, _mm256_add_ps(au, av));
+    const F8 r = _mm256_sub_ps(one, abs8(signed_distance));
+    const F8 t =
+        select(_mm256_cmp_ps(r, splat(0.0f), _CMP_EQ_OQ), splat(0.0f), _mm256_div_ps(_mm256_sub_ps(av, au), r));
+    const F8 a = _mm256_mul_ps(t, splat(kPiF / 4)), a2 = _mm256_mul_ps(a, a);
+    F8 sin_a = _mm256_add_ps(_mm256_mul_ps(splat(-1.9515295891e-4f), a2), splat(8.3321608736e-3f));
+    sin_a = _mm256_sub_ps(_mm256_mul_ps(sin_a, a2), splat(1.6666654611e-1f));
+    sin_a = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(sin_a, a2), a), a);
+    F8 cos_a = _mm256_sub_ps(_mm256_mul_ps(splat(2.443315711809948e-5f), a2), splat(1.388731625493765e-3f));
+    cos_a = _mm256_add_ps(_mm256_mul_ps(cos_a, a2), splat(4.166664568298827e-2f));
+    cos_a = _mm256_mul_ps(_mm256_mul_ps(cos_a, a2), a2);
+    cos_a = _mm256_add_ps(_mm256_sub_ps(cos_a, _mm256_mul_ps(splat(0.5f), a2)), one);
+    const F8 r2 = _mm256_mul_ps(r, r), root_arg = _mm256_sub_ps(splat(2.0f), r2);
+    const F8 root = _mm256_sqrt_ps(select(less(splat(0.0f), root_arg), root_arg, splat(0.0f)));
+    const F8 s = _mm256_mul_ps(_mm256_mul_ps(r, root), splat(0.70710678118654752f));
+    return {_mm256_mul_ps(copysign8(_mm256_sub_ps(cos_a, sin_a), u), s),
+            _mm256_mul_ps(copysign8(_mm256_add_ps(cos_a, sin_a), v), s),
+            copysign8(_mm256_sub_ps(one, r2), signed_distance)};
 }
 
 // The radiance of eight texels (row-major indices), stored from lane l on.
@@ -223,20 +251,44 @@ struct Cells8 {
     F8 v;
 };
 
-// equirect_uv (mapping.h) and the cells of eval_uv and pdf_uv (envmap.h), for the
-// eight directions from lane l on; starts loading each texel's radiance and CDF entry.
-ENVMIS_AVX2 Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l) noexcept {
+// An image point in eight lanes.
+struct Uv8 {
+    F8 u, v;
+};
+
+// equirect_uv (mapping.h).
+ENVMIS_AVX2 Uv8 equirect_uv8(const Vec8& d) noexcept {
     constexpr float kInvPi = static_cast<float>(1 / kPi);
-    const F8 z = clamp8(_mm256_loadu_ps(in.z + l), -1.0f, 1.0f);
+    const F8 z = clamp8(d.z, -1.0f, 1.0f);
     const F8 s2 = _mm256_mul_ps(_mm256_sub_ps(splat(1.0f), z), _mm256_add_ps(splat(1.0f), z));
     const F8 sin_theta = _mm256_sqrt_ps(select(less(splat(0.0f), s2), s2, splat(0.0f)));
     const F8 theta = atan2_8(sin_theta, z);
-    const F8 phi = atan2_8(_mm256_loadu_ps(in.y + l), _mm256_loadu_ps(in.x + l));
+    const F8 phi = atan2_8(d.y, d.x);
     const F8 turn = select(less(phi, splat(0.0f)), _mm256_add_ps(phi, splat(2 * kPiF)), phi);
-    const F8 u = clamp8(_mm256_mul_ps(splat(0.5f * kInvPi), turn), 0.0f, kOneMinusEpsilon);
-    const F8 v = clamp8(_mm256_mul_ps(theta, splat(kInvPi)), 0.0f, kOneMinusEpsilon);
-    const I8 x = cell8(u, env.distribution.w), y = cell8(v, env.distribution.h);
-    const Cells8 c{x, y, _mm256_mullo_epi32(y, _mm256_set1_epi32(static_cast<int>(env.distribution.w))), v};
+    return {clamp8(_mm256_mul_ps(splat(0.5f * kInvPi), turn), 0.0f, kOneMinusEpsilon),
+            clamp8(_mm256_mul_ps(theta, splat(kInvPi)), 0.0f, kOneMinusEpsilon)};
+}
+
+// equal_area_uv (mapping.h).
+ENVMIS_AVX2 Uv8 equal_area_uv8(const Vec8& d) noexcept {
+    const F8 one = splat(1.0f), abs_z = abs8(d.z);
+    const F8 r = _mm256_sqrt_ps(_mm256_sub_ps(one, select(less(one, abs_z), one, abs_z)));
+    const F8 t = _mm256_mul_ps(atan2_8(abs8(d.y), abs8(d.x)), splat(static_cast<float>(2 / kPi)));
+    const F8 north_v = _mm256_mul_ps(t, r), north_u = _mm256_sub_ps(r, north_v);
+    const F8 south = less(d.z, splat(0.0f));
+    const F8 u = select(south, _mm256_sub_ps(one, north_v), north_u);
+    const F8 v = select(south, _mm256_sub_ps(one, north_u), north_v);
+    return {clamp8(_mm256_mul_ps(splat(0.5f), _mm256_add_ps(copysign8(u, d.x), one)), 0.0f, kOneMinusEpsilon),
+            clamp8(_mm256_mul_ps(splat(0.5f), _mm256_add_ps(copysign8(v, d.y), one)), 0.0f, kOneMinusEpsilon)};
+}
+
+// EnvMapView::uv_of and the cells of eval_uv and pdf_uv (envmap.h), for the eight
+// directions from lane l on; starts loading each texel's radiance and CDF entry.
+ENVMIS_AVX2 Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l) noexcept {
+    const Vec8 d{_mm256_loadu_ps(in.x + l), _mm256_loadu_ps(in.y + l), _mm256_loadu_ps(in.z + l)};
+    const Uv8 p = env.mapping == Mapping::equal_area ? equal_area_uv8(d) : equirect_uv8(d);
+    const I8 x = cell8(p.u, env.distribution.w), y = cell8(p.v, env.distribution.h);
+    const Cells8 c{x, y, _mm256_mullo_epi32(y, _mm256_set1_epi32(static_cast<int>(env.distribution.w))), p.v};
     alignas(32) uint32_t texel[8];
     _mm256_store_si256(reinterpret_cast<I8*>(texel), _mm256_add_epi32(c.row, c.x));
     for (const uint32_t i : texel) {
@@ -248,9 +300,14 @@ ENVMIS_AVX2 Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l
 
 // Radiance and solid-angle pdf at eight located directions, stored from lane l on.
 ENVMIS_AVX2 void fetch8(const EnvMapView& env, const Cells8& c, LookupArrays out, uint32_t l) noexcept {
+    const Distribution2DView& d = env.distribution;
     store_radiance8(env.radiance, _mm256_add_epi32(c.row, c.x), out.r, out.g, out.b, l);
-    const F8 sin_theta = sincos_half_turns8(env.turns, c.v).sin;
-    _mm256_storeu_ps(out.pdf + l, solid_angle_pdf8(env.distribution, c.x, c.y, c.row, sin_theta));
+    const I8 row_width = span8(d.marginal.start, _mm256_setzero_si256(), c.y, d.h).width;
+    const F8 image_pdf = image_pdf8(d, row_width, span8(d.start, c.row, c.x, d.w).width);
+    const F8 pdf = env.mapping == Mapping::equal_area
+                       ? equal_area_pdf8(image_pdf)
+                       : solid_angle_pdf8(image_pdf, sincos_half_turns8(env.turns, c.v).sin);
+    _mm256_storeu_ps(out.pdf + l, pdf);
 }
 
 // Lanes [0, n - n % 8) in groups of eight, up to four groups at a time: start(first)
@@ -358,6 +415,19 @@ ENVMIS_AVX2 Rows8 rows8(const EnvMapView& env, PointArrays in, uint32_t l, uint3
     return rows;
 }
 
+// EnvMapView::at for eight image points with their image-space density: the direction
+// and its solid-angle pdf.
+struct Direction8 {
+    Vec8 d;
+    F8 pdf;
+};
+ENVMIS_AVX2 Direction8 at8(const EnvMapView& env, F8 u, F8 v, F8 image_pdf) noexcept {
+    if (env.mapping == Mapping::equal_area) return {equal_area_direction8(u, v), equal_area_pdf8(image_pdf)};
+    const SinCos8 theta = sincos_half_turns8(env.turns, v), phi = sincos_turns8(env.turns, u);
+    return {{_mm256_mul_ps(theta.sin, phi.cos), _mm256_mul_ps(theta.sin, phi.sin), theta.cos},
+            solid_angle_pdf8(image_pdf, theta.sin)};
+}
+
 // EnvMapView::sample for the eight points from lane l on, their rows found.
 ENVMIS_AVX2 void sample8(const EnvMapView& env, const Rows8& rows, SampleArrays out, uint32_t l) noexcept {
     const Distribution2DView& d = env.distribution;
@@ -365,13 +435,13 @@ ENVMIS_AVX2 void sample8(const EnvMapView& env, const Rows8& rows, SampleArrays 
     const I8 row = rows.row;
     const Hit8 c = search8(d.start, d.guide, row, d.w, rows.column);
     const F8 u = point_in_cell8(c.index, c.offset, d.w), v = point_in_cell8(r.index, r.offset, d.h);
-    const SinCos8 theta = sincos_half_turns8(env.turns, v), phi = sincos_turns8(env.turns, u);
+    const Direction8 e = at8(env, u, v, image_pdf8(d, r.width, c.width));
     if (out.u) _mm256_storeu_ps(out.u + l, u);
     if (out.v) _mm256_storeu_ps(out.v + l, v);
-    _mm256_storeu_ps(out.x + l, _mm256_mul_ps(theta.sin, phi.cos));
-    _mm256_storeu_ps(out.y + l, _mm256_mul_ps(theta.sin, phi.sin));
-    _mm256_storeu_ps(out.z + l, theta.cos);
-    _mm256_storeu_ps(out.pdf + l, widths_pdf8(d, r.width, c.width, theta.sin));
+    _mm256_storeu_ps(out.x + l, e.d.x);
+    _mm256_storeu_ps(out.y + l, e.d.y);
+    _mm256_storeu_ps(out.z + l, e.d.z);
+    _mm256_storeu_ps(out.pdf + l, e.pdf);
     store_radiance8(env.radiance, _mm256_add_epi32(row, c.index), out.r, out.g, out.b, l);
 }
 
