@@ -6,6 +6,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <random>
@@ -269,6 +270,50 @@ void sample_mapped(benchmark::State& state) {
     state.counters["Mtexels"] = static_cast<double>(state.range(0) * state.range(1)) / 1e6;
 }
 
+// The two mappings interleaved: blocks of 1024 samples at the same points on the
+// equal-area sky, then on the equirect one, so that their ratio spans the same seconds of
+// the machine's drift (the cases above run minutes apart). Manual time: the equal-area
+// map's; the counter equal_area/equirect is the ratio of the two maps' totals.
+// Arguments: the equal-area side, the equirect width and height, compensated, and
+// sample_many (1) or single calls (0).
+void equal_area_over_equirect(benchmark::State& state) {
+    const bool compensated = state.range(3) != 0, batch = state.range(4) != 0;
+    const auto side = static_cast<uint32_t>(state.range(0));
+    const EnvMapView maps[2] = {mapped_sky(side, side, envmis::Mapping::equal_area, compensated).view(),
+                                mapped_sky(static_cast<uint32_t>(state.range(1)), static_cast<uint32_t>(state.range(2)),
+                                           envmis::Mapping::equirect, compensated)
+                                    .view()};
+    constexpr size_t kBlock = 1024;  // long enough to make the clock's reading negligible
+    const BatchPoints& p = batch_points();
+    std::vector<float> out(7 * kBlock);
+    float* o = out.data();
+    const envmis::SampleArrays arrays{
+        o, o + kBlock, o + 2 * kBlock, o + 3 * kBlock, o + 4 * kBlock, o + 5 * kBlock, o + 6 * kBlock};
+    double seconds[2] = {0, 0};
+    size_t first = 0;
+    for (auto _ : state) {
+        for (int m = 0; m < 2; ++m) {
+            const auto start = std::chrono::steady_clock::now();
+            if (batch) {
+                envmis::sample_many(maps[m], {p.ux.data() + first, p.uy.data() + first}, arrays, kBlock);
+                benchmark::DoNotOptimize(out.data());
+            } else {
+                for (size_t i = first; i < first + kBlock; ++i) {
+                    const envmis::EnvSample e = maps[m].sample({p.ux[i], p.uy[i]});
+                    benchmark::DoNotOptimize(e);
+                }
+            }
+            const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            seconds[m] += elapsed;
+            if (m == 0) state.SetIterationTime(elapsed);
+        }
+        first = (first + kBlock) & (p.ux.size() - 1);
+    }
+    state.counters["per_sample"] = benchmark::Counter(
+        static_cast<double>(kBlock), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+    state.counters["equal_area/equirect"] = seconds[0] / seconds[1];
+}
+
 void sizes(benchmark::internal::Benchmark* b) { b->Arg(1024)->Arg(8192)->Unit(benchmark::kMillisecond); }
 void sizes_ns(benchmark::internal::Benchmark* b) { b->Arg(1024)->Arg(8192)->Unit(benchmark::kNanosecond); }
 
@@ -303,6 +348,11 @@ BENCHMARK(sample_mapped<envmis::Mapping::equirect>)
     ->ArgsProduct({{4096}, {4096}, {0, 1}})
     ->ArgsProduct({{5792}, {2896}, {0, 1}})
     ->ArgsProduct({{8192}, {4096}, {0, 1}});
+BENCHMARK(equal_area_over_equirect)
+    ->Name("sample/equal-area-over-equirect")
+    ->ArgsProduct({{4096}, {5792}, {2896}, {0, 1}, {0, 1}})
+    ->ArgsProduct({{5792}, {8192}, {4096}, {0, 1}, {0, 1}})
+    ->UseManualTime();
 BENCHMARK_CAPTURE(estimate, mis_balance_lambert, "mis-balance", envmis::Bsdf::lambert())
     ->Name("estimate/mis-balance/lambert")
     ->Args({1024, 1})

@@ -190,8 +190,9 @@ ENVMIS_HD inline float quotient_to_float(double a, uint32_t n) noexcept {
 
 // The float nearest (index + offset) / n that still lies in cell `index`: rounding to
 // float can step over a cell edge, and one step back always suffices because a cell is
-// many float ulps wide.
-ENVMIS_HD inline float point_in_cell(uint32_t index, float offset, uint32_t n) noexcept {
+// many float ulps wide. Forced inline: GCC left it out of line in envmis bench's sample
+// loop, a tenth of an equal-area sample's time (measured: docs/performance-log.md).
+ENVMIS_HD ENVMIS_INLINE float point_in_cell(uint32_t index, float offset, uint32_t n) noexcept {
     if ((n & (n - 1)) == 0) {
         // Power-of-two n (most maps): index / n and offset / n are exact floats, so
         // their sum rounds once, to the same float as the division below, and can only
