@@ -343,9 +343,9 @@ TEST(EnvMap, AxesRotateDirectionsWithoutChangingPdfs) {
     }
 }
 
-// Maps for the batch functions' SIMD path (AVX2, default axes) and for each way around
-// it: power-of-two and odd sizes, compensated or not, in both mappings, 2x1 and 1x1
-// (whose full-width cell, 2^31 units, breaks a signed conversion), y up.
+// Maps for the batch functions' paths: power-of-two and odd sizes, compensated or not,
+// in both mappings, 2x1 and 1x1 (whose full-width cell, 2^31 units, breaks a signed
+// conversion), y up and a permutation with two axes negated.
 std::vector<EnvMap> batch_maps() {
     EnvMapOptions y_up = options(true), equal_area = options(true), equal_area_plain = options(false);
     y_up.axes = Axes::parse("y-up");
@@ -366,6 +366,9 @@ std::vector<EnvMap> batch_maps() {
     EnvMapOptions equal_area_y_up = equal_area;
     equal_area_y_up.axes = y_up.axes;
     maps.emplace_back(test::random_map(16, 16, 9), equal_area_y_up);
+    EnvMapOptions mirrored = options(false);
+    mirrored.axes = Axes::parse("-z,x,-y");
+    maps.emplace_back(test::random_map(37, 19, 10), mirrored);
     return maps;
 }
 

@@ -51,7 +51,7 @@ struct BatchPaths {
 //   against 1.4x); the scalar pipeline on older AMD families (not measured);
 // - the estimator's lanes (arithmetic, no gathers of their own) wherever AVX2 is usable.
 // The same rules serve equal-area maps: on the 5792^2 sky, family 0x19, the AVX2 kernels
-// sample in 0.45-0.67x of the scalar pipeline's time, and look up 2.6-2.9x faster than
+// sample in 0.43-0.67x of the scalar pipeline's time, and look up 2.6-2.9x faster than
 // single pdf calls against its 1.5-1.9x.
 // No AVX-512 path: much of the kernels' time goes to gathers, and on AMD family 0x1a one
 // 16-lane gather of eight 64-bit pairs took 1.7x the time of the two 8-lane AVX2 gathers

@@ -5,12 +5,12 @@
 // detail/pipeline.h: bit-identical to the single calls by construction.
 //
 // The AVX2 paths (eight lanes at a time, hardware gathers) repeat the scalar arithmetic
-// operation for operation (equirect_uv, equal_area_uv, fast_atan2, detail::cell_of,
-// CdfView::width and invert, detail::point_in_cell, Distribution2DView::pdf_of,
-// sincos_turns, sincos_half_turns, equal_area_direction, solid_angle_pdf): the same IEEE
-// operations in the same order, no fused multiply-add, so every lane's result is
-// bit-identical to the scalar call (tests/core/sampling/envmap_test.cpp checks it on maps
-// of several sizes in both mappings, at the poles, the seam and the last column, on every
+// operation for operation (detail::cell_of, CdfView::width and invert,
+// detail::point_in_cell, Distribution2DView::pdf_of, sincos_turns, sincos_half_turns,
+// solid_angle_pdf, and the mappings of detail/mapping8.h): the same IEEE operations in
+// the same order, no fused multiply-add, so every lane's result is bit-identical to the
+// scalar call (tests/core/sampling/envmap_test.cpp checks it on maps of several sizes, in
+// both mappings and several axes, at the poles, the seam and the last column, on every
 // path the CPU has). If one of those functions changes, this file must change with it;
 // the tests fail until it does. GCC 12's auto-vectoriser does not vectorise the scalar
 // loops in a target("avx2") function (docs/performance-log.md), hence the intrinsics.
@@ -19,6 +19,7 @@
 #include <algorithm>
 
 #include "detail/cell8.h"
+#include "detail/mapping8.h"
 #include "detail/pipeline.h"
 #include "detail/simd.h"
 #include "envmis/cpu.h"
@@ -87,29 +88,9 @@ void sample_scalar(const EnvMapView& env, PointArrays in, SampleArrays out, uint
 #ifdef ENVMIS_AVX2_BATCHES
 using namespace simd;
 
-// The SIMD path's preconditions: the default axes, and 32-bit gather indices for the
-// three floats of every texel.
+// The SIMD path's precondition: 32-bit gather indices for the three floats of every texel.
 bool avx2_applies(const EnvMapView& env) noexcept {
-    return env.axes.identity() && uint64_t{env.distribution.w} * env.distribution.h * 3 < (uint64_t{1} << 31);
-}
-
-// fast_atan2 (fast_math.h).
-ENVMIS_AVX2 F8 atan2_8(F8 y, F8 x) noexcept {
-    const F8 ax = abs8(x), ay = abs8(y);
-    const F8 swap = _mm256_cmp_ps(ay, ax, _CMP_GT_OQ);
-    const F8 n = select(swap, ax, ay), d = select(swap, ay, ax);
-    const F8 reduce = _mm256_cmp_ps(n, _mm256_mul_ps(splat(0.41421356237309515f), d), _CMP_GT_OQ);
-    const F8 num = select(reduce, _mm256_sub_ps(n, d), n), den = select(reduce, _mm256_add_ps(n, d), d);
-    const F8 r = select(_mm256_cmp_ps(den, splat(0.0f), _CMP_GT_OQ), _mm256_div_ps(num, den), splat(0.0f));
-    const F8 z = _mm256_mul_ps(r, r);
-    F8 p = _mm256_sub_ps(_mm256_mul_ps(splat(8.05374449538e-2f), z), splat(1.38776856032e-1f));
-    p = _mm256_add_ps(_mm256_mul_ps(p, z), splat(1.99777106478e-1f));
-    p = _mm256_sub_ps(_mm256_mul_ps(p, z), splat(3.33329491539e-1f));
-    F8 a = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(p, z), r), r);
-    a = _mm256_add_ps(a, select(reduce, splat(kPiF / 4), splat(0.0f)));
-    a = select(swap, _mm256_sub_ps(splat(kPiF / 2), a), a);
-    a = select(less(x, splat(0.0f)), _mm256_sub_ps(splat(kPiF), a), a);
-    return copysign8(a, y);
+    return uint64_t{env.distribution.w} * env.distribution.h * 3 < (uint64_t{1} << 31);
 }
 
 ENVMIS_AVX2 I8 gather(const uint32_t* a, I8 i) noexcept {
@@ -205,35 +186,6 @@ ENVMIS_AVX2 F8 solid_angle_pdf8(F8 image_pdf, F8 sin_theta) noexcept {
 // The equal-area solid-angle pdf (EnvMapView::at_equal_area, image_to_solid_angle).
 ENVMIS_AVX2 F8 equal_area_pdf8(F8 image_pdf) noexcept { return _mm256_mul_ps(image_pdf, splat(1 / kFourPi)); }
 
-// equal_area_direction (mapping.h).
-struct Vec8 {
-    F8 x, y, z;
-};
-ENVMIS_AVX2 Vec8 equal_area_direction8(F8 uv_x, F8 uv_y) noexcept {
-    const F8 one = splat(1.0f);
-    const F8 u = _mm256_sub_ps(_mm256_mul_ps(splat(2.0f), uv_x), one);
-    const F8 v = _mm256_sub_ps(_mm256_mul_ps(splat(2.0f), uv_y), one);
-    const F8 au = abs8(u), av = abs8(v);
-    const F8 signed_distance = _mm256_sub_ps(one, _mm256_add_ps(au, av));
-    const F8 r = _mm256_sub_ps(one, abs8(signed_distance));
-    const F8 t =
-        select(_mm256_cmp_ps(r, splat(0.0f), _CMP_EQ_OQ), splat(0.0f), _mm256_div_ps(_mm256_sub_ps(av, au), r));
-    const F8 a = _mm256_mul_ps(t, splat(kPiF / 4)), a2 = _mm256_mul_ps(a, a);
-    F8 sin_a = _mm256_add_ps(_mm256_mul_ps(splat(-1.9515295891e-4f), a2), splat(8.3321608736e-3f));
-    sin_a = _mm256_sub_ps(_mm256_mul_ps(sin_a, a2), splat(1.6666654611e-1f));
-    sin_a = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(sin_a, a2), a), a);
-    F8 cos_a = _mm256_sub_ps(_mm256_mul_ps(splat(2.443315711809948e-5f), a2), splat(1.388731625493765e-3f));
-    cos_a = _mm256_add_ps(_mm256_mul_ps(cos_a, a2), splat(4.166664568298827e-2f));
-    cos_a = _mm256_mul_ps(_mm256_mul_ps(cos_a, a2), a2);
-    cos_a = _mm256_add_ps(_mm256_sub_ps(cos_a, _mm256_mul_ps(splat(0.5f), a2)), one);
-    const F8 r2 = _mm256_mul_ps(r, r), root_arg = _mm256_sub_ps(splat(2.0f), r2);
-    const F8 root = _mm256_sqrt_ps(select(less(splat(0.0f), root_arg), root_arg, splat(0.0f)));
-    const F8 s = _mm256_mul_ps(_mm256_mul_ps(r, root), splat(0.70710678118654752f));
-    return {_mm256_mul_ps(copysign8(_mm256_sub_ps(cos_a, sin_a), u), s),
-            _mm256_mul_ps(copysign8(_mm256_add_ps(cos_a, sin_a), v), s),
-            copysign8(_mm256_sub_ps(one, r2), signed_distance)};
-}
-
 // The radiance of eight texels (row-major indices), stored from lane l on.
 ENVMIS_AVX2 void store_radiance8(const Rgb* radiance, I8 texel, float* r, float* g, float* b, uint32_t l) noexcept {
     const I8 three = _mm256_add_epi32(texel, _mm256_add_epi32(texel, texel));
@@ -245,47 +197,17 @@ ENVMIS_AVX2 void store_radiance8(const Rgb* radiance, I8 texel, float* r, float*
 }
 
 // Where eight directions fall: their cells, the first texel of their rows (y w) and
-// the image v (for sin theta).
+// the image v (for sin theta, on equirect maps).
 struct Cells8 {
     I8 x, y, row;
     F8 v;
 };
 
-// An image point in eight lanes.
-struct Uv8 {
-    F8 u, v;
-};
-
-// equirect_uv (mapping.h).
-ENVMIS_AVX2 Uv8 equirect_uv8(const Vec8& d) noexcept {
-    constexpr float kInvPi = static_cast<float>(1 / kPi);
-    const F8 z = clamp8(d.z, -1.0f, 1.0f);
-    const F8 s2 = _mm256_mul_ps(_mm256_sub_ps(splat(1.0f), z), _mm256_add_ps(splat(1.0f), z));
-    const F8 sin_theta = _mm256_sqrt_ps(select(less(splat(0.0f), s2), s2, splat(0.0f)));
-    const F8 theta = atan2_8(sin_theta, z);
-    const F8 phi = atan2_8(d.y, d.x);
-    const F8 turn = select(less(phi, splat(0.0f)), _mm256_add_ps(phi, splat(2 * kPiF)), phi);
-    return {clamp8(_mm256_mul_ps(splat(0.5f * kInvPi), turn), 0.0f, kOneMinusEpsilon),
-            clamp8(_mm256_mul_ps(theta, splat(kInvPi)), 0.0f, kOneMinusEpsilon)};
-}
-
-// equal_area_uv (mapping.h).
-ENVMIS_AVX2 Uv8 equal_area_uv8(const Vec8& d) noexcept {
-    const F8 one = splat(1.0f), abs_z = abs8(d.z);
-    const F8 r = _mm256_sqrt_ps(_mm256_sub_ps(one, select(less(one, abs_z), one, abs_z)));
-    const F8 t = _mm256_mul_ps(atan2_8(abs8(d.y), abs8(d.x)), splat(static_cast<float>(2 / kPi)));
-    const F8 north_v = _mm256_mul_ps(t, r), north_u = _mm256_sub_ps(r, north_v);
-    const F8 south = less(d.z, splat(0.0f));
-    const F8 u = select(south, _mm256_sub_ps(one, north_v), north_u);
-    const F8 v = select(south, _mm256_sub_ps(one, north_u), north_v);
-    return {clamp8(_mm256_mul_ps(splat(0.5f), _mm256_add_ps(copysign8(u, d.x), one)), 0.0f, kOneMinusEpsilon),
-            clamp8(_mm256_mul_ps(splat(0.5f), _mm256_add_ps(copysign8(v, d.y), one)), 0.0f, kOneMinusEpsilon)};
-}
-
 // EnvMapView::uv_of and the cells of eval_uv and pdf_uv (envmap.h), for the eight
 // directions from lane l on; starts loading each texel's radiance and CDF entry.
 ENVMIS_AVX2 Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l) noexcept {
-    const Vec8 d{_mm256_loadu_ps(in.x + l), _mm256_loadu_ps(in.y + l), _mm256_loadu_ps(in.z + l)};
+    const Vec8 d =
+        to_canonical8(env.axes, {_mm256_loadu_ps(in.x + l), _mm256_loadu_ps(in.y + l), _mm256_loadu_ps(in.z + l)});
     const Uv8 p = env.mapping == Mapping::equal_area ? equal_area_uv8(d) : equirect_uv8(d);
     const I8 x = cell8(p.u, env.distribution.w), y = cell8(p.v, env.distribution.h);
     const Cells8 c{x, y, _mm256_mullo_epi32(y, _mm256_set1_epi32(static_cast<int>(env.distribution.w))), p.v};
@@ -422,10 +344,11 @@ struct Direction8 {
     F8 pdf;
 };
 ENVMIS_AVX2 Direction8 at8(const EnvMapView& env, F8 u, F8 v, F8 image_pdf) noexcept {
-    if (env.mapping == Mapping::equal_area) return {equal_area_direction8(u, v), equal_area_pdf8(image_pdf)};
+    if (env.mapping == Mapping::equal_area)
+        return {to_world8(env.axes, equal_area_direction8(u, v)), equal_area_pdf8(image_pdf)};
     const SinCos8 theta = sincos_half_turns8(env.turns, v), phi = sincos_turns8(env.turns, u);
-    return {{_mm256_mul_ps(theta.sin, phi.cos), _mm256_mul_ps(theta.sin, phi.sin), theta.cos},
-            solid_angle_pdf8(image_pdf, theta.sin)};
+    const Vec8 canonical{_mm256_mul_ps(theta.sin, phi.cos), _mm256_mul_ps(theta.sin, phi.sin), theta.cos};
+    return {to_world8(env.axes, canonical), solid_angle_pdf8(image_pdf, theta.sin)};
 }
 
 // EnvMapView::sample for the eight points from lane l on, their rows found.

@@ -158,8 +158,8 @@ struct EnvMapView {
 // EnvMapView::lookup for n directions at once, for code that holds many (an estimator's
 // or a wavefront renderer's BSDF samples): directions in, one array per world
 // coordinate; radiance and solid-angle pdf out, likewise. Bit-identical to n calls of
-// lookup. A map in the default axes, in either mapping, is looked up eight directions at
-// a time with AVX2 where batch_paths() chose it for this CPU (envmis/cpu.h); otherwise one
+// lookup. A map in either mapping and any axes is looked up eight directions at a time
+// with AVX2 where batch_paths() chose it for this CPU (envmis/cpu.h); otherwise one
 // direction at a time, software-pipelined with prefetches so that the misses of many
 // lookups overlap (envmap_many.cpp). Host only; noexcept and allocation-free.
 struct DirectionArrays {
