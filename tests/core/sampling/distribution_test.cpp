@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "envmis/sampling/distribution.h"
@@ -297,6 +298,30 @@ TEST(Distribution1D, SingleCellAndAllZero) {
     const Distribution1D zero(std::vector<float>(5, 0.0f));
     EXPECT_TRUE(zero.uniform_fallback());
     EXPECT_FLOAT_EQ(zero.pdf(0.5f), 1.0f);
+}
+
+// Points outside [0,1) sample as the nearest point inside it (NaN as 0) instead of reading
+// outside the tables: 1.0 is what a float conversion of a random integer can round to.
+TEST(Distribution2D, PointsOutsideTheUnitSquareSampleAsTheNearestPointInside) {
+    const Distribution2D d(test::random_function(37 * 19, 61), 37, 19);
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    const std::pair<float, float> cases[] = {{1.0f, kOneMinusEpsilon},
+                                             {2.0f, kOneMinusEpsilon},
+                                             {inf, kOneMinusEpsilon},
+                                             {-0.5f, 0.0f},
+                                             {-inf, 0.0f},
+                                             {nan, 0.0f}};
+    for (const auto& [outside, inside] : cases) {
+        for (const Vec2 u : {Vec2{outside, 0.3f}, Vec2{0.3f, outside}, Vec2{outside, outside}}) {
+            const Vec2 clamped{u.x == 0.3f ? 0.3f : inside, u.y == 0.3f ? 0.3f : inside};
+            const auto got = d.sample(u), expected = d.sample(clamped);
+            EXPECT_EQ(got.x, expected.x) << outside;
+            EXPECT_EQ(got.y, expected.y) << outside;
+            EXPECT_EQ(got.pdf, expected.pdf) << outside;
+        }
+        const Distribution1D one(std::vector<float>{1, 0, 3, 2});
+        EXPECT_EQ(one.sample(outside).index, one.sample(inside).index) << outside;
+    }
 }
 
 // The point of a sample is the float nearest (index + offset) / n inside cell `index`.

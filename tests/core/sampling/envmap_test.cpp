@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 
@@ -410,7 +411,12 @@ TEST(EnvMap, LookupManyIsBitIdenticalToLookup) {
 // at the ends of [0,1), on the random generator's grid and off it; the image points too.
 TEST(EnvMap, SampleManyIsBitIdenticalToSample) {
     ENVMIS_SKIP_IF_FORCED_PATH_UNAVAILABLE();
-    const float edges[] = {0.0f, 0x1p-24f, 0.5f, 0.25f, 1 - 0x1p-24f, kOneMinusEpsilon};
+    // And outside [0,1), which both paths clamp (unit_point).
+    const float edges[] = {0.0f,         0x1p-24f,
+                           0.5f,         0.25f,
+                           1 - 0x1p-24f, kOneMinusEpsilon,
+                           1.0f,         -0.5f,
+                           2.0f,         std::numeric_limits<float>::quiet_NaN()};
     std::vector<Vec2> points;
     for (const float a : edges)
         for (const float b : edges) points.push_back({a, b});

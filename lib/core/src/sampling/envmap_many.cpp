@@ -263,7 +263,9 @@ struct Unit8 {
     I8 t, k;
 };
 ENVMIS_AVX2 Unit8 unit8(F8 u, uint32_t n) noexcept {
-    const F8 x = _mm256_mul_ps(u, splat(static_cast<float>(kCdfUnits)));
+    const F8 inside = select(less(splat(kOneMinusEpsilon), u), splat(kOneMinusEpsilon), u);  // unit_point
+    const F8 point = select(_mm256_cmp_ps(u, splat(0.0f), _CMP_GT_OQ), inside, splat(0.0f));
+    const F8 x = _mm256_mul_ps(point, splat(static_cast<float>(kCdfUnits)));
     const I8 t = _mm256_cvttps_epi32(x);  // x < 2^31
     const I8 nn = _mm256_set1_epi32(static_cast<int>(n));
     const I8 even = _mm256_srli_epi64(_mm256_mul_epu32(t, nn), 31);

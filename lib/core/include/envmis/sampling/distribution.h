@@ -70,6 +70,11 @@ struct CellHit {
     float offset = 0;
 };
 
+// u clamped into [0, kOneMinusEpsilon], NaN to 0: the samplers take points of [0,1), and
+// this keeps any other input from reading outside their tables (a renderer's float
+// conversion of a random integer can round up to 1). Valid points pass unchanged.
+ENVMIS_HD inline float unit_point(float u) noexcept { return u > 0.0f ? min(u, kOneMinusEpsilon) : 0.0f; }
+
 // The hint of CdfView::invert that does nothing.
 struct NoHint {
     ENVMIS_HD void operator()(uint32_t) const noexcept {}
@@ -101,7 +106,7 @@ struct CdfView {
     // prefetches would only take load slots.
     template <bool kPrefetch = true, class Hint = NoHint>
     ENVMIS_HD ENVMIS_INLINE CellHit invert(float u, Hint near_answer = {}) const noexcept {
-        const float x = u * static_cast<float>(kCdfUnits);
+        const float x = unit_point(u) * static_cast<float>(kCdfUnits);
         const auto t = static_cast<uint32_t>(x);
         const uint32_t k = bucket_of_unit(t);
         if constexpr (kPrefetch) prefetch_bucket(k, near_answer);
@@ -151,7 +156,7 @@ struct CdfView {
         return static_cast<uint32_t>((static_cast<uint64_t>(t) * n) >> 31);
     }
     ENVMIS_HD uint32_t bucket(float u) const noexcept {
-        return bucket_of_unit(static_cast<uint32_t>(u * static_cast<float>(kCdfUnits)));
+        return bucket_of_unit(static_cast<uint32_t>(unit_point(u) * static_cast<float>(kCdfUnits)));
     }
 
     // The u that `invert` maps to (index, offset).

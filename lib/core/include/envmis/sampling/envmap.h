@@ -77,6 +77,7 @@ struct EnvMapView {
     const SinCos* turns = nullptr;  // make_turn_table() (fast_math.h)
     Mapping mapping = Mapping::equirect;
 
+    // u in [0,1)^2; a coordinate outside it (1.0, NaN) is clamped into it (unit_point).
     ENVMIS_HD ENVMIS_INLINE EnvSample sample(Vec2 u) const noexcept {
         // Prefetching the radiance near the answer overlaps its load with the search's.
         const auto s = distribution.sample(u, [this](size_t i) { ENVMIS_PREFETCH(radiance + i); });
