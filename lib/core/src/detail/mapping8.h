@@ -79,7 +79,7 @@ ENVMIS_AVX2 inline Vec8 equal_area_direction8(F8 uv_x, F8 uv_y) noexcept {
     cos_a = _mm256_mul_ps(_mm256_mul_ps(cos_a, a2), a2);
     cos_a = _mm256_add_ps(_mm256_sub_ps(cos_a, _mm256_mul_ps(splat(0.5f), a2)), one);
     const F8 r2 = _mm256_mul_ps(r, r), root_arg = _mm256_sub_ps(splat(2.0f), r2);
-    const F8 root = _mm256_sqrt_ps(select(less(splat(0.0f), root_arg), root_arg, splat(0.0f)));
+    const F8 root = _mm256_sqrt_ps(max0(root_arg));
     const F8 s = _mm256_mul_ps(_mm256_mul_ps(r, root), splat(0.70710678118654752f));
     return {_mm256_mul_ps(copysign8(_mm256_sub_ps(cos_a, sin_a), u), s),
             _mm256_mul_ps(copysign8(_mm256_add_ps(cos_a, sin_a), v), s),
@@ -96,7 +96,7 @@ ENVMIS_AVX2 inline Uv8 equirect_uv8(const Vec8& d) noexcept {
     constexpr float kInvPi = static_cast<float>(1 / kPi);
     const F8 z = clamp8(d.z, -1.0f, 1.0f);
     const F8 s2 = _mm256_mul_ps(_mm256_sub_ps(splat(1.0f), z), _mm256_add_ps(splat(1.0f), z));
-    const F8 sin_theta = _mm256_sqrt_ps(select(less(splat(0.0f), s2), s2, splat(0.0f)));
+    const F8 sin_theta = _mm256_sqrt_ps(max0(s2));
     const F8 theta = atan2_8(sin_theta, z);
     const F8 phi = atan2_8(d.y, d.x);
     const F8 turn = select(less(phi, splat(0.0f)), _mm256_add_ps(phi, splat(2 * kPiF)), phi);
@@ -107,7 +107,7 @@ ENVMIS_AVX2 inline Uv8 equirect_uv8(const Vec8& d) noexcept {
 // equal_area_uv (mapping.h).
 ENVMIS_AVX2 inline Uv8 equal_area_uv8(const Vec8& d) noexcept {
     const F8 one = splat(1.0f), abs_z = abs8(d.z);
-    const F8 r = _mm256_sqrt_ps(_mm256_sub_ps(one, select(less(one, abs_z), one, abs_z)));
+    const F8 r = _mm256_sqrt_ps(_mm256_sub_ps(one, min8(abs_z, one)));
     const F8 t = _mm256_mul_ps(atan2_8(abs8(d.y), abs8(d.x)), splat(static_cast<float>(2 / kPi)));
     const F8 north_v = _mm256_mul_ps(t, r), north_u = _mm256_sub_ps(r, north_v);
     const F8 south = less(d.z, splat(0.0f));

@@ -263,7 +263,7 @@ struct Unit8 {
     I8 t, k;
 };
 ENVMIS_AVX2 Unit8 unit8(F8 u, uint32_t n) noexcept {
-    const F8 inside = select(less(splat(kOneMinusEpsilon), u), splat(kOneMinusEpsilon), u);  // unit_point
+    const F8 inside = min8(u, splat(kOneMinusEpsilon));  // unit_point
     const F8 point = select(_mm256_cmp_ps(u, splat(0.0f), _CMP_GT_OQ), inside, splat(0.0f));
     const F8 x = _mm256_mul_ps(point, splat(static_cast<float>(kCdfUnits)));
     const I8 t = _mm256_cvttps_epi32(x);  // x < 2^31
@@ -307,7 +307,7 @@ ENVMIS_AVX2 Hit8 search8(const uint32_t* start, const uint16_t* guide, I8 base, 
     const I8 before = _mm256_sub_epi32(t, cell.start);  // < 2^31
     const F8 offset = _mm256_div_ps(_mm256_add_ps(_mm256_cvtepi32_ps(before), _mm256_sub_ps(x, _mm256_cvtepi32_ps(t))),
                                     width_to_float(cell.width));
-    return {lo, select(less(splat(kOneMinusEpsilon), offset), splat(kOneMinusEpsilon), offset), cell.width};
+    return {lo, min8(offset, splat(kOneMinusEpsilon)), cell.width};
 }
 
 // Eight points of EnvMapView::sample with their rows found (the marginal is small and

@@ -59,8 +59,6 @@ ENVMIS_AVX2 SinCos8 fast_sincos8(F8 x) noexcept {
 ENVMIS_AVX2 F8 not_below(F8 z) noexcept { return _mm256_cmp_ps(z, _mm256_setzero_ps(), _CMP_NLE_UQ); }
 ENVMIS_AVX2 F8 both(F8 a, F8 b) noexcept { return _mm256_and_ps(a, b); }
 ENVMIS_AVX2 F8 sqrt8(F8 v) noexcept { return _mm256_sqrt_ps(v); }
-// max(0.0f, v) (math.h): 0 < v ? v : 0.
-ENVMIS_AVX2 F8 max0(F8 v) noexcept { return select(less(splat(0.0f), v), v, splat(0.0f)); }
 ENVMIS_AVX2 I8 bits_of(F8 v) noexcept { return _mm256_castps_si256(v); }
 ENVMIS_AVX2 F8 float_of(I8 v) noexcept { return _mm256_castsi256_ps(v); }
 ENVMIS_AVX2 I8 splat_int(uint32_t v) noexcept { return _mm256_set1_epi32(static_cast<int32_t>(v)); }
