@@ -101,12 +101,14 @@ const BatchPoints& batch_points() {
     }();
     return p;
 }
-envmis::SampleArrays sample_arrays(float* o) {
-    return {o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch, o + 4 * kBatch, o + 5 * kBatch, o + 6 * kBatch};
+// Output arrays of n samples each, one after the other in o (7 n floats).
+envmis::SampleArrays sample_arrays(float* o, size_t n = kBatch) {
+    return {o, o + n, o + 2 * n, o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n};
 }
-void per_sample(benchmark::State& state) {
+// The time per sample of n samples an iteration.
+void per_sample(benchmark::State& state, size_t n = kBatch) {
     state.counters["per_sample"] = benchmark::Counter(
-        static_cast<double>(kBatch), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+        static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 template <bool kCompensated>
@@ -287,9 +289,7 @@ void equal_area_over_equirect(benchmark::State& state) {
     constexpr size_t kBlock = 1024;  // long enough to make the clock's reading negligible
     const BatchPoints& p = batch_points();
     std::vector<float> out(7 * kBlock);
-    float* o = out.data();
-    const envmis::SampleArrays arrays{
-        o, o + kBlock, o + 2 * kBlock, o + 3 * kBlock, o + 4 * kBlock, o + 5 * kBlock, o + 6 * kBlock};
+    const envmis::SampleArrays arrays = sample_arrays(out.data(), kBlock);
     double seconds[2] = {0, 0};
     size_t first = 0;
     int leader = 0;
@@ -313,8 +313,7 @@ void equal_area_over_equirect(benchmark::State& state) {
         first = (first + kBlock) & (p.ux.size() - 1);
         leader ^= 1;
     }
-    state.counters["per_sample"] = benchmark::Counter(
-        static_cast<double>(kBlock), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+    per_sample(state, kBlock);
     state.counters["equal_area/equirect"] = seconds[0] / seconds[1];
 }
 
