@@ -227,7 +227,9 @@ TEST(Distribution2D, TheCoarsePredictionLiesInTheSpanThatHoldsTheAnswer) {
             ASSERT_LE(answer, last) << y << " " << u;
             ASSERT_LE(first, predicted) << y << " " << u;
             ASSERT_LE(predicted, last) << y << " " << u;
-            if (y == 1) ASSERT_LE(std::max(answer, predicted) - std::min(answer, predicted), 1u) << u;
+            if (y == 1) {
+                ASSERT_LE(std::max(answer, predicted) - std::min(answer, predicted), 1u) << u;
+            }
         }
     }
 }
