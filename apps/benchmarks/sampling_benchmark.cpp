@@ -90,13 +90,14 @@ constexpr size_t kBatch = 64;
 const std::vector<envmis::Vec3>& directions();
 const std::vector<envmis::Vec3>& normals();
 struct BatchPoints {
-    std::vector<float> ux, uy, nx, ny, nz;
+    std::vector<float> ux, uy, nx, ny, nz, dx, dy, dz;  // points, normals, directions
 };
 const BatchPoints& batch_points() {
     static const BatchPoints p = [] {
         BatchPoints b;
         for (const envmis::Vec2 u : uniforms()) b.ux.push_back(u.x), b.uy.push_back(u.y);
         for (const envmis::Vec3 n : normals()) b.nx.push_back(n.x), b.ny.push_back(n.y), b.nz.push_back(n.z);
+        for (const envmis::Vec3 d : directions()) b.dx.push_back(d.x), b.dy.push_back(d.y), b.dz.push_back(d.z);
         return b;
     }();
     return p;
@@ -272,11 +273,35 @@ void sample_mapped(benchmark::State& state) {
     state.counters["Mtexels"] = static_cast<double>(state.range(0) * state.range(1)) / 1e6;
 }
 
-// The two mappings interleaved: blocks of 1024 samples at the same points on the
-// equal-area sky and on the equirect one, in turns (the first of each pair reads the
-// points cold), so that their ratio spans the same seconds of the machine's drift (the
-// cases above run minutes apart). Manual time: the equal-area map's; the counter
-// equal_area/equirect is the ratio of the two maps' totals.
+// Two kinds of work in turns, `work(m, first)` for m = 0 and 1 on the block of `block`
+// points from `first` (of `points`, a power of two) each iteration, the one going first
+// alternating (the first of a pair reads its points cold), so that their ratio spans the
+// same seconds of the machine's drift. Manual time: work 0's; returns the ratio of work
+// 0's total time to work 1's.
+template <class Work>
+double in_turns(benchmark::State& state, size_t points, size_t block, Work&& work) {
+    double seconds[2] = {0, 0};
+    size_t first = 0;
+    int leader = 0;
+    for (auto _ : state) {
+        for (int turn = 0; turn < 2; ++turn) {
+            const int m = leader ^ turn;
+            const auto start = std::chrono::steady_clock::now();
+            work(m, first);
+            const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            seconds[m] += elapsed;
+            if (m == 0) state.SetIterationTime(elapsed);
+        }
+        first = (first + block) & (points - 1);
+        leader ^= 1;
+    }
+    per_sample(state, block);
+    return seconds[0] / seconds[1];
+}
+
+// The two mappings in turns: blocks of 1024 samples at the same points on the equal-area
+// sky and on the equirect one (the cases above run minutes apart). Manual time: the
+// equal-area map's; the counter equal_area/equirect is the ratio of the two maps' totals.
 // Arguments: the equal-area side, the equirect width and height, compensated, and
 // sample_many (1) or single calls (0).
 void equal_area_over_equirect(benchmark::State& state) {
@@ -290,31 +315,64 @@ void equal_area_over_equirect(benchmark::State& state) {
     const BatchPoints& p = batch_points();
     std::vector<float> out(7 * kBlock);
     const envmis::SampleArrays arrays = sample_arrays(out.data(), kBlock);
-    double seconds[2] = {0, 0};
-    size_t first = 0;
-    int leader = 0;
-    for (auto _ : state) {
-        for (int turn = 0; turn < 2; ++turn) {
-            const int m = leader ^ turn;
-            const auto start = std::chrono::steady_clock::now();
-            if (batch) {
-                envmis::sample_many(maps[m], {p.ux.data() + first, p.uy.data() + first}, arrays, kBlock);
-                benchmark::DoNotOptimize(out.data());
-            } else {
-                for (size_t i = first; i < first + kBlock; ++i) {
-                    const envmis::EnvSample e = maps[m].sample({p.ux[i], p.uy[i]});
-                    benchmark::DoNotOptimize(e);
-                }
-            }
-            const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-            seconds[m] += elapsed;
-            if (m == 0) state.SetIterationTime(elapsed);
+    state.counters["equal_area/equirect"] = in_turns(state, p.ux.size(), kBlock, [&](int m, size_t first) {
+        if (batch) {
+            envmis::sample_many(maps[m], {p.ux.data() + first, p.uy.data() + first}, arrays, kBlock);
+            benchmark::DoNotOptimize(out.data());
+            return;
         }
-        first = (first + kBlock) & (p.ux.size() - 1);
-        leader ^= 1;
+        for (size_t i = first; i < first + kBlock; ++i) {
+            const envmis::EnvSample e = maps[m].sample({p.ux[i], p.uy[i]});
+            benchmark::DoNotOptimize(e);
+        }
+    });
+}
+
+// lookup_many against the memory's floor: independent reads of the data each of its
+// lookups must fetch (the texel's radiance at both ends, its CDF start and the next, its
+// row's marginal entry), at texels found before timing. On a map beyond the cache those
+// reads are the misses, and a loop that only issues them keeps as many in flight as the
+// CPU allows. Blocks of 1024 directions, the two in turns (in_turns): the counter
+// many/line_reads is the ratio of their totals; each reads a block the other read half
+// the points ago, long out of the cache (its lines would otherwise arrive warm). 1 would
+// mean the lookups are bound by the memory system alone, not by their arithmetic or by
+// misses that wait on each other. Manual time: lookup_many's. Arguments: the map's
+// width, compensated.
+void lookup_over_line_reads(benchmark::State& state) {
+    const auto w = static_cast<uint32_t>(state.range(0));
+    const EnvMap map(sky(w), state.range(1) != 0 ? options<true>() : plain_options());
+    const EnvMapView view = map.view();
+    const envmis::Distribution2DView& d = view.distribution;
+    const BatchPoints& p = batch_points();
+    std::vector<uint32_t> texels, rows;
+    for (const envmis::Vec3 dir : directions()) {
+        const envmis::Vec2 uv = view.uv_of(dir);
+        rows.push_back(envmis::detail::cell_of(uv.y, d.h));
+        texels.push_back(rows.back() * d.w + envmis::detail::cell_of(uv.x, d.w));
     }
-    per_sample(state, kBlock);
-    state.counters["equal_area/equirect"] = seconds[0] / seconds[1];
+    const size_t last = size_t{d.w} * d.h - 1;
+    const auto read_lines = [&](size_t first, size_t n) {
+        float radiance = 0;
+        uint32_t units = 0;
+        for (size_t i = first; i < first + n; ++i) {
+            const size_t k = texels[i];
+            radiance += view.radiance[k].r + view.radiance[k].b;
+            units += d.start[k] + d.start[std::min(k + 1, last)] + d.marginal.start[rows[i]];
+        }
+        benchmark::DoNotOptimize(radiance);
+        benchmark::DoNotOptimize(units);
+    };
+    constexpr size_t kBlock = 1024;
+    std::vector<float> out(4 * kBatch);
+    const envmis::LookupArrays arrays{out.data(), out.data() + kBatch, out.data() + 2 * kBatch,
+                                      out.data() + 3 * kBatch};
+    state.counters["many/line_reads"] = in_turns(state, texels.size(), kBlock, [&](int m, size_t first) {
+        if (m == 1) return read_lines((first + texels.size() / 2) & (texels.size() - 1), kBlock);
+        for (size_t b = first; b < first + kBlock; b += kBatch) {
+            envmis::lookup_many(view, {p.dx.data() + b, p.dy.data() + b, p.dz.data() + b}, arrays, kBatch);
+            benchmark::DoNotOptimize(out.data());
+        }
+    });
 }
 
 void sizes(benchmark::internal::Benchmark* b) { b->Arg(1024)->Arg(8192)->Unit(benchmark::kMillisecond); }
@@ -355,6 +413,10 @@ BENCHMARK(equal_area_over_equirect)
     ->Name("sample/equal-area-over-equirect")
     ->ArgsProduct({{4096}, {5792}, {2896}, {0, 1}, {0, 1}})
     ->ArgsProduct({{5792}, {8192}, {4096}, {0, 1}, {0, 1}})
+    ->UseManualTime();
+BENCHMARK(lookup_over_line_reads)
+    ->Name("lookup/many-over-line-reads")
+    ->ArgsProduct({{1024, 8192}, {0, 1}})
     ->UseManualTime();
 BENCHMARK_CAPTURE(estimate, mis_balance_lambert, "mis-balance", envmis::Bsdf::lambert())
     ->Name("estimate/mis-balance/lambert")
