@@ -204,20 +204,21 @@ struct Cells8 {
 };
 
 // EnvMapView::uv_of and the cells of eval_uv and pdf_uv (envmap.h), for the eight
-// directions from lane l on; starts loading each texel's radiance and CDF entry.
+// directions from lane l on; starts loading all that fetch8 reads there (prefetch_cell).
+// Both lines of a texel that straddles two, and the next CDF entry's where it starts a
+// line: a gather waits for its slowest lane, and with one line a texel prefetched, one
+// group of eight in five or so waited on a miss of its own (measured:
+// docs/performance-log.md).
 ENVMIS_AVX2 Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l) noexcept {
     const Vec8 d =
         to_canonical8(env.axes, {_mm256_loadu_ps(in.x + l), _mm256_loadu_ps(in.y + l), _mm256_loadu_ps(in.z + l)});
     const Uv8 p = env.mapping == Mapping::equal_area ? equal_area_uv8(d) : equirect_uv8(d);
     const I8 x = cell8(p.u, env.distribution.w), y = cell8(p.v, env.distribution.h);
-    const Cells8 c{x, y, _mm256_mullo_epi32(y, _mm256_set1_epi32(static_cast<int>(env.distribution.w))), p.v};
-    alignas(32) uint32_t texel[8];
-    _mm256_store_si256(reinterpret_cast<I8*>(texel), _mm256_add_epi32(c.row, c.x));
-    for (const uint32_t i : texel) {
-        ENVMIS_PREFETCH(env.radiance + i);
-        ENVMIS_PREFETCH(env.distribution.start + i);
-    }
-    return c;
+    alignas(32) uint32_t column[8], row[8];
+    _mm256_store_si256(reinterpret_cast<I8*>(column), x);
+    _mm256_store_si256(reinterpret_cast<I8*>(row), y);
+    for (int lane = 0; lane < 8; ++lane) env.prefetch_cell(column[lane], row[lane]);
+    return {x, y, _mm256_mullo_epi32(y, _mm256_set1_epi32(static_cast<int>(env.distribution.w))), p.v};
 }
 
 // Radiance and solid-angle pdf at eight located directions, stored from lane l on.

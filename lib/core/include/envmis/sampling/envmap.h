@@ -129,7 +129,11 @@ struct EnvMapView {
     // Starts loading what eval_uv and pdf_uv read at uv, so that code with several
     // lookups to make (a batch of shading samples) overlaps their cache misses.
     ENVMIS_HD void prefetch_uv(Vec2 uv) const noexcept {
-        const uint32_t x = detail::cell_of(uv.x, distribution.w), y = detail::cell_of(uv.y, distribution.h);
+        prefetch_cell(detail::cell_of(uv.x, distribution.w), detail::cell_of(uv.y, distribution.h));
+    }
+    // The same for the texel in column x of row y: all a lookup there reads beyond the
+    // turn table (prefetch_texel, and the row's marginal entry).
+    ENVMIS_HD void prefetch_cell(uint32_t x, uint32_t y) const noexcept {
         prefetch_texel(static_cast<size_t>(y) * distribution.w + x);
         ENVMIS_PREFETCH(distribution.marginal.start + y);
     }
