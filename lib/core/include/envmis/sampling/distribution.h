@@ -324,19 +324,22 @@ struct Distribution2DView {
     ENVMIS_HD uint32_t coarse_row_size() const noexcept { return coarse_guide_size(w); }
     // u.y picks the row, u.x the column within it. `near_answer(i)` is told the
     // row-major index i = y w + x of a cell usually near the one sampled (see
-    // CdfView::invert), for the caller to prefetch its data.
+    // CdfView::invert), for the caller to prefetch its data. The marginal is read by every
+    // sample and stays in cache: its inversion prefetches nothing.
     template <class Hint = NoHint>
     ENVMIS_HD ENVMIS_INLINE Sample sample(Vec2 u, Hint near_answer = {}) const noexcept {
-        return sample_in_row(marginal.invert(u.y), u.x, near_answer);
+        return sample_in_row(marginal.invert<false>(u.y), u.x, near_answer);
     }
     // The second stage of sample: the column in row r (marginal.invert(u.y)) and the
     // point. Batch callers find many rows first and prefetch the columns' data meanwhile.
     template <class Hint = NoHint>
     ENVMIS_HD ENVMIS_INLINE Sample sample_in_row(CellHit r, float ux, Hint near_answer = {}) const noexcept {
-        const CdfView cdf = row(r.index);
+        // Without the coarse guide, which only the prefetches of a cold row read: row()
+        // would work out its pointer for every sample.
         const size_t row_start = static_cast<size_t>(r.index) * w;
+        const CdfView cdf{start + row_start, guide + row_start, w};
         const auto near = [&](uint32_t x) { near_answer(row_start + x); };
-        const CellHit c = hot_row(r.index) ? cdf.invert<false>(ux) : cdf.invert(ux, near);
+        const CellHit c = hot_row(r.index) ? cdf.invert<false>(ux) : row(r.index).invert(ux, near);
         const Vec2 p{detail::point_in_cell(c.index, c.offset, w), detail::point_in_cell(r.index, r.offset, h)};
         return {p, pdf_of(marginal.width(r.index), cdf.width(c.index)), c.index, r.index};
     }
