@@ -206,8 +206,8 @@ struct Cells8 {
 // EnvMapView::uv_of and the cells of eval_uv and pdf_uv (envmap.h), for the eight
 // directions from lane l on; starts loading all that fetch8 reads there (prefetch_cell).
 // Both lines of a texel that straddles two, and the next CDF entry's where it starts a
-// line: a gather waits for its slowest lane, and with one line a texel prefetched, one
-// group of eight in five or so waited on a miss of its own (measured:
+// line: a gather waits for its slowest lane, and with one line a texel prefetched, four
+// groups of eight in five had a lane whose line nobody had asked for (measured:
 // docs/performance-log.md).
 ENVMIS_AVX2 Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l) noexcept {
     const Vec8 d =
