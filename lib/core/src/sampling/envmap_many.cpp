@@ -60,7 +60,7 @@ void prefetch_column(const EnvMapView& env, uint32_t y, uint32_t k) noexcept {
 // Distribution2DView::hot_row); then the column and the rest.
 CellHit find_row(const EnvMapView& env, Vec2 u) noexcept {
     const Distribution2DView& d = env.distribution;
-    const CellHit r = d.marginal.invert<false>(u.y);
+    const CellHit r = d.sample_row(u.y);
     if (!d.hot_row(r.index)) prefetch_column(env, r.index, d.row(r.index).bucket(u.x));
     return r;
 }

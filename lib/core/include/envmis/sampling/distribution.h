@@ -324,14 +324,16 @@ struct Distribution2DView {
     ENVMIS_HD uint32_t coarse_row_size() const noexcept { return coarse_guide_size(w); }
     // u.y picks the row, u.x the column within it. `near_answer(i)` is told the
     // row-major index i = y w + x of a cell usually near the one sampled (see
-    // CdfView::invert), for the caller to prefetch its data. The marginal is read by every
-    // sample and stays in cache: its inversion prefetches nothing.
+    // CdfView::invert), for the caller to prefetch its data.
     template <class Hint = NoHint>
     ENVMIS_HD ENVMIS_INLINE Sample sample(Vec2 u, Hint near_answer = {}) const noexcept {
-        return sample_in_row(marginal.invert<false>(u.y), u.x, near_answer);
+        return sample_in_row(sample_row(u.y), u.x, near_answer);
     }
-    // The second stage of sample: the column in row r (marginal.invert(u.y)) and the
-    // point. Batch callers find many rows first and prefetch the columns' data meanwhile.
+    // The first stage of sample: the row that u.y picks. The marginal is read by every
+    // sample and stays in cache: its inversion prefetches nothing.
+    ENVMIS_HD ENVMIS_INLINE CellHit sample_row(float uy) const noexcept { return marginal.invert<false>(uy); }
+    // The second stage of sample: the column in row r (sample_row(u.y)) and the point.
+    // Batch callers find many rows first and prefetch the columns' data meanwhile.
     template <class Hint = NoHint>
     ENVMIS_HD ENVMIS_INLINE Sample sample_in_row(CellHit r, float ux, Hint near_answer = {}) const noexcept {
         // Without the coarse guide, which only the prefetches of a cold row read: row()
