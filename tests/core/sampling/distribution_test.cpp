@@ -220,9 +220,10 @@ TEST(Distribution2D, TheCoarsePredictionLiesInTheSpanThatHoldsTheAnswer) {
         const CdfView row = d.view().row(y);
         for (int i = 0; i < 20000; ++i) {
             const float u = i < 3 ? (i == 0 ? 0.0f : (i == 1 ? 0.5f : kOneMinusEpsilon)) : rng.uniform();
-            const uint32_t k = row.bucket(u), j = k / kCoarseGuideStep;
+            const uint64_t b = row.bucket_position(unit_of(u));
+            const uint32_t j = row.bucket(u) / kCoarseGuideStep;
             const uint32_t first = row.coarse[j], last = (j + 1) * kCoarseGuideStep < w ? row.coarse[j + 1] : w - 1;
-            const uint32_t answer = row.invert(u).index, predicted = row.predicted_cell(k);
+            const uint32_t answer = row.invert(u).index, predicted = row.predicted_cell(b);
             ASSERT_LE(first, answer) << y << " " << u;
             ASSERT_LE(answer, last) << y << " " << u;
             ASSERT_LE(first, predicted) << y << " " << u;

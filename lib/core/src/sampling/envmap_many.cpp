@@ -46,13 +46,14 @@ void lookup_scalar(const EnvMapView& env, DirectionArrays in, LookupArrays out, 
         });
 }
 
-// What the column search in row y reads for guide bucket k: the guide entry, the CDF
+// What the column search in row y reads for unit t (unit_of): the guide entry, the CDF
 // where CdfView::invert would prefetch it, and the radiance there.
-void prefetch_column(const EnvMapView& env, uint32_t y, uint32_t k) noexcept {
+void prefetch_column(const EnvMapView& env, uint32_t y, uint32_t t) noexcept {
     const CdfView row = env.distribution.row(y);
-    const Rgb* radiance = env.radiance + static_cast<size_t>(y) * env.distribution.w;
-    ENVMIS_PREFETCH(row.guide + k);
-    row.prefetch_bucket(k, [radiance](uint32_t x) { ENVMIS_PREFETCH(radiance + x); });
+    const size_t row_start = static_cast<size_t>(y) * env.distribution.w;
+    ENVMIS_PREFETCH(row.guide + row.bucket_of_unit(t));
+    row.prefetch_unit(
+        t, [&](uint32_t first, uint32_t last) { env.prefetch_radiance(row_start + first, row_start + last); });
 }
 
 // EnvMapView::sample in the two stages of Distribution2DView::sample: the row (the
@@ -61,12 +62,13 @@ void prefetch_column(const EnvMapView& env, uint32_t y, uint32_t k) noexcept {
 CellHit find_row(const EnvMapView& env, Vec2 u) noexcept {
     const Distribution2DView& d = env.distribution;
     const CellHit r = d.sample_row(u.y);
-    if (!d.hot_row(r.index)) prefetch_column(env, r.index, d.row(r.index).bucket(u.x));
+    if (!d.hot_row(r.index)) prefetch_column(env, r.index, unit_of(u.x));
     return r;
 }
 
 EnvSample sample_in_row(const EnvMapView& env, CellHit r, Vec2 u) noexcept {
-    const auto s = env.distribution.sample_in_row(r, u.x, [&](size_t i) { ENVMIS_PREFETCH(env.radiance + i); });
+    const auto s =
+        env.distribution.sample_in_row(r, u.x, [&](size_t first, size_t last) { env.prefetch_radiance(first, last); });
     return env.at(s.p, s.pdf, static_cast<size_t>(s.y) * env.distribution.w + s.x);
 }
 
@@ -328,14 +330,14 @@ ENVMIS_AVX2 Rows8 rows8(const EnvMapView& env, PointArrays in, uint32_t l, uint3
     const Hit8 r = search8(d.marginal.start, d.marginal.guide, zero, d.h, unit8(_mm256_loadu_ps(in.y + l), d.h));
     const Rows8 rows{r, _mm256_mullo_epi32(r.index, _mm256_set1_epi32(static_cast<int>(d.w))),
                      unit8(_mm256_loadu_ps(in.x + l), d.w)};
-    alignas(32) uint32_t y[8], k[8];
+    alignas(32) uint32_t y[8], t[8];
     _mm256_store_si256(reinterpret_cast<I8*>(y), r.index);
-    _mm256_store_si256(reinterpret_cast<I8*>(k), rows.column.k);
+    _mm256_store_si256(reinterpret_cast<I8*>(t), rows.column.t);
     const I8 cap = _mm256_set1_epi32(static_cast<int>(hot_units));
     const I8 cold = _mm256_cmpeq_epi32(_mm256_min_epu32(r.width, cap), r.width);  // unsigned width <= cap
     for (auto m = static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(cold))); m != 0; m &= m - 1) {
         const int lane = __builtin_ctz(m);
-        prefetch_column(env, y[lane], k[lane]);
+        prefetch_column(env, y[lane], t[lane]);
     }
     return rows;
 }

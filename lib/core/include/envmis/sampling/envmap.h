@@ -80,7 +80,7 @@ struct EnvMapView {
     // u in [0,1)^2; a coordinate outside it (1.0, NaN) is clamped into it (unit_point).
     ENVMIS_HD ENVMIS_INLINE EnvSample sample(Vec2 u) const noexcept {
         // Prefetching the radiance near the answer overlaps its load with the search's.
-        const auto s = distribution.sample(u, [this](size_t i) { ENVMIS_PREFETCH(radiance + i); });
+        const auto s = distribution.sample(u, [this](size_t first, size_t last) { prefetch_radiance(first, last); });
         return at(s.p, s.pdf, static_cast<size_t>(s.y) * distribution.w + s.x);
     }
     // The sample at image point p of texel `texel`, drawn with image-space density
@@ -137,13 +137,18 @@ struct EnvMapView {
         prefetch_texel(static_cast<size_t>(y) * distribution.w + x);
         ENVMIS_PREFETCH(distribution.marginal.start + y);
     }
-    // The same for texel i (row-major) but its row's marginal entry: its radiance (both
-    // ends: a texel may straddle two cache lines), its CDF entry and the next (its width).
+    // The same for texel i (row-major) but its row's marginal entry: its radiance, its
+    // CDF entry and the next (its width).
     ENVMIS_HD void prefetch_texel(size_t i) const noexcept {
-        ENVMIS_PREFETCH(radiance + i);
-        ENVMIS_PREFETCH(&radiance[i].b);
+        prefetch_radiance(i, i);
         ENVMIS_PREFETCH(distribution.start + i);
         ENVMIS_PREFETCH(distribution.start + i + 1);  // one past the table at most: a prefetch does not fault
+    }
+    // The radiance of texels first to last of a row, at most five (two cache lines),
+    // through both ends: a texel may straddle two lines.
+    ENVMIS_HD void prefetch_radiance(size_t first, size_t last) const noexcept {
+        ENVMIS_PREFETCH(radiance + first);
+        ENVMIS_PREFETCH(&radiance[last].b);
     }
     // Both at once, mapping the direction to the image once (MIS needs both).
     struct Lookup {
