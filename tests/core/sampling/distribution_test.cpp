@@ -235,6 +235,33 @@ TEST(Distribution2D, TheCoarsePredictionLiesInTheSpanThatHoldsTheAnswer) {
     }
 }
 
+// invert_cached starts the search from the coarse entries around the bucket instead of
+// the guide's where those are at most a cell apart: rows with a few cells bright enough
+// to span many buckets each. It finds the same cell and offset as invert for every
+// point, on such rows (with a dim rest, and with empty cells) and on rows where the
+// coarse span is never that narrow.
+TEST(Distribution2D, ASearchFromTheCoarseGuideFindsWhatTheGuideFinds) {
+    const uint32_t w = kCoarseW, h = kCoarseH;
+    std::vector<float> f = test::random_function(size_t{w} * h, 43, 8);
+    for (uint32_t x = 0; x < w; ++x) f[x] = 1e-3f, f[w + x] = 0;
+    for (const uint32_t x : {5u, 700u, w - 1}) f[x] = f[w + x] = 1e3f;  // the last in the row's shorter last step
+    const Distribution2D d(f, w, h);
+    Rng rng(47);
+    size_t narrow = 0;
+    for (const uint32_t y : {0u, 1u, 2u, h - 1}) {
+        const CdfView row = d.view().row(y);
+        for (int i = 0; i < 20000; ++i) {
+            const float u = i < 3 ? (i == 0 ? 0.0f : (i == 1 ? 0.5f : kOneMinusEpsilon)) : rng.uniform();
+            const CellHit cached = row.invert_cached(u), guided = row.invert(u);
+            ASSERT_EQ(cached.index, guided.index) << y << " " << u;
+            ASSERT_EQ(cached.offset, guided.offset) << y << " " << u;
+            const uint32_t j = row.bucket(u) / kCoarseGuideStep;
+            narrow += ((j + 1) * kCoarseGuideStep < w ? row.coarse[j + 1] : w - 1) - row.coarse[j] <= 1;
+        }
+    }
+    EXPECT_GT(narrow, 30000u);  // rows 0 and 1 mostly start from the coarse guide
+}
+
 // A row is hot (its data stays in cache, so samples in it prefetch nothing) when it holds
 // more than kHotRowFactor times the mean row's units. Single calls test it with a product
 // (hot_row), the AVX2 kernel with a threshold in units (hot_row_units): the same rule,
