@@ -255,8 +255,8 @@ TEST(Distribution2D, ASearchFromTheCoarseGuideFindsWhatTheGuideFinds) {
             const CellHit cached = row.invert_cached(u), guided = row.invert(u);
             ASSERT_EQ(cached.index, guided.index) << y << " " << u;
             ASSERT_EQ(cached.offset, guided.offset) << y << " " << u;
-            const uint32_t j = row.bucket(u) / kCoarseGuideStep;
-            narrow += ((j + 1) * kCoarseGuideStep < w ? row.coarse[j + 1] : w - 1) - row.coarse[j] <= 1;
+            const CdfView::Span s = row.coarse_span(row.bucket(u));
+            narrow += s.hi - s.lo <= 1;
         }
     }
     EXPECT_GT(narrow, 30000u);  // rows 0 and 1 mostly start from the coarse guide

@@ -122,21 +122,26 @@ struct CdfView {
     // whose few bright cells span many buckets each. A 2D distribution's row read often
     // (Distribution2DView::hot_row) keeps its coarse guide, 1/64 of its guide, in the
     // nearest cache, where its guide spills into the next: compensated single samples on
-    // the 8k sky took 0.87-0.96x the time of a search from the guide (AMD EPYC family
+    // the 8k sky took 0.87-0.99x the time of a search from the guide (AMD EPYC family
     // 0x19). The same answer as invert.
     ENVMIS_HD ENVMIS_INLINE CellHit invert_cached(float u) const noexcept {
         const float x = unit_point(u) * static_cast<float>(kCdfUnits);
         const auto t = static_cast<uint32_t>(x);
-        const uint32_t k = bucket_of_unit(t), j = k >> kCoarseGuideShift;
-        const Span coarse_span{coarse[j], (j + 1) * kCoarseGuideStep < n ? coarse[j + 1] : n - 1};
-        return find(coarse_span.hi - coarse_span.lo <= 1 ? coarse_span : guide_span(k), x, t);
+        const uint32_t k = bucket_of_unit(t);
+        const Span coarse = coarse_span(k);
+        return find(coarse.hi - coarse.lo <= 1 ? coarse : guide_span(k), x, t);
     }
 
-    // The first and last cell that may hold the answer for a unit in guide bucket k.
+    // The first and last cell that may hold the answer for a unit in guide bucket k: from
+    // the guide, and from the coarse guide (a wider span, the step's).
     struct Span {
         uint32_t lo, hi;
     };
     ENVMIS_HD Span guide_span(uint32_t k) const noexcept { return {guide[k], k + 1 < n ? guide[k + 1] : n - 1}; }
+    ENVMIS_HD Span coarse_span(uint32_t k) const noexcept {
+        const uint32_t j = k >> kCoarseGuideShift;
+        return {coarse[j], (j + 1) * kCoarseGuideStep < n ? coarse[j + 1] : n - 1};
+    }
     // The cell in span s holding unit t (x: t with its fraction), and the position inside it.
     ENVMIS_HD ENVMIS_INLINE CellHit find(Span s, float x, uint32_t t) const noexcept {
         uint32_t lo = s.lo, hi = s.hi;
