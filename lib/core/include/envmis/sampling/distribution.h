@@ -364,7 +364,8 @@ struct Distribution2DView {
     uint32_t w = 0, h = 0;
     float pdf_scale = 0;  // w h 2^-62: density per unit of the marginal times unit of a row
     // coarse_row_size() h, row-major, the rows' coarse guides (CdfView::coarse); optional
-    // (null below kCoarseGuideMinBytes): samples are the same, only prefetches differ.
+    // (null below kCoarseGuideMinBytes): samples are the same, only the host's prefetches
+    // and hot rows' searches differ. Device code never reads it, so it need not be uploaded.
     const uint16_t* coarse = nullptr;
 
     struct Sample {
@@ -396,11 +397,20 @@ struct Distribution2DView {
         const size_t row_start = static_cast<size_t>(r.index) * w;
         const CdfView cdf = row(r.index);
         const auto near = [&](uint32_t first, uint32_t last) { near_answer(row_start + first, row_start + last); };
-        const CellHit c = !hot_row(r.index) ? cdf.invert(ux, near)
-                          : coarse          ? cdf.invert_cached(ux)
-                                            : cdf.invert<false>(ux);
+        const CellHit c = !hot_row(r.index)      ? cdf.invert(ux, near)
+                          : search_from_coarse() ? cdf.invert_cached(ux)
+                                                 : cdf.invert<false>(ux);
         const Vec2 p{detail::point_in_cell(c.index, c.offset, w), detail::point_in_cell(r.index, r.offset, h)};
         return {p, pdf_of(marginal.width(r.index), cdf.width(c.index)), c.index, r.index};
+    }
+    // True where hot rows search from the coarse guide (CdfView::invert_cached): on the
+    // host where there is one; its cache argument is the CPU's.
+    ENVMIS_HD bool search_from_coarse() const noexcept {
+#if defined(__CUDA_ARCH__)
+        return false;
+#else
+        return coarse != nullptr;
+#endif
     }
     // True if row y holds more than kHotRowFactor times the mean row's units: its data
     // stays in cache. The same as marginal.width(y) > hot_row_units(), without a division.
