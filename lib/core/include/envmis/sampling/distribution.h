@@ -52,11 +52,12 @@ inline constexpr uint32_t kHotRowFactor = 64;
 // One coarse guide entry per this many guide buckets of a 2D distribution's row: the
 // guide entry of every 64th bucket, 1 MiB for an 8192 x 4096 map, small enough to stay
 // in cache where the full guide (64 MiB) does not. A sample reads it to guess where in
-// the row its answer lies before the guide entry, a cache miss, says so: see
-// CdfView::invert. Built only where the tables (6 bytes a cell) reach
-// kCoarseGuideMinBytes, about 2.8 million cells and up: smaller ones stay in the
-// last-level cache, where it has little to hide (a 1k map, one process, with against
-// without it: compensated 0.99-1.00x, plain 1.05-1.06x; AMD EPYC family 0x1a).
+// the row its answer lies before the guide entry, a cache miss, says so (see
+// CdfView::invert), and in a hot row to skip the guide (CdfView::invert_cached).
+// Built only where the tables (6 bytes a cell) reach kCoarseGuideMinBytes, about 2.8
+// million cells and up: smaller ones stay in the last-level cache, where it has
+// little to hide (a 1k map, one process, with against without it: compensated
+// 0.99-1.00x, plain 1.05-1.06x; AMD EPYC family 0x1a).
 inline constexpr uint32_t kCoarseGuideShift = 6, kCoarseGuideStep = 1u << kCoarseGuideShift;
 inline constexpr size_t kCoarseGuideMinBytes = size_t{16} << 20;
 // Coarse guide entries of a row of w cells (the last step may be shorter).
