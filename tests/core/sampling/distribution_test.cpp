@@ -255,11 +255,36 @@ TEST(Distribution2D, ASearchFromTheCoarseGuideFindsWhatTheGuideFinds) {
             const CellHit cached = row.invert_cached(u), guided = row.invert(u);
             ASSERT_EQ(cached.index, guided.index) << y << " " << u;
             ASSERT_EQ(cached.offset, guided.offset) << y << " " << u;
+            ASSERT_EQ(cached.width, guided.width) << y << " " << u;
             const CdfView::Span s = row.coarse_span(row.bucket(u));
             narrow += s.hi - s.lo <= 1;
         }
     }
     EXPECT_GT(narrow, 30000u);  // rows 0 and 1 mostly start from the coarse guide
+}
+
+// An inversion reports the width of the cell it found, which the sampler's pdf takes
+// instead of reading the CDF again: the marginal's, and each row's from the guide and
+// from the coarse guide, on a function with empty cells (whose neighbours share a start).
+TEST(Distribution2D, AnInversionReportsTheWidthOfTheCellItFinds) {
+    const uint32_t w = 4096, h = 1024;  // large enough for a coarse guide
+    std::vector<float> f = test::random_function(size_t{w} * h, 53, 8);
+    for (size_t i = 0; i < f.size(); i += 3) f[i] = 0;
+    const Distribution2D d(f, w, h);
+    const Distribution2DView v = d.view();
+    ASSERT_NE(v.coarse, nullptr);
+    Rng rng(59);
+    for (int i = 0; i < 20000; ++i) {
+        const Vec2 u{rng.uniform(), rng.uniform()};
+        const CellHit r = v.sample_row(u.y);
+        ASSERT_EQ(r.width, v.marginal.width(r.index));
+        ASSERT_GT(r.width, 0u);
+        const CdfView row = v.row(r.index);
+        for (const CellHit c : {row.invert(u.x), row.invert_cached(u.x)}) {
+            ASSERT_EQ(c.width, row.width(c.index)) << "row " << r.index << " u.x " << u.x;
+            ASSERT_GT(c.width, 0u);
+        }
+    }
 }
 
 // A row is hot (its data stays in cache, so samples in it prefetch nothing) when it holds

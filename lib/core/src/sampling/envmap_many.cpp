@@ -62,7 +62,7 @@ void prefetch_column(const EnvMapView& env, uint32_t y, uint32_t t) noexcept {
 CellHit find_row(const EnvMapView& env, Vec2 u) noexcept {
     const Distribution2DView& d = env.distribution;
     const CellHit r = d.sample_row(u.y);
-    if (!d.hot_row(r.index)) prefetch_column(env, r.index, unit_of(u.x));
+    if (!d.hot(r.width)) prefetch_column(env, r.index, unit_of(u.x));
     return r;
 }
 

@@ -319,7 +319,7 @@ ENVMIS_HD inline BinView::Row BinView::find_row(const Cell& c, float uy) const n
     const uint32_t x1 = min(m.column_edges[c.cx + 1], m.plain.distribution.w - 1);
     for (uint32_t x = m.column_edges[c.cx]; x < x1; x += 16) ENVMIS_PREFETCH(start + x);
     ENVMIS_PREFETCH(start + x1);
-    return {y, rows.width(ry.index), ry.offset};
+    return {y, ry.width, ry.offset};
 }
 
 // The texel: the plain row CDF inverted inside the cell's segment of the row, at u.x's

@@ -65,10 +65,15 @@ ENVMIS_HD inline uint32_t coarse_guide_size(uint32_t w) noexcept {
     return (w + kCoarseGuideStep - 1) / kCoarseGuideStep;
 }
 
-// A point found by inverting a CDF: the cell and the position inside it, in [0,1).
+// A point found by inverting a CDF: the cell, the position inside it, in [0,1), and the
+// cell's width in units (CdfView::width), which the search has read and the caller's pdf
+// needs. Reading it again took plain single samples of the 8k sky 6-13% longer (AMD EPYC
+// family 0x19): a cold row's sample must leave room in the reorder buffer for the next
+// sample's first misses, and a few instructions more decide whether they fit.
 struct CellHit {
     uint32_t index = 0;
     float offset = 0;
+    uint32_t width = 0;
 };
 
 // u clamped into [0, kOneMinusEpsilon], NaN to 0: the samplers take points of [0,1), and
@@ -153,11 +158,12 @@ struct CdfView {
             else
                 hi = mid - 1;
         }
+        const uint32_t cell_width = width(lo);
         const float offset =
-            (static_cast<float>(t - start[lo]) + (x - static_cast<float>(t))) / static_cast<float>(width(lo));
+            (static_cast<float>(t - start[lo]) + (x - static_cast<float>(t))) / static_cast<float>(cell_width);
         // Both terms are >= 0 (t >= start[lo], t <= x) and the found cell is not empty,
         // so only the rounding up to 1 needs a clamp.
-        return {lo, min(offset, kOneMinusEpsilon)};
+        return {lo, min(offset, kOneMinusEpsilon), cell_width};
     }
 
     // The prefetches of invert for unit t: the CDF at its guide bucket k and, with a
@@ -320,15 +326,17 @@ struct Distribution1DView {
 
     ENVMIS_HD Sample sample(float u) const noexcept {
         const CellHit hit = cdf.invert(u);
-        return {detail::point_in_cell(hit.index, hit.offset, cdf.n), cell_pdf(hit.index), hit.index};
+        return {detail::point_in_cell(hit.index, hit.offset, cdf.n), width_pdf(hit.width), hit.index};
     }
     ENVMIS_HD float pdf(float x) const noexcept { return cell_pdf(detail::cell_of(x, cdf.n)); }
     ENVMIS_HD float invert(float x) const noexcept {
         const uint32_t i = detail::cell_of(x, cdf.n);
         return cdf.at(i, detail::offset_in_cell(x, i, cdf.n));
     }
-    ENVMIS_HD float cell_pdf(uint32_t i) const noexcept {
-        return static_cast<float>(static_cast<double>(cdf.width(i)) * cdf.n / kCdfUnits);
+    ENVMIS_HD float cell_pdf(uint32_t i) const noexcept { return width_pdf(cdf.width(i)); }
+    // The density of a cell `width` units wide.
+    ENVMIS_HD float width_pdf(uint32_t width) const noexcept {
+        return static_cast<float>(static_cast<double>(width) * cdf.n / kCdfUnits);
     }
 };
 
@@ -398,11 +406,11 @@ struct Distribution2DView {
         const size_t row_start = static_cast<size_t>(r.index) * w;
         const CdfView cdf = row(r.index);
         const auto near = [&](uint32_t first, uint32_t last) { near_answer(row_start + first, row_start + last); };
-        const CellHit c = !hot_row(r.index)      ? cdf.invert(ux, near)
+        const CellHit c = !hot(r.width)          ? cdf.invert(ux, near)
                           : search_from_coarse() ? cdf.invert_cached(ux)
                                                  : cdf.invert<false>(ux);
         const Vec2 p{detail::point_in_cell(c.index, c.offset, w), detail::point_in_cell(r.index, r.offset, h)};
-        return {p, pdf_of(marginal.width(r.index), cdf.width(c.index)), c.index, r.index};
+        return {p, pdf_of(r.width, c.width), c.index, r.index};
     }
     // True where hot rows search from the coarse guide (CdfView::invert_cached): on the
     // host where there is one; its cache argument is the CPU's.
@@ -415,8 +423,10 @@ struct Distribution2DView {
     }
     // True if row y holds more than kHotRowFactor times the mean row's units: its data
     // stays in cache. The same as marginal.width(y) > hot_row_units(), without a division.
-    ENVMIS_HD bool hot_row(uint32_t y) const noexcept {
-        return uint64_t{marginal.width(y)} * h > (uint64_t{kHotRowFactor} << 31);
+    ENVMIS_HD bool hot_row(uint32_t y) const noexcept { return hot(marginal.width(y)); }
+    // The same for a row of row_width units (CellHit::width of sample_row).
+    ENVMIS_HD bool hot(uint32_t row_width) const noexcept {
+        return uint64_t{row_width} * h > (uint64_t{kHotRowFactor} << 31);
     }
     ENVMIS_HD uint32_t hot_row_units() const noexcept {
         return static_cast<uint32_t>(min((uint64_t{kHotRowFactor} << 31) / h, uint64_t{kCdfUnits}));
