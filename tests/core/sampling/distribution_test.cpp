@@ -289,7 +289,7 @@ TEST(Distribution2D, AnInversionReportsTheWidthOfTheCellItFinds) {
 
 // A row is hot (its data stays in cache, so samples in it prefetch nothing) when it holds
 // more than kHotRowFactor times the mean row's units. Single calls test it with a product
-// (hot_row), the AVX2 kernel with a threshold in units (hot_row_units): the same rule,
+// (row_is_hot), the AVX2 kernel with a threshold in units (hot_row_units): the same rule,
 // on both sides of the threshold, for any number of rows.
 TEST(Distribution2D, HotRowsAreTheSameByTheProductAndByTheUnitThreshold) {
     for (uint32_t h : {2u, 3u, 63u, 64u, 65u, 127u, 1000u, 4096u, 5792u, 65535u, 65536u}) {
@@ -301,7 +301,8 @@ TEST(Distribution2D, HotRowsAreTheSameByTheProductAndByTheUnitThreshold) {
              {threshold - 2, threshold - 1, threshold, threshold + 1, threshold + 2, int64_t{kCdfUnits}, int64_t{0}}) {
             if (width > int64_t{kCdfUnits}) continue;  // more than a CDF holds (few rows)
             std::fill(start.begin() + 1, start.end(), static_cast<uint32_t>(width));  // row 0's width
-            EXPECT_EQ(d.hot_row(0), d.marginal.width(0) > d.hot_row_units()) << "h=" << h << " width=" << width;
+            EXPECT_EQ(d.row_is_hot(d.marginal.width(0)), d.marginal.width(0) > d.hot_row_units())
+                << "h=" << h << " width=" << width;
         }
     }
 }

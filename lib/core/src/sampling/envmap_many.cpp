@@ -58,11 +58,11 @@ void prefetch_column(const EnvMapView& env, uint32_t y, uint32_t t) noexcept {
 
 // EnvMapView::sample in the two stages of Distribution2DView::sample: the row (the
 // marginal is small and stays in cache) with the column's prefetches (none in hot rows:
-// Distribution2DView::hot_row); then the column and the rest.
+// Distribution2DView::row_is_hot); then the column and the rest.
 CellHit find_row(const EnvMapView& env, Vec2 u) noexcept {
     const Distribution2DView& d = env.distribution;
     const CellHit r = d.sample_row(u.y);
-    if (!d.hot(r.width)) prefetch_column(env, r.index, unit_of(u.x));
+    if (!d.row_is_hot(r.width)) prefetch_column(env, r.index, unit_of(u.x));
     return r;
 }
 

@@ -126,7 +126,7 @@ struct CdfView {
     // invert for a CDF in cache that has a coarse guide: the search starts from the coarse
     // entries around the guide bucket where they are at most a cell apart, as in a row
     // whose few bright cells span many buckets each. A 2D distribution's row read often
-    // (Distribution2DView::hot_row) keeps its coarse guide, 1/64 of its guide, in the
+    // (Distribution2DView::row_is_hot) keeps its coarse guide, 1/64 of its guide, in the
     // nearest cache, where its guide spills into the next: compensated single samples on
     // the 8k sky took 0.87-0.99x the time of a search from the guide (AMD EPYC family
     // 0x19). The same answer as invert.
@@ -406,7 +406,7 @@ struct Distribution2DView {
         const size_t row_start = static_cast<size_t>(r.index) * w;
         const CdfView cdf = row(r.index);
         const auto near = [&](uint32_t first, uint32_t last) { near_answer(row_start + first, row_start + last); };
-        const CellHit c = !hot(r.width)          ? cdf.invert(ux, near)
+        const CellHit c = !row_is_hot(r.width)   ? cdf.invert(ux, near)
                           : search_from_coarse() ? cdf.invert_cached(ux)
                                                  : cdf.invert<false>(ux);
         const Vec2 p{detail::point_in_cell(c.index, c.offset, w), detail::point_in_cell(r.index, r.offset, h)};
@@ -421,11 +421,11 @@ struct Distribution2DView {
         return coarse != nullptr;
 #endif
     }
-    // True if row y holds more than kHotRowFactor times the mean row's units: its data
-    // stays in cache. The same as marginal.width(y) > hot_row_units(), without a division.
-    ENVMIS_HD bool hot_row(uint32_t y) const noexcept { return hot(marginal.width(y)); }
-    // The same for a row of row_width units (CellHit::width of sample_row).
-    ENVMIS_HD bool hot(uint32_t row_width) const noexcept {
+    // True if a row of row_width units of the marginal (marginal.width(y), or the
+    // CellHit::width of sample_row) holds more than kHotRowFactor times the mean row's
+    // units: its data stays in cache. The same as row_width > hot_row_units(), without a
+    // division.
+    ENVMIS_HD bool row_is_hot(uint32_t row_width) const noexcept {
         return uint64_t{row_width} * h > (uint64_t{kHotRowFactor} << 31);
     }
     ENVMIS_HD uint32_t hot_row_units() const noexcept {
