@@ -287,6 +287,34 @@ TEST(Distribution2D, AnInversionReportsTheWidthOfTheCellItFinds) {
     }
 }
 
+// invert tries the cells it prefetched before the guide: the cell it finds there is the
+// one the guide's search finds, on rows with empty cells, where the coarse guide's
+// prediction is right, next to the answer, or far from it (then the guide decides).
+TEST(Distribution2D, ASearchNearThePrefetchedCellsFindsWhatTheGuideFinds) {
+    const uint32_t w = 4096, h = 1024;  // large enough for a coarse guide
+    std::vector<float> f = test::random_function(size_t{w} * h, 61, 8);
+    for (size_t i = 0; i < f.size(); i += 3) f[i] = 0;
+    const Distribution2D d(f, w, h);
+    const Distribution2DView v = d.view();
+    ASSERT_NE(v.coarse, nullptr);
+    Rng rng(67);
+    size_t near = 0, far = 0;
+    for (int i = 0; i < 200000; ++i) {
+        const CdfView row = v.row(static_cast<uint32_t>(rng.uniform() * h));
+        const float u = i < 3 ? (i == 0 ? 0.0f : (i == 1 ? 0.5f : kOneMinusEpsilon)) : rng.uniform();
+        const float x = unit_point(u) * static_cast<float>(kCdfUnits);
+        const auto t = static_cast<uint32_t>(x);
+        const CellHit guided = row.find(row.guide_span(row.bucket_of_unit(t)), x, t), hit = row.invert(u);
+        ASSERT_EQ(hit.index, guided.index) << u;
+        ASSERT_EQ(hit.offset, guided.offset) << u;
+        ASSERT_EQ(hit.width, guided.width) << u;
+        uint32_t cell;
+        (row.find_near(row.prefetch_unit(t, NoHint{}), t, cell) ? near : far) += 1;
+    }
+    EXPECT_GT(near, 10000u);  // both ways met (near: 14% on this rough function)
+    EXPECT_GT(far, 10000u);
+}
+
 // A row is hot (its data stays in cache, so samples in it prefetch nothing) when it holds
 // more than kHotRowFactor times the mean row's units. Single calls test it with a product
 // (row_is_hot), the AVX2 kernel with a threshold in units (hot_row_units): the same rule,
