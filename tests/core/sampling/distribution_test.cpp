@@ -263,14 +263,20 @@ TEST(Distribution2D, ASearchFromTheCoarseGuideFindsWhatTheGuideFinds) {
     EXPECT_GT(narrow, 30000u);  // rows 0 and 1 mostly start from the coarse guide
 }
 
+// A 4096 x 1024 distribution (large enough for a coarse guide) of a rough function
+// (eight decades) with every third cell empty, whose neighbours share a start.
+Distribution2D rough_with_empty_cells(uint64_t seed) {
+    const uint32_t w = 4096, h = 1024;
+    std::vector<float> f = test::random_function(size_t{w} * h, seed, 8);
+    for (size_t i = 0; i < f.size(); i += 3) f[i] = 0;
+    return Distribution2D(f, w, h);
+}
+
 // An inversion reports the width of the cell it found, which the sampler's pdf takes
 // instead of reading the CDF again: the marginal's, and each row's from the guide and
-// from the coarse guide, on a function with empty cells (whose neighbours share a start).
+// from the coarse guide.
 TEST(Distribution2D, AnInversionReportsTheWidthOfTheCellItFinds) {
-    const uint32_t w = 4096, h = 1024;  // large enough for a coarse guide
-    std::vector<float> f = test::random_function(size_t{w} * h, 53, 8);
-    for (size_t i = 0; i < f.size(); i += 3) f[i] = 0;
-    const Distribution2D d(f, w, h);
+    const Distribution2D d = rough_with_empty_cells(53);
     const Distribution2DView v = d.view();
     ASSERT_NE(v.coarse, nullptr);
     Rng rng(59);
@@ -288,19 +294,16 @@ TEST(Distribution2D, AnInversionReportsTheWidthOfTheCellItFinds) {
 }
 
 // invert tries the cells it prefetched before the guide: the cell it finds there is the
-// one the guide's search finds, on rows with empty cells, where the coarse guide's
-// prediction is right, next to the answer, or far from it (then the guide decides).
+// one the guide's search finds, where the coarse guide's prediction is right, next to
+// the answer, or far from it (then the guide decides).
 TEST(Distribution2D, ASearchNearThePrefetchedCellsFindsWhatTheGuideFinds) {
-    const uint32_t w = 4096, h = 1024;  // large enough for a coarse guide
-    std::vector<float> f = test::random_function(size_t{w} * h, 61, 8);
-    for (size_t i = 0; i < f.size(); i += 3) f[i] = 0;
-    const Distribution2D d(f, w, h);
+    const Distribution2D d = rough_with_empty_cells(61);
     const Distribution2DView v = d.view();
     ASSERT_NE(v.coarse, nullptr);
     Rng rng(67);
     size_t near = 0, far = 0;
     for (int i = 0; i < 200000; ++i) {
-        const CdfView row = v.row(static_cast<uint32_t>(rng.uniform() * h));
+        const CdfView row = v.row(static_cast<uint32_t>(rng.uniform() * v.h));
         const float u = i < 3 ? (i == 0 ? 0.0f : (i == 1 ? 0.5f : kOneMinusEpsilon)) : rng.uniform();
         const float x = unit_point(u) * static_cast<float>(kCdfUnits);
         const auto t = static_cast<uint32_t>(x);
