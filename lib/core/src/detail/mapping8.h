@@ -59,8 +59,7 @@ ENVMIS_AVX2 inline Vec8 to_canonical8(const Axes& a, const Vec8& world) noexcept
     return {c[0], c[1], c[2]};
 }
 
-// equal_area_direction (mapping.h). The square root's argument is clamped as there, though
-// it lies in [1, 2] for points in [0,1)^2.
+// equal_area_direction (mapping.h).
 ENVMIS_AVX2 inline Vec8 equal_area_direction8(F8 uv_x, F8 uv_y) noexcept {
     const F8 one = splat(1.0f);
     const F8 u = _mm256_sub_ps(_mm256_mul_ps(splat(2.0f), uv_x), one);
@@ -68,19 +67,17 @@ ENVMIS_AVX2 inline Vec8 equal_area_direction8(F8 uv_x, F8 uv_y) noexcept {
     const F8 au = abs8(u), av = abs8(v);
     const F8 signed_distance = _mm256_sub_ps(one, _mm256_add_ps(au, av));
     const F8 r = _mm256_sub_ps(one, abs8(signed_distance));
-    const F8 t =
-        select(_mm256_cmp_ps(r, splat(0.0f), _CMP_EQ_OQ), splat(0.0f), _mm256_div_ps(_mm256_sub_ps(av, au), r));
-    const F8 a = _mm256_mul_ps(t, splat(kPiF / 4)), a2 = _mm256_mul_ps(a, a);
-    F8 sin_a = _mm256_add_ps(_mm256_mul_ps(splat(-1.9515295891e-4f), a2), splat(8.3321608736e-3f));
-    sin_a = _mm256_sub_ps(_mm256_mul_ps(sin_a, a2), splat(1.6666654611e-1f));
-    sin_a = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(sin_a, a2), a), a);
-    F8 cos_a = _mm256_sub_ps(_mm256_mul_ps(splat(2.443315711809948e-5f), a2), splat(1.388731625493765e-3f));
-    cos_a = _mm256_add_ps(_mm256_mul_ps(cos_a, a2), splat(4.166664568298827e-2f));
-    cos_a = _mm256_mul_ps(_mm256_mul_ps(cos_a, a2), a2);
-    cos_a = _mm256_add_ps(_mm256_sub_ps(cos_a, _mm256_mul_ps(splat(0.5f), a2)), one);
-    const F8 r2 = _mm256_mul_ps(r, r), root_arg = _mm256_sub_ps(splat(2.0f), r2);
-    const F8 root = _mm256_sqrt_ps(max0(root_arg));
-    const F8 s = _mm256_mul_ps(_mm256_mul_ps(r, root), splat(0.70710678118654752f));
+    const F8 a = select(_mm256_cmp_ps(r, splat(0.0f), _CMP_EQ_OQ), splat(0.0f),
+                        _mm256_div_ps(_mm256_mul_ps(_mm256_sub_ps(av, au), splat(kPiF / 4)), r));
+    const F8 a2 = _mm256_mul_ps(a, a), a3 = _mm256_mul_ps(a2, a), a4 = _mm256_mul_ps(a2, a2);
+    F8 sin_a = _mm256_sub_ps(_mm256_mul_ps(splat(8.3321608736e-3f), a2), splat(1.6666654611e-1f));
+    sin_a = _mm256_add_ps(sin_a, _mm256_mul_ps(a4, splat(-1.9515295891e-4f)));
+    sin_a = _mm256_add_ps(_mm256_mul_ps(a3, sin_a), a);
+    F8 cos_a = _mm256_add_ps(_mm256_mul_ps(splat(-1.388731625493765e-3f), a2), splat(4.166664568298827e-2f));
+    cos_a = _mm256_add_ps(cos_a, _mm256_mul_ps(a4, splat(2.443315711809948e-5f)));
+    cos_a = _mm256_add_ps(_mm256_mul_ps(a4, cos_a), _mm256_sub_ps(one, _mm256_mul_ps(splat(0.5f), a2)));
+    const F8 r2 = _mm256_mul_ps(r, r);
+    const F8 s = _mm256_mul_ps(r, _mm256_sqrt_ps(_mm256_sub_ps(one, _mm256_mul_ps(_mm256_mul_ps(splat(0.5f), r), r))));
     return {_mm256_mul_ps(copysign8(_mm256_sub_ps(cos_a, sin_a), u), s),
             _mm256_mul_ps(copysign8(_mm256_add_ps(cos_a, sin_a), v), s),
             copysign8(_mm256_sub_ps(one, r2), signed_distance)};
