@@ -245,15 +245,17 @@ void estimate(benchmark::State& state, const char* technique, envmis::Bsdf bsdf)
 
 // Equal-area against equirect at nearly the same texel count: the synthetic sky w x h
 // under `mapping` (equal-area: square), built once per size for every row that times it.
-const EnvMap& mapped_sky(uint32_t w, uint32_t h, envmis::Mapping mapping, bool compensated) {
-    static std::map<std::tuple<uint32_t, uint32_t, envmis::Mapping, bool>, EnvMap> maps;
-    const auto key = std::make_tuple(w, h, mapping, compensated);
+using envmis::reference::SkyDetail;
+const EnvMap& mapped_sky(uint32_t w, uint32_t h, envmis::Mapping mapping, bool compensated,
+                         SkyDetail detail = SkyDetail::clear) {
+    static std::map<std::tuple<uint32_t, uint32_t, envmis::Mapping, bool, SkyDetail>, EnvMap> maps;
+    const auto key = std::make_tuple(w, h, mapping, compensated, detail);
     auto it = maps.find(key);
     if (it == maps.end()) {
         envmis::EnvMapOptions o = options();
         o.compensation.enabled = compensated;
         o.mapping = mapping;
-        it = maps.emplace(key, EnvMap(envmis::reference::synthetic_sky(w, h, mapping), o)).first;
+        it = maps.emplace(key, EnvMap(envmis::reference::synthetic_sky(w, h, mapping, detail), o)).first;
     }
     return it->second;
 }
@@ -303,13 +305,15 @@ double in_turns(benchmark::State& state, size_t points, size_t block, Work&& wor
 // sky and on the equirect one (the cases above run minutes apart). Manual time: the
 // equal-area map's; the counter equal_area/equirect is the ratio of the two maps' totals.
 // Arguments: the equal-area side, the equirect width and height, compensated, and
-// sample_many (1) or single calls (0).
+// sample_many (1) or single calls (0). On the clear sky the equirect side's cold rows are
+// flat (SkyDetail), on the cloudy one neither side's are.
+template <SkyDetail kDetail>
 void equal_area_over_equirect(benchmark::State& state) {
     const bool compensated = state.range(3) != 0, batch = state.range(4) != 0;
     const auto side = static_cast<uint32_t>(state.range(0));
-    const EnvMapView maps[2] = {mapped_sky(side, side, envmis::Mapping::equal_area, compensated).view(),
+    const EnvMapView maps[2] = {mapped_sky(side, side, envmis::Mapping::equal_area, compensated, kDetail).view(),
                                 mapped_sky(static_cast<uint32_t>(state.range(1)), static_cast<uint32_t>(state.range(2)),
-                                           envmis::Mapping::equirect, compensated)
+                                           envmis::Mapping::equirect, compensated, kDetail)
                                     .view()};
     constexpr size_t kBlock = 1024;  // long enough to make the clock's reading negligible
     const BatchPoints& p = batch_points();
@@ -409,9 +413,13 @@ BENCHMARK(sample_mapped<envmis::Mapping::equirect>)
     ->ArgsProduct({{4096}, {4096}, {0, 1}})
     ->ArgsProduct({{5792}, {2896}, {0, 1}})
     ->ArgsProduct({{8192}, {4096}, {0, 1}});
-BENCHMARK(equal_area_over_equirect)
+BENCHMARK(equal_area_over_equirect<SkyDetail::clear>)
     ->Name("sample/equal-area-over-equirect")
     ->ArgsProduct({{4096}, {5792}, {2896}, {0, 1}, {0, 1}})
+    ->ArgsProduct({{5792}, {8192}, {4096}, {0, 1}, {0, 1}})
+    ->UseManualTime();
+BENCHMARK(equal_area_over_equirect<SkyDetail::clouds>)
+    ->Name("sample/equal-area-over-equirect-clouds")
     ->ArgsProduct({{5792}, {8192}, {4096}, {0, 1}, {0, 1}})
     ->UseManualTime();
 BENCHMARK(lookup_over_line_reads)

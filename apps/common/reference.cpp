@@ -48,7 +48,15 @@ float TextbookEnvMap::pdf(Vec3 direction) const noexcept {
     return EnvMapView::solid_angle_pdf(distribution_.pdf(uv), std::sin(kPiF * uv.y));
 }
 
-RgbImage synthetic_sky(uint32_t w, uint32_t h, Mapping mapping) {
+// The clouds' brightness factor in direction d, 0.3 to 2: products of sines of the
+// direction's coordinates, a few periods across the sphere.
+double cloud_factor(Vec3 d) {
+    const double c = std::sin(7.0 * d.x + 3 * std::sin(5.0 * d.y)) * std::sin(6.0 * d.y + 2.0 * d.z) *
+                     std::cos(9.0 * d.z + 4.0 * d.x);
+    return 0.3 + 1.7 * (0.5 + 0.5 * c);
+}
+
+RgbImage synthetic_sky(uint32_t w, uint32_t h, Mapping mapping, SkyDetail detail) {
     RgbImage sky{w, h, RgbPixels(size_t{w} * h)};
     const double sun_theta = kPi / 4, sun_phi = kPi / 3, sun_radius = 0.25 * kPi / 180;
     const Vec3 sun{static_cast<float>(std::sin(sun_theta) * std::cos(sun_phi)),
@@ -59,7 +67,8 @@ RgbImage synthetic_sky(uint32_t w, uint32_t h, Mapping mapping) {
         for (uint32_t x = 0; x < w; ++x) {
             const Vec3 d = image_direction(mapping, {(x + 0.5f) / w, (y + 0.5f) / h});
             const float up = std::max(d.z, 0.0f);
-            const float sky_level = d.z >= 0 ? 0.3f + 0.7f * up : 0.05f;
+            float sky_level = d.z >= 0 ? 0.3f + 0.7f * up : 0.05f;
+            if (detail == SkyDetail::clouds) sky_level *= static_cast<float>(cloud_factor(d));
             Rgb& p = sky.pixels[size_t{y} * w + x];
             p = {0.5f * sky_level, 0.7f * sky_level, 1.0f * sky_level};
             if (dot(d, sun) >= cos_radius) p = {1e5f, 0.95e5f, 0.9e5f};

@@ -30,9 +30,17 @@ private:
     TextbookDistribution2D distribution_;
 };
 
+// What a synthetic sky holds besides its sun. `clear`: a gradient of height alone, so
+// every equirect row but the sun's is constant, a sampler's easiest case (its cold rows'
+// answers lie where the guide table points). `clouds`: the same gradient broken up by a
+// smooth pattern of the direction (brightness 0.3x to 2x) that varies along every row
+// in either mapping, as a real sky does.
+enum class SkyDetail { clear, clouds };
+
 // A w x h sky: blue, brighter towards the zenith, with a sun of ~0.5 degrees (radiance
 // 1e5) at 45 degrees elevation: the shape of a typical outdoor map, 8192x4096 by default.
 // Equal-area (a square w x w) for timing that mapping against equirect on the same sky.
-RgbImage synthetic_sky(uint32_t w, uint32_t h, Mapping mapping = Mapping::equirect);
+RgbImage synthetic_sky(uint32_t w, uint32_t h, Mapping mapping = Mapping::equirect,
+                       SkyDetail detail = SkyDetail::clear);
 
 }  // namespace envmis::reference
