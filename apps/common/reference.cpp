@@ -22,6 +22,14 @@ std::vector<float> textbook_density(const RgbImage& image, const EnvMapOptions& 
     return density;
 }
 
+// The clouds' brightness factor in direction d, 0.3 to 2: products of sines of the
+// direction's coordinates, a few periods across the sphere.
+double cloud_factor(Vec3 d) {
+    const double c = std::sin(7.0 * d.x + 3 * std::sin(5.0 * d.y)) * std::sin(6.0 * d.y + 2.0 * d.z) *
+                     std::cos(9.0 * d.z + 4.0 * d.x);
+    return 0.3 + 1.7 * (0.5 + 0.5 * c);
+}
+
 }  // namespace
 
 TextbookEnvMap::TextbookEnvMap(const RgbImage& image, const EnvMapOptions& options)
@@ -46,14 +54,6 @@ float TextbookEnvMap::pdf(Vec3 direction) const noexcept {
     const Vec2 uv = image_uv(mapping_, to_canonical(axes_, direction));
     if (mapping_ == Mapping::equal_area) return distribution_.pdf(uv) / kFourPi;
     return EnvMapView::solid_angle_pdf(distribution_.pdf(uv), std::sin(kPiF * uv.y));
-}
-
-// The clouds' brightness factor in direction d, 0.3 to 2: products of sines of the
-// direction's coordinates, a few periods across the sphere.
-double cloud_factor(Vec3 d) {
-    const double c = std::sin(7.0 * d.x + 3 * std::sin(5.0 * d.y)) * std::sin(6.0 * d.y + 2.0 * d.z) *
-                     std::cos(9.0 * d.z + 4.0 * d.x);
-    return 0.3 + 1.7 * (0.5 + 0.5 * c);
 }
 
 RgbImage synthetic_sky(uint32_t w, uint32_t h, Mapping mapping, SkyDetail detail) {
