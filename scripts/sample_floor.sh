@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# How fast a single sample of the 8k sky could be against the textbook sampler's on this
+# CPU (issue 20's "single-call sample >= 5x the textbook"): builds scripts/sample_floor.cpp
+# against the library's headers as they are and against copies with parts of the sample
+# taken out, then runs the binaries in turns and prints each one's median ratio.
+#
+#   as-is          the library's sample
+#   no-azimuth     the azimuth's sine and cosine (turn table) replaced by the point's
+#                  coordinates: what computing them costs beyond the rest
+#   no-polar       the same for the polar angle (whose sine the solid-angle pdf divides by)
+#   no-direction   both: the sample without its trigonometry, the two inversions (table
+#                  reads, searches, divisions), point placement, pdf and radiance alone
+#
+# The variants' results are wrong (only their timing means something). Needs a Release
+# build in build/ (bash scripts/test.sh or scripts/demo.sh). Usage:
+#   bash scripts/sample_floor.sh [--no-compensate] [rounds]   (rounds: default 5)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+density=""
+[ "${1:-}" = "--no-compensate" ] && density=$1 && shift
+rounds=${1:-5}
+[[ "$rounds" =~ ^[1-9][0-9]?$ ]] || { echo "sample_floor.sh: rounds must be 1 to 99, got '$rounds'" >&2; exit 2; }
+for lib in build/apps/libenvmis_reference.a build/lib/libenvmis_study.a build/lib/libenvmis_core.a; do
+    [ -f "$lib" ] || { echo "sample_floor.sh: $lib is missing: build first (bash scripts/test.sh)" >&2; exit 2; }
+done
+
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+# Copies lib/core/include to $work/$1 and replaces, in file $2 there, the text $3 by $4;
+# fails if $3 is not found exactly once (the library changed: update this script).
+variant() {
+    cp -r lib/core/include "$work/$1"
+    /usr/bin/env python3 - "$work/$1/envmis/$2" "$3" "$4" <<'EOF'
+import sys
+path, old, new = sys.argv[1:]
+text = open(path).read()
+if text.count(old) != 1:
+    sys.exit(f"sample_floor.sh: {path} no longer holds {old!r} once: update the script")
+open(path, "w").write(text.replace(old, new))
+EOF
+}
+line="const SinCos theta = sincos_half_turns(turns, p.y), phi = sincos_turns(turns, p.x);"
+cp -r lib/core/include "$work/as-is"
+variant no-azimuth sampling/envmap.h "$line" "const SinCos theta = sincos_half_turns(turns, p.y), phi{p.x + 1, p.x * 2};"
+variant no-polar sampling/envmap.h "$line" "const SinCos theta{p.y, p.y * 2}, phi = sincos_turns(turns, p.x);"
+variant no-direction sampling/envmap.h "$line" "const SinCos theta{p.y, p.y * 2}, phi{p.x + 1, p.x * 2};"
+
+names=(as-is no-azimuth no-polar no-direction)
+for name in "${names[@]}"; do
+    g++ -O3 -DNDEBUG -std=c++20 -I"$work/$name" -Ilib/study/include -Iapps/common scripts/sample_floor.cpp \
+        build/apps/libenvmis_reference.a build/lib/libenvmis_study.a build/lib/libenvmis_core.a -lpthread \
+        -o "$work/$name.bin"
+done
+
+cpu_field() { lscpu | sed -n "s/^$1: *//p" | head -n 1; }
+echo "cpu: $(cpu_field 'Model name') (family $(cpu_field 'CPU family'), model $(cpu_field 'Model')), $(nproc) cores"
+for ((round = 1; round <= rounds; ++round)); do
+    for name in "${names[@]}"; do
+        echo "$name $("$work/$name.bin" $density)"
+    done
+done | tee "$work/runs.txt"
+echo "medians over $rounds rounds (ratio: textbook ns / guided ns, a round's median of 7):"
+for name in "${names[@]}"; do
+    grep "^$name " "$work/runs.txt" | sed 's/.*ratio=//' | sort -n |
+        awk -v n="$name" '{ r[NR] = $1 } END { printf "  %-13s %sx (of %d: %s to %s)\n", n, r[int((NR + 1) / 2)], NR, r[1], r[NR] }'
+done
