@@ -12,7 +12,9 @@
 #                  reads, searches, divisions), point placement, pdf and radiance alone
 #
 # The variants' results are wrong (only their timing means something). Needs a Release
-# build in build/ (bash scripts/test.sh or scripts/demo.sh). Usage:
+# build (bash scripts/test.sh) in build/ or ENVMIS_BUILD_DIR; compiles with g++ or CXX.
+# ctest runs it for one round (scripts.sample_floor), so that it keeps up with the
+# library's code. Usage:
 #   bash scripts/sample_floor.sh [--no-compensate] [rounds]   (rounds: default 5)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,8 +22,10 @@ cd "$(dirname "$0")/.."
 density=""
 [ "${1:-}" = "--no-compensate" ] && density=$1 && shift
 rounds=${1:-5}
+build_dir=${ENVMIS_BUILD_DIR:-build}
 [[ "$rounds" =~ ^[1-9][0-9]?$ ]] || { echo "sample_floor.sh: rounds must be 1 to 99, got '$rounds'" >&2; exit 2; }
-for lib in build/apps/libenvmis_reference.a build/lib/libenvmis_study.a build/lib/libenvmis_core.a; do
+libs=("$build_dir/apps/libenvmis_reference.a" "$build_dir/lib/libenvmis_study.a" "$build_dir/lib/libenvmis_core.a")
+for lib in "${libs[@]}"; do
     [ -f "$lib" ] || { echo "sample_floor.sh: $lib is missing: build first (bash scripts/test.sh)" >&2; exit 2; }
 done
 
@@ -32,14 +36,14 @@ trap 'rm -rf "$work"' EXIT
 # fails if $3 is not found exactly once (the library changed: update this script).
 variant() {
     cp -r lib/core/include "$work/$1"
-    /usr/bin/env python3 - "$work/$1/envmis/$2" "$3" "$4" <<'EOF'
-import sys
-path, old, new = sys.argv[1:]
-text = open(path).read()
-if text.count(old) != 1:
-    sys.exit(f"sample_floor.sh: {path} no longer holds {old!r} once: update the script")
-open(path, "w").write(text.replace(old, new))
-EOF
+    local file="$work/$1/envmis/$2" text
+    text=$(<"$file")
+    local without="${text//"$3"/}"
+    if (((${#text} - ${#without}) != ${#3})); then
+        echo "sample_floor.sh: lib/core/include/envmis/$2 no longer holds '$3' once: update the script" >&2
+        exit 2
+    fi
+    printf '%s\n' "${text/"$3"/"$4"}" >"$file"
 }
 line="const SinCos theta = sincos_half_turns(turns, p.y), phi = sincos_turns(turns, p.x);"
 cp -r lib/core/include "$work/as-is"
@@ -49,9 +53,8 @@ variant no-direction sampling/envmap.h "$line" "const SinCos theta{p.y, p.y * 2}
 
 names=(as-is no-azimuth no-polar no-direction)
 for name in "${names[@]}"; do
-    g++ -O3 -DNDEBUG -std=c++20 -I"$work/$name" -Ilib/study/include -Iapps/common scripts/sample_floor.cpp \
-        build/apps/libenvmis_reference.a build/lib/libenvmis_study.a build/lib/libenvmis_core.a -lpthread \
-        -o "$work/$name.bin"
+    "${CXX:-g++}" -O3 -DNDEBUG -std=c++20 -I"$work/$name" -Ilib/study/include -Iapps/common \
+        scripts/sample_floor.cpp "${libs[@]}" -lpthread -o "$work/$name.bin"
 done
 
 cpu_field() { lscpu | sed -n "s/^$1: *//p" | head -n 1; }
