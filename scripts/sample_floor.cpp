@@ -1,12 +1,16 @@
-// Single samples of the 8k sky against the textbook sampler's, in one process: the
-// measure of `envmis bench`'s `speedup_vs_textbook sample`, built by
+// Single samples timed against a reference sampler in one process, built by
 // scripts/sample_floor.sh against the library's headers as they are and against copies
 // with parts of the sample taken out, to show what the rest costs on the CPU at hand.
 //
-// Usage: sample_floor [--no-compensate]. Prints the guided and the textbook sampler's
-// ns a sample (free-running, as in a renderer's loop of calls) and their ratio, the
-// median of the ratios of 7 rounds; in each round the two samplers take turns over
-// blocks of 4096 points, so that a drifting machine speed does not bias the ratio.
+//   sample_floor [--no-compensate]               the 8k sky's guided sampler against the
+//       textbook sampler: envmis bench's `speedup_vs_textbook sample` (textbook ns / guided ns)
+//   sample_floor [--no-compensate] --equal-area  the sky as a 5792^2 equal-area map against
+//       the 8192 x 4096 equirect one, 0.02% more texels: `sample/equal-area-over-equirect`
+//       (equal-area ns / equirect ns)
+//
+// Prints both samplers' ns a sample (free-running, as in a renderer's loop of calls) and
+// the median of the ratios of 7 rounds; in each round the two take turns over blocks of
+// 4096 points, so that a drifting machine speed does not bias the ratio.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -43,15 +47,9 @@ double median(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-    EnvMapOptions options;
-    options.compensation.enabled = !(argc > 1 && std::strcmp(argv[1], "--no-compensate") == 0);
-    const RgbImage sky = reference::synthetic_sky(8192, 4096);
-    const EnvMap guided(sky, options);
-    const reference::TextbookEnvMap textbook(sky, options);
-
+// The two samplers' ns a sample, a over b in turns, and the median ratio b / a per round.
+template <class A, class B>
+void compare(const char* a_name, const A& a, const char* b_name, const B& b) {
     constexpr size_t kPoints = size_t{1} << 19, kBlock = 4096;
     constexpr int kRounds = 7;
     std::mt19937_64 rng(7);
@@ -59,23 +57,50 @@ int main(int argc, char** argv) {
     std::vector<Vec2> points(kPoints);
     for (Vec2& u : points) u = {uniform(), uniform()};
 
-    const EnvMapView view = guided.view();
     volatile float sink = 0;
-    std::vector<double> guided_ns, textbook_ns, ratios;
+    std::vector<double> a_ns, b_ns, ratios;
     for (int round = 0; round < kRounds; ++round) {
         double t[2] = {0, 0};
-        for (size_t b = 0; b < kPoints; b += kBlock) {
-            const bool guided_first = (b / kBlock) % 2 == 0;
+        for (size_t first = 0; first < kPoints; first += kBlock) {
+            const bool a_first = (first / kBlock) % 2 == 0;
             for (int turn = 0; turn < 2; ++turn) {
-                const bool textbook_turn = (turn == 0) != guided_first;
-                t[textbook_turn] += textbook_turn ? time_block(textbook, points.data() + b, kBlock, sink)
-                                                  : time_block(view, points.data() + b, kBlock, sink);
+                const bool b_turn = (turn == 0) != a_first;
+                t[b_turn] += b_turn ? time_block(b, points.data() + first, kBlock, sink)
+                                    : time_block(a, points.data() + first, kBlock, sink);
             }
         }
-        guided_ns.push_back(t[0] / kPoints);
-        textbook_ns.push_back(t[1] / kPoints);
+        a_ns.push_back(t[0] / kPoints);
+        b_ns.push_back(t[1] / kPoints);
         ratios.push_back(t[1] / t[0]);
     }
-    std::printf("compensated=%d guided_ns=%.1f textbook_ns=%.1f ratio=%.2f\n", options.compensation.enabled ? 1 : 0,
-                median(guided_ns), median(textbook_ns), median(ratios));
+    std::printf("%s_ns=%.1f %s_ns=%.1f ratio=%.2f\n", a_name, median(a_ns), b_name, median(b_ns), median(ratios));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    EnvMapOptions options;
+    bool equal_area = false;
+    for (int i = 1; i < argc; ++i) {
+        if (std::strcmp(argv[i], "--no-compensate") == 0)
+            options.compensation.enabled = false;
+        else if (std::strcmp(argv[i], "--equal-area") == 0)
+            equal_area = true;
+        else {
+            std::fprintf(stderr, "sample_floor: unknown argument %s\n", argv[i]);
+            return 2;
+        }
+    }
+    std::printf("compensated=%d ", options.compensation.enabled ? 1 : 0);
+    const RgbImage sky = reference::synthetic_sky(8192, 4096);
+    const EnvMap equirect(sky, options);
+    if (!equal_area) {
+        const reference::TextbookEnvMap textbook(sky, options);
+        compare("guided", equirect.view(), "textbook", textbook);
+        return 0;
+    }
+    EnvMapOptions square = options;
+    square.mapping = Mapping::equal_area;
+    const EnvMap equal_area_map(reference::synthetic_sky(5792, 5792, Mapping::equal_area), square);
+    compare("equirect", equirect.view(), "equal_area", equal_area_map.view());
 }

@@ -16,7 +16,8 @@ namespace envmis::reference {
 
 class TextbookEnvMap {
 public:
-    // Expects clean pixels (no NaN, Inf or negative values).
+    // Expects clean pixels (no NaN, Inf or negative values). Reads the radiance from
+    // `image`, which must outlive the map.
     TextbookEnvMap(const RgbImage& image, const EnvMapOptions& options);
 
     EnvSample sample(Vec2 u) const noexcept;
