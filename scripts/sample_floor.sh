@@ -34,6 +34,7 @@ while [[ "${1:-}" == --* ]]; do
     esac
     shift
 done
+(($# <= 1)) || { echo "sample_floor.sh: options go before the rounds; got '$*'" >&2; exit 2; }
 rounds=${1:-5}
 build_dir=${ENVMIS_BUILD_DIR:-build}
 [[ "$rounds" =~ ^[1-9][0-9]?$ ]] || { echo "sample_floor.sh: rounds must be 1 to 99, got '$rounds'" >&2; exit 2; }
