@@ -5,7 +5,7 @@
 //   sample_floor [--no-compensate]               the 8k sky's guided sampler against the
 //       textbook sampler: envmis bench's `speedup_vs_textbook sample` (textbook ns / guided ns)
 //   sample_floor [--no-compensate] --equal-area  the sky as a 5792^2 equal-area map against
-//       the 8192 x 4096 equirect one, 0.02% more texels: `sample/equal-area-over-equirect`
+//       the 8192 x 4096 equirect one (0.02% fewer texels): `sample/equal-area-over-equirect`
 //       (equal-area ns / equirect ns)
 //
 // Prints both samplers' ns a sample (free-running, as in a renderer's loop of calls) and

@@ -20,8 +20,8 @@
 #
 # The variants' results are wrong (only their timing means something). Needs a Release
 # build (bash scripts/test.sh) in build/ or ENVMIS_BUILD_DIR; compiles with g++ or CXX.
-# ctest runs it for one round (scripts.sample_floor), so that it keeps up with the
-# library's code. Usage:
+# ctest runs one round of each mode (scripts.sample_floor.*), so that it keeps up with
+# the library's code. Usage:
 #   bash scripts/sample_floor.sh [--no-compensate] [--equal-area] [rounds]   (rounds: default 5)
 set -euo pipefail
 cd "$(dirname "$0")/.."
