@@ -3,14 +3,16 @@
 // with parts of the sample taken out, to show what the rest costs on the CPU at hand.
 //
 //   sample_floor [--no-compensate]               the 8k sky's guided sampler against the
-//       textbook sampler: envmis bench's `speedup_vs_textbook sample` (textbook ns / guided ns)
+//       textbook sampler as envmis bench times them (`speedup_vs_textbook sample`): each
+//       over 2^20 points in a row, the two in turns, textbook ns / guided ns
 //   sample_floor [--no-compensate] --equal-area  the sky as a 5792^2 equal-area map against
-//       the 8192 x 4096 equirect one (0.02% fewer texels): `sample/equal-area-over-equirect`
-//       (equal-area ns / equirect ns)
+//       the 8192 x 4096 equirect one (0.02% fewer texels) as the Google Benchmark case
+//       `sample/equal-area-over-equirect` times them: in turns over blocks of 1024 points,
+//       equal-area ns / equirect ns
 //
 // Prints both samplers' ns a sample (free-running, as in a renderer's loop of calls) and
-// the median of the ratios of 7 rounds; in each round the two take turns over blocks of
-// 4096 points, so that a drifting machine speed does not bias the ratio.
+// the median of the ratios of 7 rounds; within a round the two samplers take turns, and
+// which goes first alternates, so that a drifting machine speed does not bias the ratio.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -47,10 +49,11 @@ double median(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
-// The two samplers' ns a sample, a over b in turns, and the median ratio b / a per round.
+// The two samplers' ns a sample, a and b in turns over blocks of `block` points (of
+// 2^20), and the median ratio b / a per round.
 template <class A, class B>
-void compare(const char* a_name, const A& a, const char* b_name, const B& b) {
-    constexpr size_t kPoints = size_t{1} << 19, kBlock = 4096;
+void compare(const char* a_name, const A& a, const char* b_name, const B& b, size_t block) {
+    constexpr size_t kPoints = size_t{1} << 20;
     constexpr int kRounds = 7;
     std::mt19937_64 rng(7);
     auto uniform = [&] { return static_cast<float>(rng() >> 40) * 0x1p-24f; };
@@ -61,12 +64,12 @@ void compare(const char* a_name, const A& a, const char* b_name, const B& b) {
     std::vector<double> a_ns, b_ns, ratios;
     for (int round = 0; round < kRounds; ++round) {
         double t[2] = {0, 0};
-        for (size_t first = 0; first < kPoints; first += kBlock) {
-            const bool a_first = (first / kBlock) % 2 == 0;
+        for (size_t first = 0; first < kPoints; first += block) {
+            const bool a_first = (round + first / block) % 2 == 0;
             for (int turn = 0; turn < 2; ++turn) {
                 const bool b_turn = (turn == 0) != a_first;
-                t[b_turn] += b_turn ? time_block(b, points.data() + first, kBlock, sink)
-                                    : time_block(a, points.data() + first, kBlock, sink);
+                t[b_turn] += b_turn ? time_block(b, points.data() + first, block, sink)
+                                    : time_block(a, points.data() + first, block, sink);
             }
         }
         a_ns.push_back(t[0] / kPoints);
@@ -96,11 +99,11 @@ int main(int argc, char** argv) {
     const EnvMap equirect(sky, options);
     if (!equal_area) {
         const reference::TextbookEnvMap textbook(sky, options);
-        compare("guided", equirect.view(), "textbook", textbook);
+        compare("guided", equirect.view(), "textbook", textbook, size_t{1} << 20);
         return 0;
     }
     EnvMapOptions square = options;
     square.mapping = Mapping::equal_area;
     const EnvMap equal_area_map(reference::synthetic_sky(5792, 5792, Mapping::equal_area), square);
-    compare("equirect", equirect.view(), "equal_area", equal_area_map.view());
+    compare("equirect", equirect.view(), "equal_area", equal_area_map.view(), 1024);
 }

@@ -6,6 +6,8 @@
 # one's median ratio. Against the textbook sampler (8k sky):
 #
 #   as-is          the library's sample
+#   control        the same, compiled with its code aligned otherwise: how far two builds of
+#                  the same code differ (code placement), the noise floor of the comparison
 #   no-azimuth     the azimuth's sine and cosine (turn table) replaced by the point's
 #                  coordinates: what computing them costs beyond the rest
 #   no-polar       the same for the polar angle (whose sine the solid-angle pdf divides by)
@@ -15,11 +17,14 @@
 # With --equal-area, the equal-area sky (5792^2) against the equirect one (8192 x 4096):
 #
 #   as-is                  the library's samples
-#   equirect-direction     the equal-area direction computed as the equirect one is (two
-#                          turn-table lookups of the point): its cost in the same place
+#   control                the same, compiled with its code aligned otherwise
+#   equirect-direction     the equal-area direction and pdf computed as the equirect ones are
+#                          (two turn-table lookups of the point, a division by sin theta):
+#                          their cost in the same place
 #
 # The variants' results are wrong (only their timing means something). Needs a Release
-# build (bash scripts/test.sh) in build/ or ENVMIS_BUILD_DIR; compiles with g++ or CXX.
+# build with static libraries (bash scripts/test.sh) in build/ or ENVMIS_BUILD_DIR;
+# compiles with CXX, else the build's compiler.
 # ctest runs one round of each mode (scripts.sample_floor.*), so that it keeps up with
 # the library's code. Usage:
 #   bash scripts/sample_floor.sh [--no-compensate] [--equal-area] [rounds]   (rounds: default 5)
@@ -61,24 +66,28 @@ variant() {
 }
 line="const SinCos theta = sincos_half_turns(turns, p.y), phi = sincos_turns(turns, p.x);"
 cp -r lib/core/include "$work/as-is"
+cp -r lib/core/include "$work/control"
 if [[ " ${flags[*]} " == *" --equal-area "* ]]; then
     variant equirect-direction sampling/envmap.h \
         "return {to_world(axes, equal_area_direction(p)), image_pdf * (1 / kFourPi), radiance[texel], p};" \
         "const SinCos theta = sincos_half_turns(turns, p.y), phi = sincos_turns(turns, p.x);
         const Vec3 d{theta.sin * phi.cos, theta.sin * phi.sin, theta.cos};
-        return {to_world(axes, d), image_pdf * (1 / kFourPi), radiance[texel], p};"
-    names=(as-is equirect-direction)
+        return {to_world(axes, d), solid_angle_pdf(image_pdf, theta.sin), radiance[texel], p};"
+    names=(as-is control equirect-direction)
     what="equal-area ns / equirect ns"
 else
     variant no-azimuth sampling/envmap.h "$line" "const SinCos theta = sincos_half_turns(turns, p.y), phi{p.x + 1, p.x * 2};"
     variant no-polar sampling/envmap.h "$line" "const SinCos theta{p.y, p.y * 2}, phi = sincos_turns(turns, p.x);"
     variant no-direction sampling/envmap.h "$line" "const SinCos theta{p.y, p.y * 2}, phi{p.x + 1, p.x * 2};"
-    names=(as-is no-azimuth no-polar no-direction)
+    names=(as-is control no-azimuth no-polar no-direction)
     what="textbook ns / guided ns"
 fi
 
+cxx=${CXX:-$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build_dir/CMakeCache.txt" 2>/dev/null)}
 for name in "${names[@]}"; do
-    "${CXX:-g++}" -O3 -DNDEBUG -std=c++20 -I"$work/$name" -Ilib/study/include -Iapps/common \
+    align=()
+    [ "$name" = control ] && align=(-falign-functions=64 -falign-loops=64 -falign-jumps=32)
+    "${cxx:-g++}" -O3 -DNDEBUG -std=gnu++20 "${align[@]}" -I"$work/$name" -Ilib/study/include -Iapps/common \
         scripts/sample_floor.cpp "${libs[@]}" -lpthread -o "$work/$name.bin"
 done
 
