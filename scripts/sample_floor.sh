@@ -64,7 +64,6 @@ variant() {
     fi
     printf '%s\n' "${text/"$3"/"$4"}" >"$file"
 }
-line="const SinCos theta = sincos_half_turns(turns, p.y), phi = sincos_turns(turns, p.x);"
 cp -r lib/core/include "$work/as-is"
 cp -r lib/core/include "$work/control"
 if [[ " ${flags[*]} " == *" --equal-area "* ]]; then
@@ -76,6 +75,7 @@ if [[ " ${flags[*]} " == *" --equal-area "* ]]; then
     names=(as-is control equirect-direction)
     what="equal-area ns / equirect ns"
 else
+    line="const SinCos theta = sincos_half_turns(turns, p.y), phi = sincos_turns(turns, p.x);"
     variant no-azimuth sampling/envmap.h "$line" "const SinCos theta = sincos_half_turns(turns, p.y), phi{p.x + 1, p.x * 2};"
     variant no-polar sampling/envmap.h "$line" "const SinCos theta{p.y, p.y * 2}, phi = sincos_turns(turns, p.x);"
     variant no-direction sampling/envmap.h "$line" "const SinCos theta{p.y, p.y * 2}, phi{p.x + 1, p.x * 2};"
