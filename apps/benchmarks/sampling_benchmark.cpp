@@ -89,8 +89,9 @@ void sample(benchmark::State& state) {
 constexpr size_t kBatch = 64;
 const std::vector<envmis::Vec3>& directions();
 const std::vector<envmis::Vec3>& normals();
+const std::vector<float>& choices();
 struct BatchPoints {
-    std::vector<float> ux, uy, nx, ny, nz, dx, dy, dz;  // points, normals, directions
+    std::vector<float> ux, uy, nx, ny, nz, dx, dy, dz, choice;  // points, normals, directions, bin picks
 };
 const BatchPoints& batch_points() {
     static const BatchPoints p = [] {
@@ -98,6 +99,7 @@ const BatchPoints& batch_points() {
         for (const envmis::Vec2 u : uniforms()) b.ux.push_back(u.x), b.uy.push_back(u.y);
         for (const envmis::Vec3 n : normals()) b.nx.push_back(n.x), b.ny.push_back(n.y), b.nz.push_back(n.z);
         for (const envmis::Vec3 d : directions()) b.dx.push_back(d.x), b.dy.push_back(d.y), b.dz.push_back(d.z);
+        b.choice = choices();
         return b;
     }();
     return p;
@@ -163,6 +165,18 @@ const std::vector<envmis::Vec3>& normals() {
     return ns;
 }
 
+// The binned sampler's pick among the bins around each normal: uniform, independent of
+// the points (another point's second coordinate).
+const std::vector<float>& choices() {
+    static const std::vector<float> cs = [] {
+        std::vector<float> v;
+        const auto& us = uniforms();
+        for (size_t i = 0; i < us.size(); ++i) v.push_back(us[(i + 54321) & (us.size() - 1)].y);
+        return v;
+    }();
+    return cs;
+}
+
 void build_bins(benchmark::State& state) {
     const EnvMap plain(sky(static_cast<uint32_t>(state.range(0))), plain_options());
     for (auto _ : state) {
@@ -178,10 +192,11 @@ void sample_binned(benchmark::State& state) {
     const envmis::BinnedEnvMapView view = binned(static_cast<uint32_t>(state.range(0))).view();
     const auto& us = uniforms();
     const auto& ns = normals();
+    const auto& cs = choices();
     size_t i = 0;
     for (auto _ : state) {
         const size_t k = i++ & (us.size() - 1);
-        const envmis::EnvSample e = view.sample(ns[k], 0, us[k]);
+        const envmis::EnvSample e = view.sample(ns[k], 0, cs[k], us[k]);
         benchmark::DoNotOptimize(e);
     }
 }
@@ -194,7 +209,7 @@ void sample_binned_batch(benchmark::State& state) {
     size_t first = 0;
     for (auto _ : state) {
         envmis::sample_many(view, 0, {p.nx.data() + first, p.ny.data() + first, p.nz.data() + first},
-                            {p.ux.data() + first, p.uy.data() + first}, arrays, kBatch);
+                            p.choice.data() + first, {p.ux.data() + first, p.uy.data() + first}, arrays, kBatch);
         benchmark::DoNotOptimize(out.data());
         first = (first + kBatch) & (p.ux.size() - 1);
     }
@@ -205,10 +220,11 @@ void pdf_binned(benchmark::State& state) {
     const envmis::BinnedEnvMapView view = binned(static_cast<uint32_t>(state.range(0))).view();
     const auto& ds = directions();
     const auto& ns = normals();
+    const auto& cs = choices();
     size_t i = 0;
     for (auto _ : state) {
         const size_t k = i++ & (ds.size() - 1);
-        benchmark::DoNotOptimize(view.pdf(ns[k], 0, ds[k]));
+        benchmark::DoNotOptimize(view.pdf(ns[k], 0, cs[k], ds[k]));
     }
 }
 

@@ -18,6 +18,7 @@
 #include <sstream>
 #include <string_view>
 
+#include "envmis/study/shading/bsdf.h"
 #include "envmis/table/atomic_file.h"
 
 namespace envmis::cli {
@@ -96,6 +97,43 @@ CLI::Validator size_validator(bool single, uint32_t min_side, uint32_t max_side)
 
 CLI::Validator bins_validator() {
     return CLI::Validator([](std::string& text) { return bins_problem(text); }, "K");
+}
+
+std::optional<Vec3> parse_direction(const std::string& text) {
+    float v[3];
+    const char* p = text.data();
+    const char* end = text.data() + text.size();
+    for (int i = 0; i < 3; ++i) {
+        if (i > 0 && (p == end || *p++ != ',')) return std::nullopt;
+        const auto [next, error] = std::from_chars(p, end, v[i]);
+        if (error != std::errc() || !std::isfinite(v[i])) return std::nullopt;
+        p = next;
+    }
+    const Vec3 n{v[0], v[1], v[2]};
+    if (p != end || !(length(n) > 0) || !std::isfinite(length(n))) return std::nullopt;
+    return normalize(n);
+}
+
+CLI::Validator direction_validator() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            if (parse_direction(text)) return {};
+            return "'" + text + "': expected X,Y,Z, three finite numbers, not all zero";
+        },
+        "");
+}
+
+CLI::Validator bsdf_validator() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            try {
+                Bsdf::parse(text);
+                return {};
+            } catch (const std::invalid_argument& e) {
+                return "'" + text + "': " + e.what();
+            }
+        },
+        "");
 }
 
 namespace {

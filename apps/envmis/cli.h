@@ -79,6 +79,12 @@ CLI::Validator size_validator(bool single, uint32_t min_side = 1, uint32_t max_s
 // A bin count flag (--bins K): a square number g^2 with g 1 to 64, as BinnedOptions
 // takes it (bins_problem in build.h); its side g.
 CLI::Validator bins_validator();
+// A direction "X,Y,Z" (a shading normal, a view): three finite numbers, not all zero,
+// normalised; empty where the text is not one. The validator refuses what it refuses.
+std::optional<Vec3> parse_direction(const std::string& text);
+CLI::Validator direction_validator();
+// A BSDF as Bsdf::parse reads it: lambert, phong:N or ggx:A.
+CLI::Validator bsdf_validator();
 inline uint32_t bins_per_side(uint32_t bins) {
     return static_cast<uint32_t>(std::lround(std::sqrt(static_cast<double>(bins))));
 }

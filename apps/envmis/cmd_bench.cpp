@@ -56,11 +56,12 @@ float every_output(const EnvMapView::Lookup& l) { return l.pdf + l.radiance.r + 
 // a batch of kBatch.
 constexpr uint32_t kBatch = 64;
 struct BatchInputs {
-    std::vector<float> ux, uy, x, y, z, nx, ny, nz;  // n: the shading normals (binned)
+    std::vector<float> ux, uy, x, y, z, nx, ny, nz, choice;  // n, choice: the binned sampler's
     std::vector<float> out = std::vector<float>(7 * kBatch);
 
-    BatchInputs(const std::vector<Vec2>& us, const std::vector<Vec3>& directions,
-                const std::vector<Vec3>& normals = {}) {
+    BatchInputs(const std::vector<Vec2>& us, const std::vector<Vec3>& directions, const std::vector<Vec3>& normals = {},
+                const std::vector<float>& choices = {})
+        : choice(choices) {
         for (const Vec2 u : us) ux.push_back(u.x), uy.push_back(u.y);
         for (const Vec3 d : directions) x.push_back(d.x), y.push_back(d.y), z.push_back(d.z);
         for (const Vec3 n : normals) nx.push_back(n.x), ny.push_back(n.y), nz.push_back(n.z);
@@ -87,13 +88,13 @@ struct BatchInputs {
     }
     double sample_cost(const BinnedEnvMapView& view, uint32_t lobe) {
         return ns_per_item(ux.size(), [&](size_t first, uint32_t n, float* o) {
-            sample_many(view, lobe, {nx.data() + first, ny.data() + first, nz.data() + first},
+            sample_many(view, lobe, {nx.data() + first, ny.data() + first, nz.data() + first}, choice.data() + first,
                         {ux.data() + first, uy.data() + first}, sample_out(o), n);
         });
     }
     double lookup_cost(const BinnedEnvMapView& view, uint32_t lobe) {
         return ns_per_item(x.size(), [&](size_t first, uint32_t n, float* o) {
-            lookup_many(view, lobe, {nx.data() + first, ny.data() + first, nz.data() + first},
+            lookup_many(view, lobe, {nx.data() + first, ny.data() + first, nz.data() + first}, choice.data() + first,
                         {x.data() + first, y.data() + first, z.data() + first},
                         {o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch}, n);
         });
@@ -210,6 +211,7 @@ BenchMap bench_map(const BenchArgs& args) {
 struct BenchPoints {
     std::vector<Vec2> us;
     std::vector<Vec3> directions, normals;
+    std::vector<float> choices;  // the binned sampler's pick among the bins around each normal
 };
 
 BenchPoints bench_points(uint32_t n, bool normals, uint32_t samples_per_normal) {
@@ -221,8 +223,10 @@ BenchPoints bench_points(uint32_t n, bool normals, uint32_t samples_per_normal) 
             d = {r * std::cos(phi), r * std::sin(phi), z};
         }
     };
-    BenchPoints points{std::vector<Vec2>(n), std::vector<Vec3>(n), std::vector<Vec3>(normals ? n : 0)};
+    BenchPoints points{std::vector<Vec2>(n), std::vector<Vec3>(n), std::vector<Vec3>(normals ? n : 0),
+                       std::vector<float>(normals ? n : 0)};
     for (Vec2& u : points.us) u = {uniform(), uniform()};
+    for (float& c : points.choices) c = uniform();
     sphere(points.directions);
     sphere(points.normals);
     // Group g takes normal g; downwards, so that every source is read before it is overwritten.
@@ -329,30 +333,36 @@ struct BinnedResult {
 // ns per call of the three samplers, back to back in each repeat; lobe class 0.
 void time_binned_calls(const EnvMapView (&today)[2], const BinnedEnvMapView& binned, const BenchPoints& points,
                        int repeats, Progress& progress, int& step, BinnedResult& result) {
-    std::vector<std::pair<Vec2, Vec3>> samples;
-    std::vector<std::pair<Vec3, Vec3>> pdfs;
+    struct Input {
+        Vec2 u;
+        Vec3 direction, normal;
+        float choice;
+    };
+    std::vector<Input> inputs;
     for (size_t i = 0; i < points.us.size(); ++i)
-        samples.emplace_back(points.us[i], points.normals[i]),
-            pdfs.emplace_back(points.directions[i], points.normals[i]);
-    BatchInputs batch(points.us, points.directions, points.normals);
+        inputs.push_back({points.us[i], points.directions[i], points.normals[i], points.choices[i]});
+    BatchInputs batch(points.us, points.directions, points.normals, points.choices);
     std::vector<double> ns[3][4], ratio[2][4], lookup_ns[3], speedup[3][3];
     for (int r = 0; r < repeats; ++r) {
         throw_if_interrupted();
         double t[3][4], lookup[3];
         for (int k = 0; k < 2; ++k) {
-            t[k][0] = ns_per_call(samples, [&](const auto& in) { return every_output(today[k].sample(in.first)); });
-            t[k][1] = ns_per_call(pdfs, [&](const auto& in) { return today[k].pdf(in.first); });
+            t[k][0] = ns_per_call(inputs, [&](const Input& in) { return every_output(today[k].sample(in.u)); });
+            t[k][1] = ns_per_call(inputs, [&](const Input& in) { return today[k].pdf(in.direction); });
             t[k][2] = batch.sample_cost(today[k]);
             t[k][3] = batch.lookup_cost(today[k]);
-            lookup[k] = ns_per_call(pdfs, [&](const auto& in) { return every_output(today[k].lookup(in.first)); });
+            lookup[k] =
+                ns_per_call(inputs, [&](const Input& in) { return every_output(today[k].lookup(in.direction)); });
         }
-        t[2][0] =
-            ns_per_call(samples, [&](const auto& in) { return every_output(binned.sample(in.second, 0, in.first)); });
-        t[2][1] = ns_per_call(pdfs, [&](const auto& in) { return binned.pdf(in.second, 0, in.first); });
+        t[2][0] = ns_per_call(
+            inputs, [&](const Input& in) { return every_output(binned.sample(in.normal, 0, in.choice, in.u)); });
+        t[2][1] =
+            ns_per_call(inputs, [&](const Input& in) { return binned.pdf(in.normal, 0, in.choice, in.direction); });
         t[2][2] = batch.sample_cost(binned, 0);
         t[2][3] = batch.lookup_cost(binned, 0);
-        lookup[2] =
-            ns_per_call(pdfs, [&](const auto& in) { return every_output(binned.lookup(in.second, 0, in.first)); });
+        lookup[2] = ns_per_call(inputs, [&](const Input& in) {
+            return every_output(binned.lookup(in.normal, 0, in.choice, in.direction));
+        });
         for (int c = 0; c < 4; ++c) {
             for (int k = 0; k < 3; ++k) ns[k][c].push_back(t[k][c]);
             for (int k = 0; k < 2; ++k) ratio[k][c].push_back(t[2][c] / t[k][c]);

@@ -2,7 +2,6 @@
 // its sampling densities, side by side; with --normal, also the density that the binned
 // sampler (binned.h) draws from at a shading point with that normal.
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -33,22 +32,6 @@ std::vector<float> pdf_image(const Density& density, uint32_t w, uint32_t h) {
 }
 std::vector<float> pdf_image(const EnvMap& map) { return pdf_image(map, map.width(), map.height()); }
 
-// A shading normal "X,Y,Z": three finite numbers, not all zero (it is normalised).
-std::optional<Vec3> parse_normal(const std::string& text) {
-    float v[3];
-    const char* p = text.data();
-    const char* end = text.data() + text.size();
-    for (int i = 0; i < 3; ++i) {
-        if (i > 0 && (p == end || *p++ != ',')) return std::nullopt;
-        const auto [next, error] = std::from_chars(p, end, v[i]);
-        if (error != std::errc() || !std::isfinite(v[i])) return std::nullopt;
-        p = next;
-    }
-    const Vec3 n{v[0], v[1], v[2]};
-    if (p != end || !(length(n) > 0) || !std::isfinite(length(n))) return std::nullopt;
-    return normalize(n);
-}
-
 // The arguments of `envmis visualize`.
 struct VisualizeArgs {
     std::string input, output;
@@ -67,15 +50,10 @@ void add_visualize_flags(CLI::App& sub, VisualizeArgs& args) {
         ->capture_default_str()
         ->check(in_range(uint32_t{64}, uint32_t{4096}));
     sub.add_option("--normal", args.normal,
-                   "Also show the density the binned sampler draws from at a shading point with this normal "
-                   "(world frame; normalised)")
+                   "Also show the density of the bin whose square holds this normal (world frame; normalised); "
+                   "a shading point there picks among it and its neighbours")
         ->type_name("X,Y,Z")
-        ->check(CLI::Validator(
-            [](std::string& text) -> std::string {
-                if (parse_normal(text)) return {};
-                return "'" + text + "': expected X,Y,Z, three finite numbers, not all zero";
-            },
-            ""));
+        ->check(direction_validator());
     sub.add_option("--bins", args.bins, "Bins of the binned sampler (with --normal)")
         ->type_name("K")
         ->capture_default_str()
@@ -85,16 +63,7 @@ void add_visualize_flags(CLI::App& sub, VisualizeArgs& args) {
                    "or ggx:A")
         ->type_name("BSDF")
         ->capture_default_str()
-        ->check(CLI::Validator(
-            [](std::string& text) -> std::string {
-                try {
-                    Bsdf::parse(text);
-                    return {};
-                } catch (const std::invalid_argument& e) {
-                    return "'" + text + "': " + e.what();
-                }
-            },
-            ""));
+        ->check(bsdf_validator());
     add_map_flags(sub, args.map);
 }
 
@@ -112,7 +81,7 @@ std::optional<BinPanel> bin_panel(const VisualizeArgs& args, const LoadedMap& lo
     if (args.normal.empty()) return std::nullopt;
     BinnedOptions options;
     options.bins_per_side = bins_per_side(args.bins);
-    const Vec3 n = *parse_normal(args.normal);  // the flag's validator has accepted it
+    const Vec3 n = *parse_direction(args.normal);  // the flag's validator has accepted it
     const Bsdf bsdf = Bsdf::parse(args.lobe);
     BinPanel p;
     std::optional<Progress> progress(std::in_place, "building bins", 1);
@@ -183,7 +152,7 @@ Visualization visualize(const std::string& name, const Densities& d, const std::
                                             pictures::resize(pdf_image(d.compensated()), w, h, pw, ph)};
     if (bin) {
         const BinnedEnvMapView view = bin->binned->view();  // the bin points into it
-        pdfs.push_back(pictures::resize(pdf_image(view.bin(bin->normal, bin->lobe), w, h), w, h, pw, ph));
+        pdfs.push_back(pictures::resize(pdf_image(view.nearest_bin(bin->normal, bin->lobe), w, h), w, h, pw, ph));
     }
     const std::vector<std::span<const float>> spans(pdfs.begin(), pdfs.end());
     const pictures::ColourScale scale = pictures::shared_log_scale(spans);

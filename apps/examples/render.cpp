@@ -197,10 +197,12 @@ Rgb direct_lighting(const Density& env, const Scene& scene, const Hit& hit, Vec3
 Rgb trace(const Environment& env, const Scene& scene, const Ray& ray, Technique technique, envmis::Pcg32& rng) {
     const std::optional<Hit> hit = scene.intersect(ray);
     if (!hit) return env.global.eval(ray.direction);
-    if (env.binned)
-        return direct_lighting(
-            env.binned->bin(envmis::lobe_axis(hit->lobe, hit->normal, ray.direction * -1.0f), hit->lobe), scene, *hit,
-            ray.direction * -1.0f, technique, rng);
+    if (env.binned) {
+        // One pick of the bins around the lobe axis serves both samples' MIS weights.
+        const Vec3 axis = envmis::lobe_axis(hit->lobe, hit->normal, ray.direction * -1.0f);
+        return direct_lighting(env.binned->bin(axis, hit->lobe, rng.uniform()), scene, *hit, ray.direction * -1.0f,
+                               technique, rng);
+    }
     return direct_lighting(env.global, scene, *hit, ray.direction * -1.0f, technique, rng);
 }
 

@@ -23,7 +23,7 @@ void interleave(float (*in)[kChunk], uint32_t m, float* out, size_t first) noexc
         for (size_t k = 0; k < K; ++k) row[k] = in[k][i];
 }
 
-// Runs `batch(first, m, points, normals, outputs)` chunk by chunk over n points with the
+// Runs `batch(points, normals, outputs, m, first)` chunk by chunk over n points with the
 // chunk's inputs deinterleaved (normals only when given) and stores its outputs.
 template <class Batch>
 void sample_chunks(const float* u, const float* normals, InterleavedSamples out, size_t n, Batch&& batch) noexcept {
@@ -35,7 +35,7 @@ void sample_chunks(const float* u, const float* normals, InterleavedSamples out,
         batch({points[0], points[1]}, DirectionArrays{normal[0], normal[1], normal[2]},
               SampleArrays{direction[0], direction[1], direction[2], out.pdf + first, radiance[0], radiance[1],
                            radiance[2], uv[0], uv[1]},
-              m);
+              m, first);
         interleave<3>(direction, m, out.direction, first);
         interleave<3>(radiance, m, out.radiance, first);
         interleave<2>(uv, m, out.uv, first);
@@ -52,7 +52,7 @@ void lookup_chunks(const float* directions, const float* normals, InterleavedLoo
         if (normals) deinterleave<3>(normals, first, m, normal);
         batch(DirectionArrays{direction[0], direction[1], direction[2]},
               DirectionArrays{normal[0], normal[1], normal[2]},
-              LookupArrays{radiance[0], radiance[1], radiance[2], out.pdf ? out.pdf + first : pdf}, m);
+              LookupArrays{radiance[0], radiance[1], radiance[2], out.pdf ? out.pdf + first : pdf}, m, first);
         if (out.radiance) interleave<3>(radiance, m, out.radiance, first);
     }
 }
@@ -60,27 +60,30 @@ void lookup_chunks(const float* directions, const float* normals, InterleavedLoo
 }  // namespace
 
 void sample(const EnvMapView& env, const float* u, InterleavedSamples out, size_t n) noexcept {
-    sample_chunks(u, nullptr, out, n,
-                  [&](PointArrays in, DirectionArrays, SampleArrays o, uint32_t m) { sample_many(env, in, o, m); });
-}
-
-void sample(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* u, InterleavedSamples out,
-            size_t n) noexcept {
-    sample_chunks(u, normals, out, n, [&](PointArrays in, DirectionArrays normal, SampleArrays o, uint32_t m) {
-        sample_many(env, lobe, normal, in, o, m);
+    sample_chunks(u, nullptr, out, n, [&](PointArrays in, DirectionArrays, SampleArrays o, uint32_t m, size_t) {
+        sample_many(env, in, o, m);
     });
 }
 
-void lookup(const EnvMapView& env, const float* directions, InterleavedLookups out, size_t n) noexcept {
-    lookup_chunks(directions, nullptr, out, n,
-                  [&](DirectionArrays in, DirectionArrays, LookupArrays o, uint32_t m) { lookup_many(env, in, o, m); });
+void sample(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* choices, const float* u,
+            InterleavedSamples out, size_t n) noexcept {
+    sample_chunks(u, normals, out, n,
+                  [&](PointArrays in, DirectionArrays normal, SampleArrays o, uint32_t m, size_t first) {
+                      sample_many(env, lobe, normal, choices + first, in, o, m);
+                  });
 }
 
-void lookup(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* directions,
-            InterleavedLookups out, size_t n) noexcept {
+void lookup(const EnvMapView& env, const float* directions, InterleavedLookups out, size_t n) noexcept {
+    lookup_chunks(
+        directions, nullptr, out, n,
+        [&](DirectionArrays in, DirectionArrays, LookupArrays o, uint32_t m, size_t) { lookup_many(env, in, o, m); });
+}
+
+void lookup(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* choices,
+            const float* directions, InterleavedLookups out, size_t n) noexcept {
     lookup_chunks(directions, normals, out, n,
-                  [&](DirectionArrays in, DirectionArrays normal, LookupArrays o, uint32_t m) {
-                      lookup_many(env, lobe, normal, in, o, m);
+                  [&](DirectionArrays in, DirectionArrays normal, LookupArrays o, uint32_t m, size_t first) {
+                      lookup_many(env, lobe, normal, choices + first, in, o, m);
                   });
 }
 

@@ -122,8 +122,11 @@ TableError on I/O failure or a destination that is not a regular file.)";
 inline constexpr const char* kBinned = R"(A normal-aware map (envmis::BinnedEnvMap): K bins of normals,
 each with its own compensated density per lobe class, over a plain (uncompensated) map.
 
-A shading point picks its bin by its normal (world frame); a lobe class by its BSDF's
-sharpness (lobe_class). Made by envmis.load(..., bins=K) or from a binned table. pdf and
+A shading point picks one of the four bins around its normal (world frame; for glossy
+classes the mirror direction of the view) with a uniform `choice`, by bilinear weights
+over the bins' centres, so that nothing changes in steps across bin borders; a lobe class
+by its BSDF's sharpness (lobe_class). The same choice must serve a point's light samples
+and its BSDF samples' MIS weights. Made by envmis.load(..., bins=K) or from a binned table. pdf and
 sample speak solid angle (per steradian) over world directions, as EnvMap's.)";
 inline constexpr const char* kPlain =
     "The plain map the bins are built over (an EnvMap sharing this map's memory; it keeps this map alive). Its source "
@@ -137,14 +140,14 @@ inline constexpr const char* kBinnedComplete =
 inline constexpr const char* kBinnedSample = R"(Directions drawn for N (point, normal) pairs.
 
 u: float32 (N, 2) in [0, 1)^2 (checked as EnvMap.sample checks it); normals: float32 (N, 3), the shading normals in the world
-frame (their bin: the octahedral cell of the normalised vector); lobe: the lobe class (0
-to classes - 1). Returns Samples as EnvMap.sample does, bit-identical to N single calls
+frame (or lobe axes); choices: float32 (N,) in [0, 1), each point's pick among the bins
+around its normal; lobe: the lobe class (0 to classes - 1). Returns Samples as EnvMap.sample does, bit-identical to N single calls
 of the C++ BinnedEnvMapView::sample; out as EnvMap.sample's. O(N), GIL released.)";
 inline constexpr const char* kBinnedPdf = R"(The solid-angle pdf (per steradian) of each direction under the bin
-its normal picks (lobe class `lobe`): what sample() with that normal would have drawn.
+its normal and choice pick (lobe class `lobe`): what sample() with them would have drawn.
 
 directions, normals: float32 (N, 3), world frame; directions unit length (not
-normalised). Returns float32 (N,). O(N), GIL released.)";
+normalised); choices: float32 (N,) in [0, 1). Returns float32 (N,). O(N), GIL released.)";
 
 inline constexpr const char* kLoad = R"(Loads an HDR image (or a table file) as `envmis precompute` builds it.
 

@@ -58,7 +58,7 @@ __global__ void binned(envmis::BinnedEnvMapView env, const envmis::Vec3* normals
     const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= n) return;
     const envmis::Vec3 axis = envmis::lobe_axis(i % env.classes, normals[i], normals[i]);
-    const envmis::BinView bin = env.bin(axis, i % env.classes);
+    const envmis::BinView bin = env.bin(axis, i % env.classes, 0.001f * (i % 1000));
     const envmis::EnvSample s = bin.sample({0.5f, 0.25f});
     const envmis::EnvMapView::Lookup l = bin.lookup(s.direction);
     out[i] = s.pdf + l.pdf + l.radiance.r + bin.pdf(normals[i]) + bin.eval(normals[i]).g;

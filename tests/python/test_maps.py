@@ -170,8 +170,10 @@ def test_a_saved_binned_map_loads_with_the_same_bins(tmp_path):
         "compact=0", "compact=1")} and table.source["name"] == PARK.name
     normals = np.tile(np.array([[0, 0, 1]], np.float32), (1000, 1))
     u = envmis.uniform_points(1000, seed=2)
+    choices = envmis.uniform_points(500, seed=3).reshape(-1)
     # Compact: the RGBE-rounded map, which a .hdr source already is.
-    assert np.array_equal(bits(table.sample(u, normals, 1).pdf), bits(binned.sample(u, normals, 1).pdf))
+    assert np.array_equal(bits(table.sample(u, normals, choices, 1).pdf),
+                          bits(binned.sample(u, normals, choices, 1).pdf))
 
 
 @needs_cli
@@ -288,18 +290,23 @@ def test_a_binned_map_samples_with_the_pdf_it_reports_and_checks_its_normals():
     rng = np.random.default_rng(3)
     normals = rng.normal(size=(5000, 3)).astype(np.float32)
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    choices = envmis.uniform_points(2500, seed=9).reshape(-1)
     for lobe in range(binned.classes):
-        s = binned.sample(envmis.uniform_points(5000, seed=lobe), normals, lobe)
-        assert np.mean(np.abs(binned.pdf(s.direction, normals, lobe) / s.pdf - 1) < 1e-4) > 0.995
+        s = binned.sample(envmis.uniform_points(5000, seed=lobe), normals, choices, lobe)
+        assert np.mean(np.abs(binned.pdf(s.direction, normals, choices, lobe) / s.pdf - 1) < 1e-4) > 0.995
     plain = binned.plain
     assert isinstance(plain, envmis.EnvMap) and not plain.compensated and plain.width == binned.width
     u = envmis.uniform_points(4, seed=1)
     with pytest.raises(ValueError, match=r"normals must be a float32 array of shape \(N, 3\) with N = 4"):
-        binned.sample(u, normals[:3])
+        binned.sample(u, normals[:3], choices[:4])
     with pytest.raises(ValueError, match=r"normals must be a float32 array of shape \(N, 3\); got a float64"):
-        binned.pdf(np.zeros((4, 3), np.float32), np.zeros((4, 3)))
+        binned.pdf(np.zeros((4, 3), np.float32), np.zeros((4, 3)), choices[:4])
+    with pytest.raises(ValueError, match=r"choices must be a float32 array of shape \(N,\) with N = 4"):
+        binned.sample(u, normals[:4], choices[:3])
+    with pytest.raises(ValueError, match=r"choices"):
+        binned.sample(u, normals[:4], np.full(4, 1.0, np.float32))
     with pytest.raises(ValueError, match=r"lobe 3 is not a lobe class of this map \(0 to 2\)"):
-        binned.sample(u, normals[:4], lobe=3)
+        binned.sample(u, normals[:4], choices[:4], lobe=3)
 
 
 @needs_cli
@@ -394,7 +401,8 @@ def sample_call(kind, small_maps, park_binned):
         return lambda u, out=None: small_maps["plain"].sample(u, out=out)
     if kind == "BinnedEnvMap":
         normals = np.tile(np.array([[0, 0, 1]], np.float32), (16, 1))
-        return lambda u, out=None: park_binned.sample(u, normals, 1, out=out)
+        choices = np.linspace(0, 0.99, 16, dtype=np.float32)
+        return lambda u, out=None: park_binned.sample(u, normals, choices, 1, out=out)
     wo = np.tile(np.array([[0.6, 0.0, 0.8]], np.float32), (16, 1))
     return lambda u, out=None: envmis.Bsdf.ggx(0.2).sample(wo, u)
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <string>
 #include <vector>
 
 #include "envmis/sampling/binned.h"
@@ -16,7 +17,7 @@
 namespace envmis::test {
 
 // The family of chi-square tests these checks make, across the binned test files.
-inline const double kBinnedLevel = sidak_level(0.01, 60);
+inline const double kBinnedLevel = sidak_level(0.01, 300);
 
 inline EnvMap plain_map(RgbImage image, Mapping mapping = Mapping::equirect) {
     EnvMapOptions o;
@@ -56,24 +57,70 @@ inline std::vector<double> texel_probabilities(const BinView& bin, const EnvMap&
     return p;
 }
 
-inline void expect_samples_follow_pdf(const BinnedEnvMap& binned, Vec3 normal, uint32_t lobe, uint64_t seed) {
-    const BinnedEnvMapView view = binned.view();
-    const BinView bin = view.bin(normal, lobe);
-    const std::vector<double> p = texel_probabilities(bin, binned.plain());
-    EXPECT_NEAR(std::accumulate(p.begin(), p.end(), 0.0), 1.0, 1e-4);
-    const size_t n = std::max<size_t>(100000, 20 * p.size());
+// The bins a normal's blend picks with positive weight, as class-bin indices, and
+// their weights.
+struct PickedBin {
+    BinView bin;
+    float weight;
+};
+inline std::vector<PickedBin> picked_bins(const BinnedEnvMapView& view, Vec3 normal, uint32_t lobe) {
+    const BinBlend blend = normal_blend(to_canonical(view.plain.axes, normal), view.bins_per_side);
+    std::vector<PickedBin> bins;
+    for (int k = 0; k < 4; ++k)
+        if (blend.weight[k] > 0) bins.push_back({view.bin_at(view.class_bin(lobe, blend.bin[k])), blend.weight[k]});
+    return bins;
+}
+
+// Chi-square of n samples (`draw` returns one) over the texels against probabilities p.
+template <class Draw>
+void expect_texels_follow(const std::vector<double>& p, const EnvMap& plain, size_t n, Draw&& draw,
+                          const std::string& what) {
     std::vector<double> expected(p.size()), observed(p.size());
     for (size_t i = 0; i < p.size(); ++i) expected[i] = p[i] * n;
-    Rng rng(seed);
-    const uint32_t w = binned.plain().width(), h = binned.plain().height();
+    const uint32_t w = plain.width(), h = plain.height();
     for (size_t i = 0; i < n; ++i) {
-        const EnvSample s = bin.sample(rng.uniform2());
-        ASSERT_EQ(s.pdf, bin.pdf_uv(s.uv));
+        const EnvSample s = draw();
         observed[size_t{detail::cell_of(s.uv.y, h)} * w + detail::cell_of(s.uv.x, w)] += 1;
     }
     const auto chi = chi_square(expected, observed);
-    EXPECT_GT(chi.p_value, kBinnedLevel) << "normal " << normal.x << "," << normal.y << "," << normal.z << " lobe "
-                                         << lobe << ": " << chi.describe();
+    EXPECT_GT(chi.p_value, kBinnedLevel) << what << ": " << chi.describe();
+}
+
+// Every bin the normal may pick: samples follow its pdf (chi-square), which integrates
+// to 1 and is what the sample returns; and samples with random picks follow the blend's
+// mixture of those pdfs (the picks' weights).
+inline void expect_samples_follow_pdf(const BinnedEnvMap& binned, Vec3 normal, uint32_t lobe, uint64_t seed) {
+    const BinnedEnvMapView view = binned.view();
+    const std::string what = "normal " + std::to_string(normal.x) + "," + std::to_string(normal.y) + "," +
+                             std::to_string(normal.z) + " lobe " + std::to_string(lobe);
+    Rng rng(seed);
+    const std::vector<PickedBin> picks = picked_bins(view, normal, lobe);
+    std::vector<double> mixture;
+    for (const PickedBin& pick : picks) {
+        const std::vector<double> p = texel_probabilities(pick.bin, binned.plain());
+        EXPECT_NEAR(std::accumulate(p.begin(), p.end(), 0.0), 1.0, 1e-4);
+        mixture.resize(p.size());
+        for (size_t i = 0; i < p.size(); ++i) mixture[i] += pick.weight * p[i];
+        const size_t n = std::max<size_t>(100000, 20 * p.size());
+        expect_texels_follow(
+            p, binned.plain(), n,
+            [&] {
+                const EnvSample s = pick.bin.sample(rng.uniform2());
+                EXPECT_EQ(s.pdf, pick.bin.pdf_uv(s.uv));
+                return s;
+            },
+            what);
+    }
+    if (picks.size() < 2) return;
+    expect_texels_follow(
+        mixture, binned.plain(), std::max<size_t>(100000, 20 * mixture.size()),
+        [&] {
+            const float choice = rng.uniform();
+            const EnvSample s = view.sample(normal, lobe, choice, rng.uniform2());
+            EXPECT_EQ(s.pdf, view.bin(normal, lobe, choice).pdf_uv(s.uv));
+            return s;
+        },
+        what + " (random picks)");
 }
 
 // Coverage: pdf > 0 at every texel centre above the normal's horizon whose luminance is
@@ -87,17 +134,21 @@ inline void expect_coverage(const BinnedEnvMap& map, uint32_t lobe) {
     for (int k = 0; k <= 400; ++k) {  // a sweep across many bin borders
         const float t = k / 400.0f;
         const Vec3 n = octahedral_normal(t, 0.5f + 0.45f * std::sin(9 * t));
-        const BinChoice& c = map.layout().choices[size_t{lobe} * g * g + normal_bin(n, g)];
-        for (uint32_t y = 0; y < h; ++y)
-            for (uint32_t x = 0; x < w; ++x) {
-                const Vec2 uv{(x + 0.5f) / w, (y + 0.5f) / h};
-                const Vec3 d = equirect_direction(uv);
-                const float l = density[size_t{y} * w + x] / row_sin_theta(y, h);
-                if (dot(d, n) <= 0 || !(l > (c.plain() ? 0 : c.threshold) * 1.001f)) continue;
-                ++checked;
-                ASSERT_GT(view.bin(n, lobe).pdf_uv(uv), 0)
-                    << "texel " << x << "," << y << " normal bin " << normal_bin(n, g);
-            }
+        const BinBlend blend = normal_blend(n, g);
+        for (int pick = 0; pick < 4; ++pick) {
+            if (!(blend.weight[pick] > 0)) continue;
+            const BinChoice& c = map.layout().choices[size_t{lobe} * g * g + blend.bin[pick]];
+            const BinView bin = view.bin_at(view.class_bin(lobe, blend.bin[pick]));
+            for (uint32_t y = 0; y < h; ++y)
+                for (uint32_t x = 0; x < w; ++x) {
+                    const Vec2 uv{(x + 0.5f) / w, (y + 0.5f) / h};
+                    const Vec3 d = equirect_direction(uv);
+                    const float l = density[size_t{y} * w + x] / row_sin_theta(y, h);
+                    if (dot(d, n) <= 0 || !(l > (c.plain() ? 0 : c.threshold) * 1.001f)) continue;
+                    ++checked;
+                    ASSERT_GT(bin.pdf_uv(uv), 0) << "texel " << x << "," << y << " bin " << blend.bin[pick];
+                }
+        }
     }
     EXPECT_GT(checked, 100);
 }

@@ -38,6 +38,39 @@ inline RgbImage random_map(uint32_t w, uint32_t h, uint64_t seed, float decades 
     return m;
 }
 
+// Maps whose black regions lie beside lit ones, inside one cell of a binned map's grid:
+// one lit texel; two bright softboxes on black; a sky over a black lower hemisphere.
+inline RgbImage single_texel_map(uint32_t w, uint32_t h, uint32_t x, uint32_t y) {
+    RgbImage m = constant_map(w, h, {});
+    m.pixels[size_t{y} * w + x] = {1, 1, 1};
+    return m;
+}
+inline RgbImage softboxes_map(uint32_t w, uint32_t h) {
+    RgbImage m = constant_map(w, h, {});
+    for (uint32_t y = h / 5; y < h / 3; ++y) {
+        for (uint32_t x = w / 8; x < w / 8 + w / 10; ++x) m.pixels[size_t{y} * w + x] = {50, 50, 50};
+        for (uint32_t x = w / 2 + 3; x < w / 2 + 3 + w / 16; ++x) m.pixels[size_t{y} * w + x] = {20, 30, 40};
+    }
+    return m;
+}
+inline RgbImage black_ground_map(uint32_t w, uint32_t h, uint64_t seed) {
+    RgbImage m = random_map(w, h, seed, 2);
+    for (uint32_t y = h / 2; y < h; ++y)
+        for (uint32_t x = 0; x < w; ++x) m.pixels[size_t{y} * w + x] = {};
+    return m;
+}
+// Sparse: each texel lit with probability `lit` (over six decades), black otherwise.
+inline RgbImage sparse_map(uint32_t w, uint32_t h, uint64_t seed, float lit) {
+    Rng rng(seed);
+    RgbImage m = constant_map(w, h, {});
+    for (Rgb& p : m.pixels)
+        if (rng.uniform() < lit) {
+            const float l = std::pow(10.0f, 6 * (rng.uniform() - 0.5f));
+            p = {l * rng.uniform(), l, l * rng.uniform()};
+        }
+    return m;
+}
+
 // Random non-negative function values over several decades, with some exact zeros.
 inline std::vector<float> random_function(size_t n, uint64_t seed, float decades = 3) {
     Rng rng(seed);

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numeric>
+#include <string>
 
 #include "binned_checks.h"
 #include "envmis/sampling/binned.h"
@@ -43,7 +44,8 @@ TEST(Binned, SolidAnglePdfIntegratesToOne) {
     const BinnedEnvMap map(plain_map(test::sun_sky_map(64, 32)));
     const BinnedEnvMapView view = map.view();
     for (Vec3 n : test_normals(BinnedOptions{}.bins_per_side))
-        EXPECT_NEAR(test::sphere_integral(256, 512, [&](Vec3 d) { return view.pdf(n, 0, d); }), 1.0, 1e-3);
+        for (float choice : {0.1f, 0.5f, 0.9f})
+            EXPECT_NEAR(test::sphere_integral(256, 512, [&](Vec3 d) { return view.pdf(n, 0, choice, d); }), 1.0, 1e-3);
 }
 
 TEST(Binned, SampleAgreesWithPdfAndEvalFromItsDirection) {
@@ -54,10 +56,11 @@ TEST(Binned, SampleAgreesWithPdfAndEvalFromItsDirection) {
     const int n = 20000;
     for (int i = 0; i < n; ++i) {
         const Vec3 normal = octahedral_normal(rng.uniform(), rng.uniform());
-        const EnvSample s = view.sample(normal, i % 3, rng.uniform2());
+        const float choice = rng.uniform();
+        const EnvSample s = view.sample(normal, i % 3, choice, rng.uniform2());
         ASSERT_GT(s.pdf, 0);
         ASSERT_NEAR(length(s.direction), 1.0f, 1e-5f);
-        const EnvMapView::Lookup l = view.lookup(normal, i % 3, s.direction);
+        const EnvMapView::Lookup l = view.lookup(normal, i % 3, choice, s.direction);
         if (std::abs(l.pdf - s.pdf) > 1e-3f * s.pdf || l.radiance.r != s.radiance.r) ++edge_cases;
     }
     EXPECT_LT(edge_cases, n / 500);
@@ -67,7 +70,7 @@ TEST(Binned, InsideACellTexelsArePickedByThePlainDensity) {
     const EnvMap plain = plain_map(test::random_map(64, 32, 5));
     const BinnedEnvMap map(plain);
     const BinnedEnvMapView view = map.view();
-    const BinView bin = view.bin({0, 0, 1}, 0);
+    const BinView bin = view.nearest_bin({0, 0, 1}, 0);
     const std::vector<double> p = texel_probabilities(bin, map.plain());
     const std::vector<float> plain_density = plain.density();
     for (uint32_t y = 0; y < 32; ++y)
@@ -104,17 +107,18 @@ TEST(Binned, BatchCallsAreBitIdenticalToSingleCalls) {
     const BinnedEnvMapView view = map.view();
     constexpr uint32_t n = 257;
     Rng rng(4);
-    float nx[n], ny[n], nz[n], ux[n], uy[n], dx[n], dy[n], dz[n];
+    float nx[n], ny[n], nz[n], c[n], ux[n], uy[n], dx[n], dy[n], dz[n];
     for (uint32_t i = 0; i < n; ++i) {
         const Vec3 normal = octahedral_normal(rng.uniform(), rng.uniform());
         nx[i] = normal.x, ny[i] = normal.y, nz[i] = normal.z, ux[i] = rng.uniform(), uy[i] = rng.uniform();
+        c[i] = rng.uniform();
         const Vec3 d = equirect_direction(rng.uniform2());
         dx[i] = d.x, dy[i] = d.y, dz[i] = d.z;
     }
     float x[n], y[n], z[n], pdf[n], r[n], g[n], b[n], u[n], v[n];
-    sample_many(view, 1, {nx, ny, nz}, {ux, uy}, {x, y, z, pdf, r, g, b, u, v}, n);
+    sample_many(view, 1, {nx, ny, nz}, c, {ux, uy}, {x, y, z, pdf, r, g, b, u, v}, n);
     for (uint32_t i = 0; i < n; ++i) {
-        const EnvSample s = view.sample({nx[i], ny[i], nz[i]}, 1, {ux[i], uy[i]});
+        const EnvSample s = view.sample({nx[i], ny[i], nz[i]}, 1, c[i], {ux[i], uy[i]});
         ASSERT_EQ(s.direction.x, x[i]);
         ASSERT_EQ(s.direction.z, z[i]);
         ASSERT_EQ(s.pdf, pdf[i]);
@@ -122,9 +126,9 @@ TEST(Binned, BatchCallsAreBitIdenticalToSingleCalls) {
         ASSERT_EQ(s.uv.x, u[i]);
         ASSERT_EQ(s.uv.y, v[i]);
     }
-    lookup_many(view, 1, {nx, ny, nz}, {dx, dy, dz}, {r, g, b, pdf}, n);
+    lookup_many(view, 1, {nx, ny, nz}, c, {dx, dy, dz}, {r, g, b, pdf}, n);
     for (uint32_t i = 0; i < n; ++i) {
-        const EnvMapView::Lookup l = view.lookup({nx[i], ny[i], nz[i]}, 1, {dx[i], dy[i], dz[i]});
+        const EnvMapView::Lookup l = view.lookup({nx[i], ny[i], nz[i]}, 1, c[i], {dx[i], dy[i], dz[i]});
         ASSERT_EQ(l.pdf, pdf[i]);
         ASSERT_EQ(l.radiance.b, b[i]);
     }
@@ -138,7 +142,8 @@ TEST(Binned, RebuildingFromTheLayoutIsBitIdentical) {
     for (int i = 0; i < 2000; ++i) {
         const Vec3 n = octahedral_normal(rng.uniform(), rng.uniform());
         const Vec2 u = rng.uniform2();
-        const EnvSample a = built.view().sample(n, i % 3, u), b = rebuilt.view().sample(n, i % 3, u);
+        const float c = rng.uniform();
+        const EnvSample a = built.view().sample(n, i % 3, c, u), b = rebuilt.view().sample(n, i % 3, c, u);
         ASSERT_EQ(a.pdf, b.pdf);
         ASSERT_EQ(a.direction.x, b.direction.x);
     }
@@ -181,11 +186,104 @@ TEST(Binned, TinyBlackAndConstantMapsWork) {
         const BinnedEnvMapView view = map.view();
         Rng rng(1);
         for (Vec3 n : test_normals(BinnedOptions{}.bins_per_side)) {
-            const EnvSample s = view.sample(n, 0, rng.uniform2());
+            const float choice = rng.uniform();
+            const EnvSample s = view.sample(n, 0, choice, rng.uniform2());
             EXPECT_GT(s.pdf, 0) << image.width << "x" << image.height;
-            EXPECT_EQ(s.pdf, view.bin(n, 0).pdf_uv(s.uv));
+            EXPECT_EQ(s.pdf, view.bin(n, 0, choice).pdf_uv(s.uv));
         }
     }
+}
+
+// Every sample, pdf and lookup of random (axis, pick, point or direction, class) finite,
+// the pdf >= 0 and the sample's pdf > 0 and equal to the pdf at its point.
+void expect_finite_everywhere(const BinnedEnvMap& map, uint64_t seed, const std::string& what) {
+    const BinnedEnvMapView view = map.view();
+    Rng rng(seed);
+    for (int i = 0; i < 4000; ++i) {
+        const Vec3 axis = octahedral_normal(rng.uniform(), rng.uniform());
+        const uint32_t lobe = static_cast<uint32_t>(i) % map.classes();
+        const float choice = rng.uniform();
+        const BinView bin = view.bin(axis, lobe, choice);
+        const EnvSample s = bin.sample(rng.uniform2());
+        ASSERT_TRUE(s.pdf > 0 && std::isfinite(s.pdf)) << what << ": sample pdf " << s.pdf;
+        ASSERT_TRUE(std::isfinite(s.direction.x + s.direction.y + s.direction.z)) << what;
+        ASSERT_TRUE(std::isfinite(s.radiance.r + s.radiance.g + s.radiance.b)) << what;
+        ASSERT_EQ(s.pdf, bin.pdf_uv(s.uv)) << what;
+        const EnvMapView::Lookup l = bin.lookup(equirect_direction(rng.uniform2()));
+        ASSERT_TRUE(l.pdf >= 0 && std::isfinite(l.pdf)) << what << ": lookup pdf " << l.pdf;
+        const Vec2 uv = rng.uniform2();
+        ASSERT_TRUE(bin.pdf_uv(uv) >= 0 && std::isfinite(bin.pdf_uv(uv))) << what << " at " << uv.x << "," << uv.y;
+    }
+}
+
+TEST(Binned, BlackTexelsBesideLitOnesInOneCellGetPdfZeroNotNaN) {
+    // Lit in one row of a cell and black in the next: the black row's segment has no
+    // plain mass (0 / 0 before).
+    const BinnedEnvMap one(plain_map(test::single_texel_map(64, 32, 10, 3)));
+    const BinnedEnvMapView view = one.view();  // the bin points into it
+    const BinView bin = view.nearest_bin({0, 0, 1}, 0);
+    for (uint32_t y = 0; y < 32; ++y)
+        for (uint32_t x = 0; x < 64; ++x) {
+            const float p = bin.pdf_uv({(x + 0.5f) / 64, (y + 0.5f) / 32});
+            ASSERT_EQ(p > 0, x == 10 && y == 3) << x << "," << y << ": " << p;
+        }
+    expect_finite_everywhere(one, 1, "single texel");
+    expect_finite_everywhere(BinnedEnvMap(plain_map(test::softboxes_map(256, 128))), 2, "softboxes");
+    expect_finite_everywhere(BinnedEnvMap(plain_map(test::black_ground_map(128, 64, 3))), 3, "black ground");
+    expect_finite_everywhere(BinnedEnvMap(plain_map(test::black_ground_map(32, 32, 4), Mapping::equal_area)), 4,
+                             "black ground, equal-area");
+}
+
+TEST(Binned, RandomSparseMapsNeverGiveANaNOrInfinitePdfOrSample) {
+    Rng rng(77);
+    for (uint64_t k = 0; k < 24; ++k) {
+        const auto w = 4 + static_cast<uint32_t>(rng.uniform() * 120),
+                   h = 2 + static_cast<uint32_t>(rng.uniform() * 60);
+        const float lit = k % 3 == 0 ? 0.002f : (k % 3 == 1 ? 0.03f : 0.3f);
+        const Mapping mapping = k % 4 == 3 ? Mapping::equal_area : Mapping::equirect;
+        const RgbImage image = test::sparse_map(w, mapping == Mapping::equal_area ? w : h, 100 + k, lit);
+        BinnedOptions o;
+        o.bins_per_side = 1 + static_cast<uint32_t>(rng.uniform() * 12);
+        expect_finite_everywhere(
+            BinnedEnvMap(plain_map(image, mapping), o), k,
+            "sparse map " + std::to_string(k) + " (" + std::to_string(w) + " wide, lit " + std::to_string(lit) + ")");
+    }
+}
+
+TEST(Binned, PicksFollowTheBilinearWeightsWhichChangeWithoutSteps) {
+    const uint32_t g = 11;
+    Rng rng(5);
+    for (int i = 0; i < 20000; ++i) {
+        const float s = rng.uniform(), t = rng.uniform();
+        const BinBlend a = normal_blend(octahedral_normal(s, t), g);
+        float sum = 0;
+        for (float w : a.weight) {
+            ASSERT_GE(w, 0.0f);
+            sum += w;
+        }
+        ASSERT_NEAR(sum, 1.0f, 1e-5f);
+        // A normal a hair away gives each bin nearly the same weight: no steps.
+        const BinBlend b = normal_blend(octahedral_normal(std::min(s + 1e-4f, 1.0f), t), g);
+        for (int k = 0; k < 4; ++k) {
+            float wb = 0;
+            for (int j = 0; j < 4; ++j)
+                if (b.bin[j] == a.bin[k]) wb += b.weight[j];
+            float wa = 0;
+            for (int j = 0; j < 4; ++j)
+                if (a.bin[j] == a.bin[k]) wa += a.weight[j];
+            ASSERT_NEAR(wa, wb, 0.02f) << s << "," << t << " bin " << a.bin[k];
+        }
+    }
+    // At a bin centre the bin alone; the pick of every choice is a bin of positive weight.
+    const BinBlend centre = normal_blend(octahedral_normal(5.5f / g, 5.5f / g), g);
+    EXPECT_EQ(pick_bin(centre, 0.999f), 5 * g + 5);
+    const BinBlend border = normal_blend(octahedral_normal(6.0f / g, 5.5f / g), g);
+    EXPECT_EQ(pick_bin(border, 0.25f), 5 * g + 5);
+    EXPECT_EQ(pick_bin(border, 0.75f), 5 * g + 6);
+    // Across the octahedral map's fold (s = 1), the bin beyond is the edge column's mirror.
+    const BinBlend fold = normal_blend(octahedral_normal(0.999f, 2.5f / g), g);
+    EXPECT_EQ(fold.bin[0], 2 * g + g - 1);
+    EXPECT_EQ(fold.bin[1], (g - 1 - 2) * g + g - 1);
 }
 
 TEST(Binned, RejectsCompensatedMapsAndInvalidOptionsAndLayouts) {

@@ -528,9 +528,10 @@ void expect_identical_binned_samples(const BinnedEnvMap& expected, const BinnedE
         const Vec3 normal = octahedral_normal(rng.uniform(), rng.uniform());
         const uint32_t lobe = static_cast<uint32_t>(i) % expected.classes();
         const Vec2 u = rng.uniform2();
-        const EnvSample x = a.sample(normal, lobe, u), y = b.sample(normal, lobe, u);
+        const float c = rng.uniform();
+        const EnvSample x = a.sample(normal, lobe, c, u), y = b.sample(normal, lobe, c, u);
         ASSERT_EQ(std::memcmp(&x, &y, sizeof x), 0) << "sample " << i;
-        ASSERT_EQ(a.pdf(normal, lobe, x.direction), b.pdf(normal, lobe, x.direction));
+        ASSERT_EQ(a.pdf(normal, lobe, c, x.direction), b.pdf(normal, lobe, c, x.direction));
     }
 }
 

@@ -94,11 +94,26 @@ Geometry::Geometry(const CellGrid& grid, uint32_t g) {
             bin_radius[b] = square_radius(bin_normal[b], static_cast<double>(s) / g, (s + 1.0) / g,
                                           static_cast<double>(t) / g, (t + 1.0) / g, octahedral_normal);
         }
+    // Within a neighbour's radius of its centre, so within the angle to that centre plus
+    // its radius of this one's (triangle inequality).
+    support_radius.resize(bin_normal.size());
+    for (uint32_t b = 0; b < bin_normal.size(); ++b) {
+        const int s = static_cast<int>(b % g), t = static_cast<int>(b / g);
+        float radius = bin_radius[b];
+        for (int dt = -1; dt <= 1; ++dt)
+            for (int ds = -1; ds <= 1; ++ds) {
+                const uint32_t nb = wrapped_bin(s + ds, t + dt, g);
+                const double angle =
+                    std::acos(std::clamp(static_cast<double>(dot(bin_normal[b], bin_normal[nb])), -1.0, 1.0));
+                radius = std::max(radius, static_cast<float>(angle + bin_radius[nb] + 1e-5));
+            }
+        support_radius[b] = radius;
+    }
 }
 
 float Geometry::bound(uint32_t bin, size_t cell) const noexcept {
     const float angle = std::acos(std::clamp(dot(bin_normal[bin], cell_direction[cell]), -1.0f, 1.0f)) -
-                        bin_radius[bin] - cell_radius[cell];
+                        support_radius[bin] - cell_radius[cell];
     if (angle <= 0) return 1;
     return angle >= kPiF / 2 ? 0.0f : std::cos(angle);
 }
@@ -274,8 +289,8 @@ struct Located {
     Vec2 uv;
 };
 
-Located locate(const BinnedEnvMapView& env, uint32_t lobe, Vec3 normal, Vec3 direction) noexcept {
-    const Located at{env.bin(normal, lobe), env.plain.uv_of(direction)};
+Located locate(const BinnedEnvMapView& env, uint32_t lobe, Vec3 axis, float choice, Vec3 direction) noexcept {
+    const Located at{env.bin(axis, lobe, choice), env.plain.uv_of(direction)};
     const Distribution2DView& d = env.plain.distribution;
     const uint32_t x = detail::cell_of(at.uv.x, d.w), y = detail::cell_of(at.uv.y, d.h);
     const uint32_t cx = env.cell_column(x), cy = env.cell_row(y);
@@ -294,12 +309,12 @@ Located locate(const BinnedEnvMapView& env, uint32_t lobe, Vec3 normal, Vec3 dir
 // and its data prefetched 32 directions before its pdf is computed from them, so that
 // the misses of 32 directions are in flight at once. Bit-identical to BinView::lookup,
 // whose functions it calls.
-void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays normals, DirectionArrays in,
-                 LookupArrays out, uint32_t n) noexcept {
+void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axes, const float* choices,
+                 DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
     detail::pipelined<32>(
         0, n,
         [&](uint32_t i) noexcept {
-            return locate(env, lobe, {normals.x[i], normals.y[i], normals.z[i]}, {in.x[i], in.y[i], in.z[i]});
+            return locate(env, lobe, {axes.x[i], axes.y[i], axes.z[i]}, choices[i], {in.x[i], in.y[i], in.z[i]});
         },
         [&](const Located& l, uint32_t i) noexcept {
             const Rgb c = env.plain.eval_uv(l.uv);
@@ -312,8 +327,8 @@ void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays nor
 // stage prefetching what the next loads, so that the misses of a block's samples overlap
 // instead of each sample waiting on its chain of dependent loads. The stages are the
 // single call's own functions, so the results are bit-identical to it.
-void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays normals, PointArrays in, SampleArrays out,
-                 uint32_t n) noexcept {
+void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axes, const float* choices, PointArrays in,
+                 SampleArrays out, uint32_t n) noexcept {
     constexpr uint32_t kBlock = 16;
     BinView bins[kBlock];
     BinView::Cell cells[kBlock];
@@ -323,7 +338,7 @@ void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays nor
         const uint32_t m = std::min(kBlock, n - first);
         for (uint32_t j = 0; j < m; ++j) {
             const uint32_t i = first + j;
-            bins[j] = env.bin({normals.x[i], normals.y[i], normals.z[i]}, lobe);
+            bins[j] = env.bin({axes.x[i], axes.y[i], axes.z[i]}, lobe, choices[i]);
             const CdfView& c = bins[j].cells;
             const uint32_t k = c.bucket(in.x[i]);
             ENVMIS_PREFETCH(c.guide + k);

@@ -198,11 +198,24 @@ std::vector<double> probabilities(std::vector<double> mass) {
     return mass;
 }
 
-// Normals of a bin the choice looks at: its centre and four points halfway to its corners.
-std::vector<Vec3> bin_samples(uint32_t bin, uint32_t g) {
-    const float s = (bin % g + 0.5f) / g, t = (bin / g + 0.5f) / g, d = 0.25f / g;
-    return {octahedral_normal(s, t), octahedral_normal(s - d, t - d), octahedral_normal(s + d, t - d),
-            octahedral_normal(s - d, t + d), octahedral_normal(s + d, t + d)};
+// Normals the choice weighs a bin's candidates at: a 3 x 3 grid over its blend support
+// (the bin's centre, and halfway to its eight neighbours' centres, wrapped over the
+// octahedral map's folds), each with the blend weight a normal there gives the bin.
+struct WeightedNormal {
+    Vec3 normal;
+    double weight;
+};
+std::vector<WeightedNormal> bin_samples(uint32_t bin, uint32_t g) {
+    std::vector<WeightedNormal> samples;
+    for (int dt = -1; dt <= 1; ++dt)
+        for (int ds = -1; ds <= 1; ++ds) {
+            double s = (bin % g + 0.5 + 0.5 * ds) / g, t = (bin / g + 0.5 + 0.5 * dt) / g;
+            if (s < 0 || s > 1) s = s < 0 ? -s : 2 - s, t = 1 - t;
+            if (t < 0 || t > 1) t = t < 0 ? -t : 2 - t, s = 1 - s;
+            const double weight = (ds == 0 ? 1 : 0.5) * (dt == 0 ? 1 : 0.5);
+            samples.push_back({octahedral_normal(static_cast<float>(s), static_cast<float>(t)), weight});
+        }
+    return samples;
 }
 
 }  // namespace
@@ -238,12 +251,13 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
             }
             for (uint32_t cls = 0; cls < classes; ++cls) {
                 std::vector<double> log_ratio(alphas.size(), 0);
-                for (Vec3 normal : bin_samples(b, options.bins_per_side)) {
-                    const Lobe lobe = lobe_at(nodes, normal, options.lobe_exponents[cls]);
+                for (const WeightedNormal& at : bin_samples(b, options.bins_per_side)) {
+                    const Lobe lobe = lobe_at(nodes, at.normal, options.lobe_exponents[cls]);
                     const double base = mis_variance(nodes, lobe, plain_p, hist.total_l);
                     for (size_t j = 0; j < alphas.size(); ++j) {
                         const double v = p[j].empty() ? 0 : mis_variance(nodes, lobe, p[j], hist.total_l);
-                        if (base > 0) log_ratio[j] += v > 0 ? std::log(v / base) : (p[j].empty() ? 1e9 : 0);
+                        if (base > 0)
+                            log_ratio[j] += at.weight * (v > 0 ? std::log(v / base) : (p[j].empty() ? 1e9 : 0));
                     }
                 }
                 const size_t best = std::min_element(log_ratio.begin(), log_ratio.end()) - log_ratio.begin();

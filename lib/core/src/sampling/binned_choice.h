@@ -20,13 +20,15 @@ struct CellGrid {
     CellGrid(uint32_t w, uint32_t h, uint32_t columns, uint32_t rows, Mapping mapping);
 };
 
-// Canonical directions and angular radii (upper bounds) of the cells and the bins.
+// Canonical directions and angular radii (upper bounds) of the cells and the bins: a
+// bin's own square, and its blend support (normal_blend: the normals that may pick it,
+// those of its own and its eight neighbours' squares).
 struct Geometry {
     std::vector<Vec3> cell_direction, bin_normal;
-    std::vector<float> cell_radius, bin_radius;
+    std::vector<float> cell_radius, bin_radius, support_radius;
 
     Geometry(const CellGrid& grid, uint32_t bins_per_side);
-    // c_b: an upper bound of cos+(omega . n) for omega in the cell and n in the bin.
+    // c_b: an upper bound of cos+(omega . n) for omega in the cell and n in the bin's support.
     float bound(uint32_t bin, size_t cell) const noexcept;
     // The cosine factor a bin's cell masses carry: > 0 exactly where bound() is.
     float weight(uint32_t bin, size_t cell) const noexcept;

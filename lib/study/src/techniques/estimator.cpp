@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <type_traits>
 
 #include "envmis/cpu.h"
 #include "envmis/study/shading/frame.h"
@@ -109,29 +110,43 @@ float fixed_weight(const Technique& t, const float* q, int k) noexcept {
 }
 
 // The lanes' batch sampling and lookups: the map's batch functions, or single calls for
-// a bin (one point's density, which the batch functions' layout does not cover).
+// bins (one per estimate: BinLanes below).
 void sample_lanes(const EnvMapView& env, PointArrays u, SampleArrays out, uint32_t n) noexcept {
     sample_many(env, u, out, n);
-}
-void sample_lanes(const BinView& env, PointArrays u, SampleArrays out, uint32_t n) noexcept {
-    for (uint32_t l = 0; l < n; ++l) {
-        const EnvSample e = env.sample({u.x[l], u.y[l]});
-        out.x[l] = e.direction.x, out.y[l] = e.direction.y, out.z[l] = e.direction.z, out.pdf[l] = e.pdf;
-        out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b;
-    }
 }
 void lookup_lanes(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
     lookup_many(env, in, out, n);
 }
-void lookup_lanes(const BinView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
+
+// Estimates side by side, for the fixed-weight techniques over one density (or one
+// bin per estimate).
+constexpr uint32_t kLanes = 32;
+
+// The bins of the lanes' estimates at one point: each estimate picks its own among the
+// bins around the point's axis (BinnedEnvMapView::bin) with its first random number,
+// as a single estimate does, then samples and weighs with it alone.
+struct BinLanes {
+    const BinnedEnvMapView* map;
+    Vec3 axis;
+    uint32_t lobe;
+    mutable BinView bins[kLanes];
+
+    void pick(uint32_t lane, float choice) const noexcept { bins[lane] = map->bin(axis, lobe, choice); }
+};
+void sample_lanes(const BinLanes& env, PointArrays u, SampleArrays out, uint32_t n) noexcept {
     for (uint32_t l = 0; l < n; ++l) {
-        const EnvMapView::Lookup e = env.lookup({in.x[l], in.y[l], in.z[l]});
+        const EnvSample e = env.bins[l].sample({u.x[l], u.y[l]});
+        out.x[l] = e.direction.x, out.y[l] = e.direction.y, out.z[l] = e.direction.z, out.pdf[l] = e.pdf;
+        out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b;
+    }
+}
+void lookup_lanes(const BinLanes& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
+    for (uint32_t l = 0; l < n; ++l) {
+        const EnvMapView::Lookup e = env.bins[l].lookup({in.x[l], in.y[l], in.z[l]});
         out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b, out.pdf[l] = e.pdf;
     }
 }
 
-// Estimates side by side, for the fixed-weight techniques over one density.
-constexpr uint32_t kLanes = 32;
 constexpr uint32_t kMaxLaneSamples = 8;  // per estimate; estimates that spend more go one at a time
 
 bool runs_in_lanes(const Technique& t, const Allocation& a) noexcept {
@@ -168,10 +183,14 @@ template <uint32_t kMaxLanes, BsdfKind K, class Env>
     const uint32_t padded = lanes;
 #endif
     float u_x[kMaxLaneSamples][kMaxLanes], u_y[kMaxLaneSamples][kMaxLanes];
-    for (uint32_t l = 0; l < lanes; ++l)
+    for (uint32_t l = 0; l < lanes; ++l) {
+        if constexpr (std::is_same_v<Env, BinLanes>) env.pick(l, rng.uniform());
         for (uint32_t j = 0; j < n_env + n_bsdf; ++j) u_x[j][l] = rng.uniform(), u_y[j][l] = rng.uniform();
+    }
     for (uint32_t j = 0; j < n_env + n_bsdf; ++j)
         for (uint32_t l = lanes; l < padded; ++l) u_x[j][l] = u_y[j][l] = 0.5f;
+    if constexpr (std::is_same_v<Env, BinLanes>)
+        for (uint32_t l = lanes; l < padded; ++l) env.bins[l] = env.bins[0];
     // The environment technique's directions (world frame), densities and radiance; the
     // BSDF's densities and values (f cos) at the same directions.
     float x[kMaxLanes], y[kMaxLanes], z[kMaxLanes], pdf[kMaxLanes], r[kMaxLanes], g[kMaxLanes], bl[kMaxLanes];
@@ -328,14 +347,14 @@ DirectLightingEstimator::DirectLightingEstimator(const BinnedEnvMap& binned, Tec
         throw std::invalid_argument(technique.name() + " does not sample a binned map (expected mis-*-bins)");
 }
 
-BinView DirectLightingEstimator::bin_of(const ShadingPoint& point, const Bsdf& bsdf) const noexcept {
+BinView DirectLightingEstimator::bin_of(const ShadingPoint& point, const Bsdf& bsdf, float choice) const noexcept {
     const uint32_t lobe = binned_->lobe_class(bsdf.phong_exponent());
-    return binned_view_.bin(lobe_axis(lobe, point.normal, point.wo), lobe);
+    return binned_view_.bin(lobe_axis(lobe, point.normal, point.wo), lobe, choice);
 }
 
 Rgb DirectLightingEstimator::estimate(const ShadingPoint& point, const Bsdf& bsdf, Pcg32& rng,
                                       PointState& state) const noexcept {
-    if (technique_.bins) return estimate_with(bin_of(point, bsdf), point, bsdf, rng, state);
+    if (technique_.bins) return estimate_with(bin_of(point, bsdf, rng.uniform()), point, bsdf, rng, state);
     return estimate_with(env_, point, bsdf, rng, state);
 }
 
@@ -447,10 +466,12 @@ void DirectLightingEstimator::estimate(const ShadingPoint& point, const Bsdf& bs
             estimate_lanes<kLanes>(env, technique_, allocation_, frame, wo, bsdf, rng,
                                    out.subspan(first, std::min<size_t>(kLanes, out.size() - first)));
     };
-    if (technique_.bins)
-        run(bin_of(point, bsdf));
-    else
+    if (technique_.bins) {
+        const uint32_t lobe = binned_->lobe_class(bsdf.phong_exponent());
+        run(BinLanes{&binned_view_, lobe_axis(lobe, point.normal, point.wo), lobe, {}});
+    } else {
         run(env_);
+    }
 }
 
 }  // namespace envmis

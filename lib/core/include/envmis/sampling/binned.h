@@ -69,17 +69,65 @@
 
 namespace envmis {
 
-// Octahedral grid of normals: the bin (of g x g) of a unit vector in the canonical
-// frame. A zero or non-finite vector gets bin 0.
-ENVMIS_HD inline uint32_t normal_bin(Vec3 n, uint32_t g) noexcept {
+// Point (s, t) in [0,1]^2 of a unit vector (canonical frame) on the octahedral map of
+// normals; a zero or non-finite vector gets (0, 0).
+ENVMIS_HD inline Vec2 octahedral_point(Vec3 n) noexcept {
     const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
-    if (!(l1 > 0 && l1 <= 0x1.fffffep127f)) return 0;
+    if (!(l1 > 0 && l1 <= 0x1.fffffep127f)) return {0, 0};
     float u = n.x / l1, v = n.y / l1;
     if (n.z < 0) {
         const float fu = (1 - std::abs(v)) * (u < 0 ? -1.0f : 1.0f), fv = (1 - std::abs(u)) * (v < 0 ? -1.0f : 1.0f);
         u = fu, v = fv;
     }
-    return detail::cell_of(0.5f * (v + 1), g) * g + detail::cell_of(0.5f * (u + 1), g);
+    return {0.5f * (u + 1), 0.5f * (v + 1)};
+}
+
+// Octahedral grid of normals: the bin (of g x g) of a unit vector in the canonical
+// frame, the one whose square holds it. A zero or non-finite vector gets bin 0.
+ENVMIS_HD inline uint32_t normal_bin(Vec3 n, uint32_t g) noexcept {
+    const Vec2 p = octahedral_point(n);
+    return detail::cell_of(p.y, g) * g + detail::cell_of(p.x, g);
+}
+
+// The bin at grid position (i, j), one step outside the grid allowed: the octahedral
+// map continues across each edge point-mirrored ((s, t) beyond s = 1 is (2 - s, 1 - t)),
+// so a column outside is the edge column with its rows reversed, and so on.
+ENVMIS_HD inline uint32_t wrapped_bin(int i, int j, uint32_t g) noexcept {
+    const int n = static_cast<int>(g);
+    if (i < 0 || i >= n) i = i < 0 ? 0 : n - 1, j = n - 1 - j;
+    if (j < 0 || j >= n) j = j < 0 ? 0 : n - 1, i = n - 1 - i;
+    return static_cast<uint32_t>(j) * g + static_cast<uint32_t>(i);
+}
+
+// Blending (seams): the four bins around a normal with bilinear weights over the grid of
+// bin centres (wrapped over the folds), continuous in the normal; weights sum to 1. A
+// shading point takes bin k with probability weight[k] (pick_bin), so that what it
+// samples, and the variance it gets (the weights' mixture of the bins' variances), change
+// without steps as its normal crosses a bin border. The pick must serve both the light
+// sample and the MIS weight of the BSDF sample: each pick then makes an ordinary
+// two-technique MIS estimator, unbiased, and so is their mixture.
+struct BinBlend {
+    uint32_t bin[4];
+    float weight[4];
+};
+ENVMIS_HD inline BinBlend normal_blend(Vec3 n, uint32_t g) noexcept {
+    const Vec2 p = octahedral_point(n);
+    const float a = p.x * static_cast<float>(g) - 0.5f, b = p.y * static_cast<float>(g) - 0.5f;
+    const float fa = std::floor(a), fb = std::floor(b), wa = a - fa, wb = b - fb;
+    const int i = static_cast<int>(fa), j = static_cast<int>(fb);
+    return {{wrapped_bin(i, j, g), wrapped_bin(i + 1, j, g), wrapped_bin(i, j + 1, g), wrapped_bin(i + 1, j + 1, g)},
+            {(1 - wa) * (1 - wb), wa * (1 - wb), (1 - wa) * wb, wa * wb}};
+}
+// The bin a uniform `choice` in [0,1) picks: the first whose running sum of weights
+// exceeds it (a bin of weight 0 never).
+ENVMIS_HD inline uint32_t pick_bin(const BinBlend& blend, float choice) noexcept {
+    uint32_t bin = blend.bin[0];
+    float sum = blend.weight[0];
+    for (int k = 1; k < 4; ++k) {
+        bin = choice >= sum && blend.weight[k] > 0 ? blend.bin[k] : bin;
+        sum += blend.weight[k];
+    }
+    return bin;
 }
 
 // Canonical unit normal at point (s, t) in [0,1]^2 of the octahedral map of normals.
@@ -191,24 +239,32 @@ struct BinnedEnvMapView {
     const uint32_t* row_edges = nullptr;     // cells_h + 1 texel rows
     uint32_t cells_w = 0, cells_h = 0, bins_per_side = 0, bins = 0, classes = 0;
 
-    // The density that normal (world frame) picks for lobe class `lobe`.
-    ENVMIS_HD BinView bin(Vec3 normal, uint32_t lobe) const noexcept {
-        const uint32_t b = normal_bin(to_canonical(plain.axes, normal), bins_per_side);
-        return bin_at(min(lobe, classes - 1) * bins + b);
+    // The density a shading point samples in lobe class `lobe`: among the bins around
+    // `axis` (world frame; lobe_axis), the one a uniform `choice` in [0,1) picks
+    // (normal_blend). A renderer draws `choice` once per shading point and keeps the
+    // returned view for its light samples and its BSDF samples' MIS weights alike.
+    ENVMIS_HD BinView bin(Vec3 axis, uint32_t lobe, float choice) const noexcept {
+        const uint32_t b = pick_bin(normal_blend(to_canonical(plain.axes, axis), bins_per_side), choice);
+        return bin_at(class_bin(lobe, b));
     }
+    // The bin whose square holds `axis`, without blending (for showing one bin's density).
+    ENVMIS_HD BinView nearest_bin(Vec3 axis, uint32_t lobe) const noexcept {
+        return bin_at(class_bin(lobe, normal_bin(to_canonical(plain.axes, axis), bins_per_side)));
+    }
+    ENVMIS_HD uint32_t class_bin(uint32_t lobe, uint32_t b) const noexcept { return min(lobe, classes - 1) * bins + b; }
     ENVMIS_HD BinView bin_at(uint32_t class_bin) const noexcept {
         const uint32_t cells = cells_w * cells_h;
         const size_t at = size_t{class_bin} * cells;
         return {this, {cell_start + at, cell_guide + at, cells}};
     }
-    ENVMIS_HD EnvSample sample(Vec3 normal, uint32_t lobe, Vec2 u) const noexcept {
-        return bin(normal, lobe).sample(u);
+    ENVMIS_HD EnvSample sample(Vec3 axis, uint32_t lobe, float choice, Vec2 u) const noexcept {
+        return bin(axis, lobe, choice).sample(u);
     }
-    ENVMIS_HD float pdf(Vec3 normal, uint32_t lobe, Vec3 direction) const noexcept {
-        return bin(normal, lobe).pdf(direction);
+    ENVMIS_HD float pdf(Vec3 axis, uint32_t lobe, float choice, Vec3 direction) const noexcept {
+        return bin(axis, lobe, choice).pdf(direction);
     }
-    ENVMIS_HD EnvMapView::Lookup lookup(Vec3 normal, uint32_t lobe, Vec3 direction) const noexcept {
-        return bin(normal, lobe).lookup(direction);
+    ENVMIS_HD EnvMapView::Lookup lookup(Vec3 axis, uint32_t lobe, float choice, Vec3 direction) const noexcept {
+        return bin(axis, lobe, choice).lookup(direction);
     }
     ENVMIS_HD Rgb eval(Vec3 direction) const noexcept { return plain.eval(direction); }
 
@@ -233,18 +289,20 @@ struct BinnedEnvMapView {
         const uint32_t x1 = column_edges[cx + 1];
         const uint32_t segment = (x1 < row.n ? row.start[x1] : kCdfUnits) - row.start[column_edges[cx]];
         const float texels = static_cast<float>(uint64_t{plain.distribution.w} * plain.distribution.h);
+        // A black segment (0 of the plain row's mass) holds only texels of width 0: its
+        // density is 0, and max(segment, 1) keeps 0 / 0 from making it NaN.
         return static_cast<float>(cell_width) * static_cast<float>(row_width) * 0x1p-62f *
-               (static_cast<float>(row.width(x)) / static_cast<float>(segment)) * texels;
+               (static_cast<float>(row.width(x)) / static_cast<float>(max(segment, 1u))) * texels;
     }
 };
 
-// Both for n (normal, direction) pairs at once, one array per world coordinate: the
-// batch forms of BinnedEnvMapView::lookup and sample, bit-identical to n single calls.
-// Host only; noexcept and allocation-free.
-void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays normals, DirectionArrays in,
-                 LookupArrays out, uint32_t n) noexcept;
-void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays normals, PointArrays in, SampleArrays out,
-                 uint32_t n) noexcept;
+// Both for n (axis, choice, direction or point) at once, one array per world coordinate:
+// the batch forms of BinnedEnvMapView::lookup and sample, bit-identical to n single
+// calls. Host only; noexcept and allocation-free.
+void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axes, const float* choices,
+                 DirectionArrays in, LookupArrays out, uint32_t n) noexcept;
+void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axes, const float* choices, PointArrays in,
+                 SampleArrays out, uint32_t n) noexcept;
 
 class BinnedEnvMap {
 public:

@@ -42,8 +42,10 @@ QuadratureResult reflected_radiance(const EnvMap& map, const Bsdf& bsdf, const S
 // and for the mixture (it samples two maps).
 double exact_variance(const EnvMap& env, Technique technique, Allocation allocation, const Bsdf& bsdf,
                       const ShadingPoint& point, int subdivisions);
-// The same for a -bins technique: the environment density is the bin that the point's
-// normal and the BSDF's lobe class pick, the radiance the binned map's plain one.
+// The same for a -bins technique: the environment density is a bin around the point's
+// lobe axis in the BSDF's lobe class, picked at random with the blend's weights
+// (binned.h), so the variance is the weights' sum of the bins' variances; the radiance
+// the binned map's plain one.
 double exact_variance(const BinnedEnvMap& binned, Technique technique, Allocation allocation, const Bsdf& bsdf,
                       const ShadingPoint& point, int subdivisions);
 

@@ -23,10 +23,11 @@
 // alone is biased, so an environment-only technique over an incomplete map is refused
 // at construction. Under MIS the BSDF technique covers what it leaves out.
 //
-// The -bins techniques sample a normal-aware density (sampling/binned.h): per estimate
-// call, the shading point's normal and the BSDF's lobe class pick one bin, whose density
-// both draws the environment samples and weighs the BSDF samples, so the MIS weights
-// match what was drawn.
+// The -bins techniques sample a normal-aware density (sampling/binned.h): per estimate,
+// its first random number picks one of the bins around the shading point's lobe axis
+// (blending, binned.h), in the BSDF's lobe class; that bin's density both draws the
+// environment samples and weighs the BSDF samples, so the MIS weights match what was
+// drawn.
 #pragma once
 
 #include <cstdint>
@@ -153,7 +154,8 @@ private:
     template <class Env>
     Rgb estimate_with(const Env& env, const ShadingPoint& point, const Bsdf& bsdf, Pcg32& rng,
                       PointState& state) const noexcept;
-    BinView bin_of(const ShadingPoint& point, const Bsdf& bsdf) const noexcept;
+    // The bin `choice` (uniform in [0,1)) picks for the point and the BSDF's lobe class.
+    BinView bin_of(const ShadingPoint& point, const Bsdf& bsdf, float choice) const noexcept;
 
     EnvMapView env_;    // the sampled density
     EnvMapView other_;  // the plain density, which the mixture also samples
