@@ -94,21 +94,15 @@ Geometry::Geometry(const CellGrid& grid, uint32_t g) {
             bin_radius[b] = square_radius(bin_normal[b], static_cast<double>(s) / g, (s + 1.0) / g,
                                           static_cast<double>(t) / g, (t + 1.0) / g, octahedral_normal);
         }
-    // Within a neighbour's radius of its centre, so within the angle to that centre plus
-    // its radius of this one's (triangle inequality).
+    // The blend support: the bin's square widened by half the blend's ramp on each side,
+    // its points beyond the map's edges taken across the folds.
     support_radius.resize(bin_normal.size());
-    for (uint32_t b = 0; b < bin_normal.size(); ++b) {
-        const int s = static_cast<int>(b % g), t = static_cast<int>(b / g);
-        float radius = bin_radius[b];
-        for (int dt = -1; dt <= 1; ++dt)
-            for (int ds = -1; ds <= 1; ++ds) {
-                const uint32_t nb = wrapped_bin(s + ds, t + dt, g);
-                const double angle =
-                    std::acos(std::clamp(static_cast<double>(dot(bin_normal[b], bin_normal[nb])), -1.0, 1.0));
-                radius = std::max(radius, static_cast<float>(angle + bin_radius[nb] + 1e-5));
-            }
-        support_radius[b] = radius;
-    }
+    const double e = 0.5 * kBlendWidth / g;
+    for (uint32_t t = 0; t < g; ++t)
+        for (uint32_t s = 0; s < g; ++s)
+            support_radius[size_t{t} * g + s] =
+                square_radius(bin_normal[size_t{t} * g + s], s * 1.0 / g - e, (s + 1.0) / g + e, t * 1.0 / g - e,
+                              (t + 1.0) / g + e, [](float u, float v) { return folded_octahedral_normal(u, v); });
 }
 
 float Geometry::bound(uint32_t bin, size_t cell) const noexcept {

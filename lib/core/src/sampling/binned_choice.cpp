@@ -199,8 +199,8 @@ std::vector<double> probabilities(std::vector<double> mass) {
 }
 
 // Normals the choice weighs a bin's candidates at: a 3 x 3 grid over its blend support
-// (the bin's centre, and halfway to its eight neighbours' centres, wrapped over the
-// octahedral map's folds), each with the blend weight a normal there gives the bin.
+// (the bin's centre, and its borders' middles and corners, across the octahedral map's
+// folds), each with the blend weight a normal there gives the bin.
 struct WeightedNormal {
     Vec3 normal;
     double weight;
@@ -209,11 +209,9 @@ std::vector<WeightedNormal> bin_samples(uint32_t bin, uint32_t g) {
     std::vector<WeightedNormal> samples;
     for (int dt = -1; dt <= 1; ++dt)
         for (int ds = -1; ds <= 1; ++ds) {
-            double s = (bin % g + 0.5 + 0.5 * ds) / g, t = (bin / g + 0.5 + 0.5 * dt) / g;
-            if (s < 0 || s > 1) s = s < 0 ? -s : 2 - s, t = 1 - t;
-            if (t < 0 || t > 1) t = t < 0 ? -t : 2 - t, s = 1 - s;
+            const double s = (bin % g + 0.5 + 0.5 * ds) / g, t = (bin / g + 0.5 + 0.5 * dt) / g;
             const double weight = (ds == 0 ? 1 : 0.5) * (dt == 0 ? 1 : 0.5);
-            samples.push_back({octahedral_normal(static_cast<float>(s), static_cast<float>(t)), weight});
+            samples.push_back({folded_octahedral_normal(static_cast<float>(s), static_cast<float>(t)), weight});
         }
     return samples;
 }

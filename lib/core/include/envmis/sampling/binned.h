@@ -13,9 +13,9 @@
 // cell's centre to n_b, less half the bin's angular radius (a typical normal of the bin,
 // not its most favourable one: 5.8x instead of 3.8x lower Lambert variance than plain
 // balance MIS on rooitou_park, exact), and at least a tenth of a conservative bound
-// (the angle less both angular radii, 0 beyond 90 degrees). So the density is > 0
-// wherever any normal of the bin sees compensated light, and 0 on cells that no normal
-// of the bin sees.
+// (the angle less the cell's radius and that of the normals that may pick the bin, its
+// blend support; 0 beyond 90 degrees). So the density is > 0 wherever any normal that
+// may pick the bin sees compensated light, and 0 on cells that none of them sees.
 //
 // Representation (what keeps it small): the map is cut into a coarse grid of cells
 // (BinLayout; 32 x 16 for a 1k map, at most 128 x 64); each bin holds only
@@ -34,10 +34,20 @@
 // compensation), so each bin holds one cell table per lobe class (by default diffuse,
 // Phong 20 and Phong 200), and a shading point picks the class nearest its BSDF's
 // sharpness (lobe_class). alpha_b is chosen per bin and class at build time: the exact
-// variance of 1 + 1 balance MIS, view along the normal, at five normals of the bin, on
-// a 64-column copy of the map (texels grouped inside cells), over that of the plain
-// density; the candidate with the lowest geometric mean wins, and the plain density
-// (alpha < 0 in BinChoice) where no candidate is predicted better.
+// variance of 1 + 1 balance MIS, view along the normal, at nine normals of the bin's
+// blend support (weighted as the blend weighs them), on a 64-column copy of the map
+// (texels grouped inside cells), over that of the plain density; the candidate with the
+// lowest weighted geometric mean wins, and the plain density (alpha < 0 in BinChoice)
+// where no candidate is predicted better. docs/table-format.md defines every quantity
+// (centres, radii, bounds, thresholds, the choice, the blend) so that a bin's density
+// can be recomputed independently.
+//
+// Blending: a shading point picks one of the four bins around its normal at random
+// (normal_blend, pick_bin), with weights that ramp over the middle half of the way
+// between bin centres, so what it samples changes without steps across bin borders.
+// Blending over the whole way (bilinear) costs diffuse surfaces much of their gain: on
+// the 14 maps of ../shared/data/envmaps, Lambert variance relative to plain balance MIS
+// 0.21 bilinear, 0.15 over the middle half, 0.13 with no blending (docs/performance.md).
 //
 // Bins: a g x g grid over the octahedral map of normals (K = g^2, 121 by default), so a
 // normal finds its bin in O(1): a few adds, one division, no loop over bins. g is odd by
@@ -47,9 +57,9 @@
 // Walls (+-x, +-y) lie on the border of two bins whose centres are 5 degrees above and
 // below them; -z on a corner.
 //
-// Measure and exactness: as EnvMapView (solid angle, world frame). pdf(n, omega) is the
-// density of the bin that n picks, so the MIS weight of a BSDF sample matches what
-// sample(n, u) would have drawn. A compensated bin is incomplete (pdf 0 where L <= its
+// Measure and exactness: as EnvMapView (solid angle, world frame). pdf(n, choice, omega) is the
+// density of the bin that n and the choice pick, so the MIS weight of a BSDF sample
+// matches what sample(n, choice, u) would have drawn. A compensated bin is incomplete (pdf 0 where L <= its
 // threshold): combine it with BSDF sampling.
 //
 // Cost: sample O(1) (three fixed-point CDF inversions: the bin's cells, the cell's rows,
@@ -57,7 +67,7 @@
 // Memory on top of the plain map: 6 bytes per cell per bin per class, 6 bytes per (cell
 // column, texel row); figures in docs/performance.md. At most 65536 cells (uint16 guide).
 // Build: three passes over the texels (choice nodes, candidate and final cell
-// histograms), then O(K classes cells) work and the choice (0.15 s for a 1k map).
+// histograms), then O(K classes cells) work and the choice (docs/performance.md).
 #pragma once
 
 #include <cstdint>
@@ -106,14 +116,21 @@ ENVMIS_HD inline uint32_t wrapped_bin(int i, int j, uint32_t g) noexcept {
 // without steps as its normal crosses a bin border. The pick must serve both the light
 // sample and the MIS weight of the BSDF sample: each pick then makes an ordinary
 // two-technique MIS estimator, unbiased, and so is their mixture.
+// The weights ramp over the middle kBlendWidth of the way between two bin centres (1:
+// bilinear), so that a normal within (1 - kBlendWidth) / 2 of the spacing from a centre
+// takes that bin alone, the one fitted to it.
+inline constexpr float kBlendWidth = 0.5f;
 struct BinBlend {
     uint32_t bin[4];
     float weight[4];
 };
+ENVMIS_HD inline float blend_ramp(float t) noexcept {
+    return clamp((t - 0.5f) * (1 / kBlendWidth) + 0.5f, 0.0f, 1.0f);
+}
 ENVMIS_HD inline BinBlend normal_blend(Vec3 n, uint32_t g) noexcept {
     const Vec2 p = octahedral_point(n);
     const float a = p.x * static_cast<float>(g) - 0.5f, b = p.y * static_cast<float>(g) - 0.5f;
-    const float fa = std::floor(a), fb = std::floor(b), wa = a - fa, wb = b - fb;
+    const float fa = std::floor(a), fb = std::floor(b), wa = blend_ramp(a - fa), wb = blend_ramp(b - fb);
     const int i = static_cast<int>(fa), j = static_cast<int>(fb);
     return {{wrapped_bin(i, j, g), wrapped_bin(i + 1, j, g), wrapped_bin(i, j + 1, g), wrapped_bin(i + 1, j + 1, g)},
             {(1 - wa) * (1 - wb), wa * (1 - wb), (1 - wa) * wb, wa * wb}};
@@ -139,6 +156,14 @@ ENVMIS_HD inline Vec3 octahedral_normal(float s, float t) noexcept {
         n.y = (1 - std::abs(u)) * (v < 0 ? -1.0f : 1.0f);
     }
     return normalize(n);
+}
+
+// The same for a point up to one square beyond [0,1]^2: the map continues across each
+// edge point-mirrored ((s, t) beyond s = 1 is (2 - s, 1 - t)).
+inline Vec3 folded_octahedral_normal(float s, float t) noexcept {
+    if (s < 0 || s > 1) s = s < 0 ? -s : 2 - s, t = 1 - t;
+    if (t < 0 || t > 1) t = t < 0 ? -t : 2 - t, s = 1 - s;
+    return octahedral_normal(s, t);
 }
 
 // Lobe classes: 0 is diffuse (Lambert); a positive exponent is a Phong lobe that sharp.
