@@ -124,9 +124,7 @@ struct BinBlend {
     uint32_t bin[4];
     float weight[4];
 };
-ENVMIS_HD inline float blend_ramp(float t) noexcept {
-    return clamp((t - 0.5f) * (1 / kBlendWidth) + 0.5f, 0.0f, 1.0f);
-}
+ENVMIS_HD inline float blend_ramp(float t) noexcept { return clamp((t - 0.5f) * (1 / kBlendWidth) + 0.5f, 0.0f, 1.0f); }
 ENVMIS_HD inline BinBlend normal_blend(Vec3 n, uint32_t g) noexcept {
     const Vec2 p = octahedral_point(n);
     const float a = p.x * static_cast<float>(g) - 0.5f, b = p.y * static_cast<float>(g) - 0.5f;
