@@ -112,19 +112,23 @@ float Geometry::bound(uint32_t bin, size_t cell) const noexcept {
     return angle >= kPiF / 2 ? 0.0f : std::cos(angle);
 }
 
-float Geometry::weight(uint32_t bin, size_t cell) const noexcept {
+float Geometry::weight(uint32_t bin, size_t cell, bool glossy) const noexcept {
+    // A glossy class's bin follows the lobe's axis, not the normal: the surface's horizon
+    // may lie anywhere around it, and a microfacet lobe's tails reach past 90 degrees
+    // from it (at grazing views most of all), where a bright source then arrives only
+    // through rare BSDF samples. So no cell of a glossy bin is left out.
+    constexpr float kGlossyFloor = 0.05f;
     const float b = bound(bin, cell);
-    if (b == 0) return 0;
-    // The cosine seen from halfway between the bin's centre and its edge, to the cell's
-    // centre: a typical normal of the bin rather than its most favourable one. On
-    // rooitou_park (exact variance, Lambert, 16 normals) the conservative bound itself
-    // gives 3.8x over mis-balance, this 5.8x; the floor keeps every cell that some
-    // normal of the bin may see positive, as coverage needs.
-    constexpr float kBinShare = 0.5f, kFloor = 0.1f;
+    if (b == 0) return glossy ? kGlossyFloor : 0.0f;
+    // The cosine seen from a quarter of the way from the bin's centre to its edge, to the
+    // cell's centre: a typical normal of the bin rather than its most favourable one
+    // (binned.h gives the figures); the floor keeps every cell that some normal of the
+    // bin may see positive, as coverage needs.
+    constexpr float kBinShare = 0.25f, kFloor = 0.1f;
     const float angle =
         std::acos(std::clamp(dot(bin_normal[bin], cell_direction[cell]), -1.0f, 1.0f)) - kBinShare * bin_radius[bin];
     const float typical = angle <= 0 ? 1.0f : (angle >= kPiF / 2 ? 0.0f : std::cos(angle));
-    return std::max(typical, kFloor * b);
+    return std::max({typical, kFloor * b, glossy ? kGlossyFloor : 0.0f});
 }
 
 }  // namespace detail

@@ -241,13 +241,17 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
     parallel_for(k, 1, stop, [&](uint32_t lo, uint32_t hi) {
         std::vector<double> mass(cells);
         for (uint32_t b = lo; b < hi; ++b) {
-            std::vector<std::vector<double>> p(alphas.size());
-            for (size_t j = 0; j < alphas.size(); ++j) {
-                for (size_t c = 0; c < cells; ++c)
-                    mass[c] = geometry.weight(b, c) * hist.above(c, thresholds[b * alphas.size() + j]);
-                p[j] = probabilities(mass);
+            std::vector<std::vector<double>> kinds[2];  // the candidates' cell probabilities, diffuse and glossy
+            for (int glossy = 0; glossy < 2; ++glossy) {
+                kinds[glossy].resize(alphas.size());
+                for (size_t j = 0; j < alphas.size(); ++j) {
+                    for (size_t c = 0; c < cells; ++c)
+                        mass[c] = geometry.weight(b, c, glossy) * hist.above(c, thresholds[b * alphas.size() + j]);
+                    kinds[glossy][j] = probabilities(mass);
+                }
             }
             for (uint32_t cls = 0; cls < classes; ++cls) {
+                const std::vector<std::vector<double>>& p = kinds[options.lobe_exponents[cls] > 0];
                 std::vector<double> log_ratio(alphas.size(), 0);
                 for (const WeightedNormal& at : bin_samples(b, options.bins_per_side)) {
                     const Lobe lobe = lobe_at(nodes, at.normal, options.lobe_exponents[cls]);
@@ -279,7 +283,8 @@ std::vector<std::vector<float>> bin_masses(const EnvMap& plain, const CellGrid& 
         for (uint32_t cb = lo; cb < hi; ++cb)
             for (size_t c = 0; c < cells; ++c) {
                 const BinChoice& choice = layout.choices[cb];
-                const double bound = choice.plain() ? 1.0 : geometry.weight(static_cast<uint32_t>(cb % k), c);
+                const bool glossy = layout.lobe_exponents[cb / k] > 0;
+                const double bound = choice.plain() ? 1.0 : geometry.weight(static_cast<uint32_t>(cb % k), c, glossy);
                 const double s = hist.above(c, choice.plain() ? 0.0f : choice.threshold);
                 const auto m = static_cast<float>(bound * s);
                 masses[cb][c] = bound > 0 && s > 0 ? std::max(m, std::numeric_limits<float>::min()) : 0.0f;

@@ -30,8 +30,9 @@ struct Geometry {
     Geometry(const CellGrid& grid, uint32_t bins_per_side);
     // c_b: an upper bound of cos+(omega . n) for omega in the cell and n in the bin's support.
     float bound(uint32_t bin, size_t cell) const noexcept;
-    // The cosine factor a bin's cell masses carry: > 0 exactly where bound() is.
-    float weight(uint32_t bin, size_t cell) const noexcept;
+    // The cosine factor a bin's cell masses carry: for the diffuse class > 0 exactly
+    // where bound() is; for a glossy class (`glossy`) > 0 everywhere.
+    float weight(uint32_t bin, size_t cell, bool glossy) const noexcept;
 };
 
 // Thresholds are rounded to the edges of a luminance histogram whose buckets are the

@@ -10,12 +10,17 @@
 //
 // where E_b / pi is the cosine-weighted mean radiance of the hemisphere around the bin's
 // centre normal n_b, and c_b the cosine factor of the cell: that of the angle from the
-// cell's centre to n_b, less half the bin's angular radius (a typical normal of the bin,
-// not its most favourable one: 5.8x instead of 3.8x lower Lambert variance than plain
-// balance MIS on rooitou_park, exact), and at least a tenth of a conservative bound
-// (the angle less the cell's radius and that of the normals that may pick the bin, its
-// blend support; 0 beyond 90 degrees). So the density is > 0 wherever any normal that
-// may pick the bin sees compensated light, and 0 on cells that none of them sees.
+// cell's centre to n_b, less a quarter of the bin's angular radius (a typical normal of
+// the bin rather than its centre: Lambert variance 0.142 of plain balance MIS's over the
+// 14 shared maps, against 0.145 with none and 0.151 with half the radius), and at least
+// a tenth of a conservative bound (the angle less the cell's radius and that of the
+// normals that may pick the bin, its blend support; 0 beyond 90 degrees). So a diffuse
+// bin's density is > 0 wherever any normal that may pick the bin sees compensated light,
+// and 0 on cells that none of them sees. A glossy class's bins follow the lobe's axis,
+// around which the surface's horizon may lie anywhere and a microfacet lobe's tails
+// reach past 90 degrees: their factor is at least 0.05 everywhere (without it GGX 0.3
+// spheres rendered at every view angle had 3.1x the relative MSE of the global table's
+// on rooitou_park, with it 0.77x).
 //
 // Representation (what keeps it small): the map is cut into a coarse grid of cells
 // (BinLayout; 32 x 16 for a 1k map, at most 128 x 64); each bin holds only
