@@ -117,7 +117,7 @@ float Geometry::weight(uint32_t bin, size_t cell, bool glossy) const noexcept {
     // may lie anywhere around it, and a microfacet lobe's tails reach past 90 degrees
     // from it (at grazing views most of all), where a bright source then arrives only
     // through rare BSDF samples. So no cell of a glossy bin is left out.
-    constexpr float kGlossyFloor = 0.05f;
+    constexpr float kGlossyFloor = 0.1f;
     const float b = bound(bin, cell);
     if (b == 0) return glossy ? kGlossyFloor : 0.0f;
     // The cosine seen from a quarter of the way from the bin's centre to its edge, to the
