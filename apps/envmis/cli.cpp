@@ -317,17 +317,19 @@ std::string lobe_name(float exponent) {
 
 // The bins' grids and lobe classes, and per class how many bins chose each alpha.
 void print_bins(std::ostream& out, const BinLayout& layout) {
-    const uint32_t g = layout.bins_per_side, bins = g * g;
-    out << "  bins          " << bins << " (" << g << " x " << g << " octahedral grid of normals), cells "
-        << layout.cell_columns << " x " << layout.cell_rows << ", lobe classes";
+    const uint32_t g = layout.bins_per_side, gd = layout.diffuse_bins_per_side;
+    out << "  bins          " << g * g << " (" << g << " x " << g << " octahedral grid of normals; the diffuse class "
+        << gd * gd << ", " << gd << " x " << gd << "), cells " << layout.cell_columns << " x " << layout.cell_rows
+        << ", lobe classes";
     for (size_t c = 0; c < layout.lobe_exponents.size(); ++c)
         out << (c ? ", " : " ") << lobe_name(layout.lobe_exponents[c]);
     out << "\n";
     for (size_t c = 0; c < layout.lobe_exponents.size(); ++c) {
         // Plain (alpha < 0) sorts first, then the alphas ascending.
         std::map<float, uint32_t> chosen;
-        for (uint32_t b = 0; b < bins && (c * bins + b) < layout.choices.size(); ++b)
-            ++chosen[std::max(layout.choices[c * bins + b].alpha, -1.0f)];
+        const auto cls = static_cast<uint32_t>(c);
+        for (size_t i = layout.first(cls); i < layout.first(cls + 1) && i < layout.choices.size(); ++i)
+            ++chosen[std::max(layout.choices[i].alpha, -1.0f)];
         out << "  bin alphas    " << std::left << std::setw(11) << lobe_name(layout.lobe_exponents[c]) + ":"
             << std::right;
         const char* separator = "";

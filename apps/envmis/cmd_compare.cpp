@@ -401,7 +401,8 @@ std::string header_line(const Setup& s, size_t points_done) {
            << o.allocation.total() << " for single techniques), alpha " << alpha.str() << ", seed " << o.seed
            << ", BSDF albedo " << albedo_text(o.bsdfs);
     if (s.binned)
-        header << ", " << s.binned->bins() << " normal bins (alpha " << (s.bins_auto ? "auto per bin" : "fixed") << ")";
+        header << ", " << s.binned->bins() << " normal bins (" << s.binned->diffuse_bins() << " diffuse; alpha "
+               << (s.bins_auto ? "auto per bin" : "fixed") << ")";
     header << "\n";
     return header.str();
 }

@@ -97,6 +97,7 @@ nlohmann::json table_details(const LoadedMap& loaded, const EnvMap& map, double 
             {"fallback", std::string(to_string(s.fallback))},
             {"complete", map.complete()},
             {"bins", loaded.bins ? loaded.bins->bins_per_side * loaded.bins->bins_per_side : 0},
+            {"diffuse_bins", loaded.bins ? loaded.bins->diffuse_bins_per_side * loaded.bins->diffuse_bins_per_side : 0},
             {"load_ms", loaded.load_ms},
             {"build_ms", loaded.build_ms},
             {"write_ms", write_ms}};

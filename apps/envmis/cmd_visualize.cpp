@@ -96,7 +96,8 @@ std::optional<BinPanel> bin_panel(const VisualizeArgs& args, const LoadedMap& lo
     title.precision(2);
     title << "binned, n=(" << n.x << "," << n.y << "," << n.z << ")";
     description << "binned panel: normal (" << n.x << ", " << n.y << ", " << n.z << "), " << bsdf.name()
-                << " -> lobe class " << lobe << " (Phong " << exponent << "), " << p.binned->bins() << " bins"
+                << " -> lobe class " << lobe << " (Phong " << exponent << "), "
+                << (lobe == 0 ? p.binned->diffuse_bins() : p.binned->bins()) << " bins"
                 << (loaded.bins ? " (the table's)\n" : "\n");
     p.title = title.str();
     p.description = description.str();

@@ -386,7 +386,10 @@ void bind_binned(py::module_& m) {
         .def_property_readonly("plain", &plain_of, docs::kPlain)
         .def_property_readonly("width", [](const BinnedEnvMap& map) { return map.plain().width(); })
         .def_property_readonly("height", [](const BinnedEnvMap& map) { return map.plain().height(); })
-        .def_property_readonly("bins", &BinnedEnvMap::bins, "K = g^2, the bins of normals (a g x g octahedral grid).")
+        .def_property_readonly("bins", &BinnedEnvMap::bins,
+                               "K = g^2, the bins of normals of each glossy class (a g x g octahedral grid).")
+        .def_property_readonly("diffuse_bins", &BinnedEnvMap::diffuse_bins,
+                               "The diffuse class's bins of normals (by default (2 g - 1)^2).")
         .def_property_readonly("classes", &BinnedEnvMap::classes, "The lobe classes (lobe arguments 0 to classes - 1).")
         .def_property_readonly(
             "lobe_exponents", [](const BinnedEnvMap& map) { return map.layout().lobe_exponents; }, docs::kExponents)

@@ -233,7 +233,7 @@ TEST_F(Cli, InfoDescribesATableAndTheImageItCameFrom) {
     ASSERT_EQ(envmis({"precompute", (kBundled / "studio.exr").string(), "-o", "studio.envmis"}).exit_code, 0);
     const Result table = envmis({"info", "studio.envmis"});
     ASSERT_EQ(table.exit_code, 0) << table;
-    EXPECT_TRUE(contains(table.out, "studio.envmis: envmis table, format version 5")) << table;
+    EXPECT_TRUE(contains(table.out, "studio.envmis: envmis table, format version 6")) << table;
     expect_studio_summary(table);
 
     const Result image = envmis({"info", (kBundled / "studio.exr").string()});
@@ -434,11 +434,11 @@ INSTANTIATE_TEST_SUITE_P(
                                  for (char& b : bytes) b = static_cast<char>((x = x * 1664525u + 1013904223u) >> 24);
                                  write_file(p, bytes);
                              }},
-                    BadInput{"TableOfANewerVersion", "newer.envmis", "version 6.*newer",
+                    BadInput{"TableOfANewerVersion", "newer.envmis", "version 7.*newer",
                              [](Cli& t, const fs::path& p) {
                                  // The format version: uint32, little-endian, at byte 8.
                                  t.damaged_table(
-                                     p, [](std::string& bytes) { bytes.replace(8, 4, std::string("\x06\0\0\0", 4)); });
+                                     p, [](std::string& bytes) { bytes.replace(8, 4, std::string("\x07\0\0\0", 4)); });
                              }},
                     BadInput{"Folder", "folder.exr", "directory",
                              [](Cli&, const fs::path& p) { fs::create_directory(p); }}),
@@ -452,7 +452,8 @@ TEST_F(Cli, PrecomputeWithBinsWritesABinnedTableThatInfoDescribes) {
     ASSERT_EQ(r.exit_code, 0) << r;
     EXPECT_EQ(r.err, "") << r;
     for (const char* line :
-         {R"(compensation +per bin)", R"(bins +64 \(8 x 8 octahedral grid of normals\), cells 2 x 1)",
+         {R"(compensation +per bin)",
+          R"(bins +64 \(8 x 8 octahedral grid of normals; the diffuse class 225, 15 x 15\), cells 2 x 1)",
           R"(bin alphas +diffuse: +[0-9]+ )", R"(bin alphas +Phong 200: +[0-9]+ )",
           R"(bins build +[0-9.]+ ms \(choosing alphas [0-9.]+ ms\), [0-9]+ bytes over the plain )"
           R"(map \(\+[0-9.]+%\))"})
@@ -460,14 +461,16 @@ TEST_F(Cli, PrecomputeWithBinsWritesABinnedTableThatInfoDescribes) {
     const Result info = envmis({"info", "binned.envmis"});
     ASSERT_EQ(info.exit_code, 0) << info;
     for (const char* line :
-         {"binned.envmis: envmis table, format version 5", R"(bins +64 \(8 x 8)", R"(bin alphas +Phong 20: )",
+         {"binned.envmis: envmis table, format version 6", R"(bins +64 \(8 x 8)", R"(bin alphas +Phong 20: )",
           R"(bins complete +diffuse (yes|no), Phong 20)",
           R"(bins build +[0-9.]+ ms \(rebuilt from the stored layout\), [0-9]+ bytes over the plain map)"})
         EXPECT_TRUE(contains(info.out, line)) << "missing /" << line << "/" << info;
     const Result fixed = envmis(
         {"precompute", "map.exr", "-o", "fixed.envmis", "--bins", "1", "--no-compensate", "--cell-columns", "4"});
     ASSERT_EQ(fixed.exit_code, 0) << fixed;
-    EXPECT_TRUE(contains(fixed.out, R"(bins +1 \(1 x 1 octahedral grid of normals\), cells 4 x 2)")) << fixed;
+    EXPECT_TRUE(
+        contains(fixed.out, R"(bins +1 \(1 x 1 octahedral grid of normals; the diffuse class 1, 1 x 1\), cells 4 x 2)"))
+        << fixed;
     EXPECT_TRUE(contains(fixed.out, R"(bin alphas +diffuse: +1 alpha 0\n)")) << fixed;
 }
 

@@ -180,7 +180,7 @@ TEST(Compare, BinsTechniquesAreReportedWithTheirExactRatios) {
                                  "--bins 16 --points 3 --spp 256 --bsdf lambert,ggx:0.1 --exact --json r.json "
                                  "--techniques mis-balance,mis-balance-bins,mis-power-bins,mis-optimal-bins");
     ASSERT_EQ(r.exit_code, 0) << r.out;
-    EXPECT_NE(r.out.find("16 normal bins (alpha auto per bin)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("16 normal bins (49 diffuse; alpha auto per bin)"), std::string::npos) << r.out;
     const nlohmann::json results = nlohmann::json::parse(std::ifstream(dir / "r.json"));
     EXPECT_EQ(results["results"].size(), 8u);
     for (const char* bsdf : {"lambert", "ggx:0.1"}) {

@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
         plain.axes = envmis::Axes::parse("y-up");
         envmis::write_table(dir / "uncompensated_16x8.envmis", envmis::EnvMap(sky(16, 8), plain), source);
 
-        // Version 4's bins section, after a full and after a compact payload.
+        // A bins section, after a full and after a compact payload.
         envmis::BinnedOptions bins;
         bins.bins_per_side = 2;
         bins.cell_columns = 4;

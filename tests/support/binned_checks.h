@@ -64,7 +64,7 @@ struct PickedBin {
     float weight;
 };
 inline std::vector<PickedBin> picked_bins(const BinnedEnvMapView& view, Vec3 normal, uint32_t lobe) {
-    const BinBlend blend = normal_blend(to_canonical(view.plain.axes, normal), view.bins_per_side);
+    const BinBlend blend = normal_blend(to_canonical(view.plain.axes, normal), view.side(lobe));
     std::vector<PickedBin> bins;
     for (int k = 0; k < 4; ++k)
         if (blend.weight[k] > 0) bins.push_back({view.bin_at(view.class_bin(lobe, blend.bin[k])), blend.weight[k]});
@@ -128,7 +128,7 @@ inline void expect_samples_follow_pdf(const BinnedEnvMap& binned, Vec3 normal, u
 inline void expect_coverage(const BinnedEnvMap& map, uint32_t lobe) {
     const BinnedEnvMapView view = map.view();
     const EnvMap& plain = map.plain();
-    const uint32_t w = plain.width(), h = plain.height(), g = map.layout().bins_per_side;
+    const uint32_t w = plain.width(), h = plain.height(), g = map.layout().side(lobe);
     const std::vector<float> density = plain.density();
     int checked = 0;
     for (int k = 0; k <= 400; ++k) {  // a sweep across many bin borders
@@ -137,7 +137,7 @@ inline void expect_coverage(const BinnedEnvMap& map, uint32_t lobe) {
         const BinBlend blend = normal_blend(n, g);
         for (int pick = 0; pick < 4; ++pick) {
             if (!(blend.weight[pick] > 0)) continue;
-            const BinChoice& c = map.layout().choices[size_t{lobe} * g * g + blend.bin[pick]];
+            const BinChoice& c = map.layout().choices[map.layout().first(lobe) + blend.bin[pick]];
             const BinView bin = view.bin_at(view.class_bin(lobe, blend.bin[pick]));
             for (uint32_t y = 0; y < h; ++y)
                 for (uint32_t x = 0; x < w; ++x) {

@@ -20,7 +20,9 @@ nlohmann::json inputs_json(const ComparisonInputs& in) {
                         {"albedo", albedo_json(o.bsdfs)}};
     for (size_t b = 0; b < o.bsdfs.size(); ++b) j["bsdf_alpha"][o.bsdfs[b].name()] = in.bsdf_alphas[b];
     if (in.choice) j["alpha_choice"] = alpha_choice_json(*in.choice, o.bsdfs);
-    if (in.binned) j["bins"] = {{"count", in.binned->bins()}, {"alpha_auto", in.bins_auto}};
+    if (in.binned)
+        j["bins"] = {
+            {"count", in.binned->bins()}, {"diffuse_count", in.binned->diffuse_bins()}, {"alpha_auto", in.bins_auto}};
     for (const ShadingPoint& p : in.points_done)
         j["points"].push_back({{"normal", {p.normal.x, p.normal.y, p.normal.z}}, {"view", {p.wo.x, p.wo.y, p.wo.z}}});
     return j;

@@ -27,8 +27,8 @@ TEST(Binned, SamplesFollowTheirPdfForNormalsAtCentresBordersAndPoles) {
     const BinnedEnvMap sun(plain_map(test::sun_sky_map(64, 32)));
     const BinnedEnvMap noise(plain_map(test::random_map(48, 24, 3)));
     uint64_t seed = 1;
-    for (Vec3 n : test_normals(BinnedOptions{}.bins_per_side))
-        for (uint32_t lobe : {0u, 2u}) {
+    for (uint32_t lobe : {0u, 2u})  // each class on its own grid's centres and borders
+        for (Vec3 n : test_normals(sun.layout().side(lobe))) {
             expect_samples_follow_pdf(sun, n, lobe, ++seed);
             expect_samples_follow_pdf(noise, n, lobe, ++seed);
         }
@@ -37,13 +37,13 @@ TEST(Binned, SamplesFollowTheirPdfForNormalsAtCentresBordersAndPoles) {
 TEST(Binned, EqualAreaMapsFollowTheirPdf) {
     const BinnedEnvMap map(plain_map(test::random_map(32, 32, 8), Mapping::equal_area));
     uint64_t seed = 100;
-    for (Vec3 n : test_normals(BinnedOptions{}.bins_per_side)) expect_samples_follow_pdf(map, n, 1, ++seed);
+    for (Vec3 n : test_normals(map.layout().side(1))) expect_samples_follow_pdf(map, n, 1, ++seed);
 }
 
 TEST(Binned, SolidAnglePdfIntegratesToOne) {
     const BinnedEnvMap map(plain_map(test::sun_sky_map(64, 32)));
     const BinnedEnvMapView view = map.view();
-    for (Vec3 n : test_normals(BinnedOptions{}.bins_per_side))
+    for (Vec3 n : test_normals(map.layout().side(0)))
         for (float choice : {0.1f, 0.5f, 0.9f})
             EXPECT_NEAR(test::sphere_integral(256, 512, [&](Vec3 d) { return view.pdf(n, 0, choice, d); }), 1.0, 1e-3);
 }
@@ -169,6 +169,34 @@ TEST(Binned, NormalsFindTheirOctahedralBin) {
     EXPECT_EQ(normal_bin({NAN, 0, 1}, 10), 0u);
 }
 
+TEST(Binned, TheDiffuseClassHasItsOwnFinerGridOfNormals) {
+    const EnvMap plain = plain_map(test::sun_sky_map(64, 32));
+    const BinnedEnvMap defaults{EnvMap(plain)};
+    EXPECT_EQ(defaults.layout().bins_per_side, 11u);
+    EXPECT_EQ(defaults.layout().diffuse_bins_per_side, 21u);
+    EXPECT_EQ(defaults.layout().choices.size(), 21u * 21 + 2 * 11 * 11);
+    const BinnedEnvMapView view = defaults.view();
+    // A normal halfway between two glossy bin centres is a diffuse bin centre: the diffuse
+    // class takes that bin alone, a glossy class blends the two.
+    const Vec3 n = octahedral_normal(6.0f / 11, 5.5f / 11);
+    const BinBlend diffuse = normal_blend(n, 21), glossy = normal_blend(n, 11);
+    EXPECT_NEAR(*std::max_element(diffuse.weight, diffuse.weight + 4), 1.0f, 1e-5f);
+    EXPECT_NEAR(*std::max_element(glossy.weight, glossy.weight + 4), 0.5f, 1e-5f);
+    EXPECT_EQ(view.bin(n, 0, 0.3f).cells.start, view.bin(n, 0, 0.9f).cells.start);
+    EXPECT_NE(view.bin(n, 1, 0.3f).cells.start, view.bin(n, 1, 0.9f).cells.start);
+    BinnedOptions o;
+    o.bins_per_side = 5;
+    o.diffuse_bins_per_side = 3;
+    const BinnedEnvMap chosen{EnvMap(plain), o};
+    EXPECT_EQ(chosen.diffuse_bins(), 9u);
+    EXPECT_EQ(chosen.bins(), 25u);
+    EXPECT_EQ(BinnedEnvMap(EnvMap(plain), chosen.layout()).layout().choices.size(), 9u + 2 * 25);
+    o.diffuse_bins_per_side = 65;
+    EXPECT_THROW(BinnedEnvMap(EnvMap(plain), o), std::invalid_argument);
+    EXPECT_EQ(diffuse_side(64), 64u);
+    EXPECT_EQ(diffuse_side(1), 1u);
+}
+
 TEST(Binned, LobeClassesPickTheNearestSharpness) {
     const std::vector<float> e = {0, 20, 200};
     EXPECT_EQ(lobe_class(e, 0), 0u);
@@ -185,7 +213,7 @@ TEST(Binned, TinyBlackAndConstantMapsWork) {
         const BinnedEnvMap map(plain_map(image));
         const BinnedEnvMapView view = map.view();
         Rng rng(1);
-        for (Vec3 n : test_normals(BinnedOptions{}.bins_per_side)) {
+        for (Vec3 n : test_normals(map.layout().side(0))) {
             const float choice = rng.uniform();
             const EnvSample s = view.sample(n, 0, choice, rng.uniform2());
             EXPECT_GT(s.pdf, 0) << image.width << "x" << image.height;

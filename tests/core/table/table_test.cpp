@@ -537,6 +537,7 @@ void expect_identical_binned_samples(const BinnedEnvMap& expected, const BinnedE
 
 void expect_same_layout(const BinLayout& a, const BinLayout& b) {
     EXPECT_EQ(a.bins_per_side, b.bins_per_side);
+    EXPECT_EQ(a.diffuse_bins_per_side, b.diffuse_bins_per_side);
     EXPECT_EQ(a.cell_columns, b.cell_columns);
     EXPECT_EQ(a.cell_rows, b.cell_rows);
     EXPECT_EQ(a.lobe_exponents, b.lobe_exponents);
@@ -628,7 +629,7 @@ TEST_F(BinnedTableTest, DamagedBinsSectionsAreRejectedNamingTheProblem) {
     const fs::path path = saved_binned_table();
     const std::vector<char> good = bytes_of(path);
     const auto [at, size] = bins_section_of(good);
-    ASSERT_EQ(size, 16 + 4 * 3 + 8 * 3 * 16u);
+    ASSERT_EQ(size, 20 + 4 * 3 + 8 * (7 * 7 + 2 * 16u));  // g 4, the diffuse class's 7
     std::vector<char> bytes = good;
     bytes[at + size / 2] ^= 0x10;
     write_bytes(path, bytes);
@@ -645,13 +646,15 @@ TEST_F(BinnedTableTest, DamagedBinsSectionsAreRejectedNamingTheProblem) {
         expect_rejected(path, problem);
     };
     field(0, 65, "65 bins per side, not 1 to 64");
-    field(0, 5, "does not hold 3 lobe classes of 25 bins");
+    field(0, 5, "does not hold 3 lobe classes of 49 diffuse and 25 glossy bins");
     field(4, 97, "cell grid 97x");
     field(8, 0, "does not fit a 96x48 map");
     field(12, 9, "9 lobe classes, not 1 to 8");
-    field(16, std::bit_cast<uint32_t>(1.0f), "lobe exponents");
-    field(16 + 12 + 4, std::bit_cast<uint32_t>(NAN), "not finite");
-    field(16 + 12 + 4, std::bit_cast<uint32_t>(-1.0f), "threshold is negative");
+    field(16, 0, "0 diffuse bins per side, not 1 to 64");
+    field(16, 3, "does not hold 3 lobe classes of 9 diffuse and 16 glossy bins");
+    field(20, std::bit_cast<uint32_t>(1.0f), "lobe exponents");
+    field(20 + 12 + 4, std::bit_cast<uint32_t>(NAN), "not finite");
+    field(20 + 12 + 4, std::bit_cast<uint32_t>(-1.0f), "threshold is negative");
 }
 
 TEST_F(BinnedTableTest, ImplausibleBinsSectionSizesAreRejectedBeforeReading) {
@@ -671,7 +674,7 @@ TEST_F(BinnedTableTest, BinsThatDoNotFitTheMapAreATableError) {
     std::vector<char> bytes = bytes_of(path);
     const auto [at, size] = bins_section_of(bytes);
     const float odd = 0.123456789f;
-    std::memcpy(bytes.data() + at + 16 + 12 + 4, &odd, sizeof odd);
+    std::memcpy(bytes.data() + at + 20 + 12 + 4, &odd, sizeof odd);
     reseal_bins(bytes);
     write_bytes(path, bytes);
     try {

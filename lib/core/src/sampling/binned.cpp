@@ -140,6 +140,9 @@ using detail::CellGrid;
 void check_options(const BinnedOptions& o) {
     if (o.bins_per_side < 1 || o.bins_per_side > 64)
         throw std::invalid_argument("bins per side must be 1 to 64, got " + std::to_string(o.bins_per_side));
+    if (o.diffuse_bins_per_side > 64)
+        throw std::invalid_argument("diffuse bins per side must be 1 to 64 (or 0: the default), got " +
+                                    std::to_string(o.diffuse_bins_per_side));
     const auto& e = o.lobe_exponents;
     if (e.empty() || e.size() > 8 || e[0] != 0 || !std::is_sorted(e.begin(), e.end()) ||
         !std::all_of(e.begin(), e.end(), [](float x) { return x >= 0 && x <= 1e5f; }))
@@ -177,33 +180,38 @@ BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinnedOptions& options, StopFlag 
     check_options(options);
     const auto started = std::chrono::steady_clock::now();
     const CellGrid grid = grid_for(plain_, options.cell_columns);
-    const detail::Geometry geometry(grid, options.bins_per_side);
-    layout_ = {options.bins_per_side, grid.cw, grid.ch, options.lobe_exponents,
-               detail::choose_bins(plain_, grid, geometry, options, stop)};
+    layout_.bins_per_side = options.bins_per_side;
+    layout_.diffuse_bins_per_side =
+        options.diffuse_bins_per_side ? options.diffuse_bins_per_side : diffuse_side(options.bins_per_side);
+    layout_.cell_columns = grid.cw, layout_.cell_rows = grid.ch;
+    layout_.lobe_exponents = options.lobe_exponents;
+    const detail::Geometries geometries(grid, layout_);
+    layout_.choices = detail::choose_bins(plain_, grid, geometries, layout_, options, stop);
     choice_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    build(detail::bin_masses(plain_, grid, geometry, layout_, stop), stop);
+    build(detail::bin_masses(plain_, grid, geometries, layout_, stop), stop);
 }
 
 BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinLayout& layout) : plain_(std::move(plain)), layout_(layout) {
-    const uint32_t g = layout.bins_per_side, w = plain_.width(), h = plain_.height();
-    if (g < 1 || g > 64 || layout.cell_columns < 1 || layout.cell_columns > std::min(w, 4096u) ||
+    const uint32_t g = layout.bins_per_side, gd = layout.diffuse_bins_per_side, w = plain_.width(), h = plain_.height();
+    if (g < 1 || g > 64 || gd < 1 || gd > 64 || layout.cell_columns < 1 || layout.cell_columns > std::min(w, 4096u) ||
         layout.cell_rows < 1 || layout.cell_rows > h)
-        throw std::invalid_argument("bin layout " + std::to_string(g) + " bins per side, " +
-                                    std::to_string(layout.cell_columns) + "x" + std::to_string(layout.cell_rows) +
-                                    " cells does not fit a " + std::to_string(w) + "x" + std::to_string(h) + " map");
+        throw std::invalid_argument("bin layout " + std::to_string(gd) + " diffuse and " + std::to_string(g) +
+                                    " glossy bins per side, " + std::to_string(layout.cell_columns) + "x" +
+                                    std::to_string(layout.cell_rows) + " cells does not fit a " + std::to_string(w) +
+                                    "x" + std::to_string(h) + " map");
     check_cells(layout.cell_columns, layout.cell_rows);
     BinnedOptions check;
     check.lobe_exponents = layout.lobe_exponents;
     check_options(check);
-    if (layout.choices.size() != size_t{g} * g * layout.lobe_exponents.size())
+    if (layout.choices.size() != layout.choice_count())
         throw std::invalid_argument("bin layout: " + std::to_string(layout.choices.size()) + " choices for " +
-                                    std::to_string(size_t{g} * g * layout.lobe_exponents.size()) + " bins");
+                                    std::to_string(layout.choice_count()) + " bins");
     for (const BinChoice& c : layout.choices)
         if (!(std::isfinite(c.alpha) && c.threshold >= 0 && std::isfinite(c.threshold) &&
               detail::on_histogram_edge(c.threshold)))
             throw std::invalid_argument("bin layout: invalid alpha or threshold");
     const CellGrid grid(w, h, layout.cell_columns, layout.cell_rows, plain_.options().mapping);
-    build(detail::bin_masses(plain_, grid, detail::Geometry(grid, g), layout_), nullptr);
+    build(detail::bin_masses(plain_, grid, detail::Geometries(grid, layout_), layout_), nullptr);
 }
 
 void BinnedEnvMap::build(const std::vector<std::vector<float>>& masses, StopFlag stop) {
@@ -257,16 +265,18 @@ BinnedEnvMapView BinnedEnvMap::view() const noexcept {
             row_edges_.data(),
             layout_.cell_columns,
             layout_.cell_rows,
+            classes(),
             layout_.bins_per_side,
             bins(),
-            classes()};
+            layout_.diffuse_bins_per_side,
+            diffuse_bins()};
 }
 
 bool BinnedEnvMap::complete(uint32_t lobe) const noexcept {
-    const uint32_t k = bins();
     lobe = std::min(lobe, classes() - 1);
+    const uint32_t k = lobe == 0 ? diffuse_bins() : bins();
     for (uint32_t b = 0; b < k; ++b) {
-        const BinChoice& c = layout_.choices[size_t{lobe} * k + b];
+        const BinChoice& c = layout_.choices[layout_.first(lobe) + b];
         if (!c.plain() && c.threshold > 0) return false;
     }
     return true;

@@ -218,77 +218,89 @@ std::vector<WeightedNormal> bin_samples(uint32_t bin, uint32_t g) {
 
 }  // namespace
 
-std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, const Geometry& geometry,
-                                   const BinnedOptions& options, StopFlag stop) {
+std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, const Geometries& geometries,
+                                   const BinLayout& shape, const BinnedOptions& options, StopFlag stop) {
     const Nodes nodes = nodes_of(plain, grid, stop);
-    const std::vector<double> means = hemisphere_means(nodes, geometry);
-    const uint32_t k = options.bins_per_side * options.bins_per_side;
-    const auto classes = static_cast<uint32_t>(options.lobe_exponents.size());
+    const auto classes = static_cast<uint32_t>(shape.lobe_exponents.size());
     const std::vector<float> alphas = options.auto_alpha ? options.candidates : std::vector<float>{options.alpha};
+    const size_t count = alphas.size();
+    // Per grid (0: the diffuse class's, 1: the glossy classes'), each bin's hemisphere
+    // mean and its candidates' thresholds, bin-major.
+    const std::vector<double> means[2] = {hemisphere_means(nodes, geometries.diffuse),
+                                          hemisphere_means(nodes, geometries.glossy)};
+    double highest_mean = 0;
+    for (const auto& m : means) highest_mean = std::max(highest_mean, *std::max_element(m.begin(), m.end()));
     const float highest_alpha = *std::max_element(alphas.begin(), alphas.end());
-    const float floor = window_floor(static_cast<float>(highest_alpha * *std::max_element(means.begin(), means.end())));
-    std::vector<float> thresholds;
-    for (uint32_t b = 0; b < k; ++b)
-        for (float a : alphas) thresholds.push_back(threshold_of(a, means[b], floor));
-    std::vector<BinChoice> choices(size_t{classes} * k);
+    const float floor = window_floor(static_cast<float>(highest_alpha * highest_mean));
+    std::vector<float> thresholds[2];
+    for (int grid_of = 0; grid_of < 2; ++grid_of)
+        for (double mean : means[grid_of])
+            for (float a : alphas) thresholds[grid_of].push_back(threshold_of(a, mean, floor));
+    std::vector<BinChoice> choices(shape.choice_count());
     if (!options.auto_alpha) {
-        for (size_t i = 0; i < choices.size(); ++i) choices[i] = {options.alpha, thresholds[i % k]};
+        for (uint32_t c = 0; c < classes; ++c)
+            for (uint32_t b = 0; b < shape.side(c) * shape.side(c); ++b)
+                choices[shape.first(c) + b] = {options.alpha, thresholds[c > 0][b]};
         return choices;
     }
-    const CellHistogram hist = histogram(plain, grid, thresholds, stop);
+    std::vector<float> every_threshold = thresholds[0];
+    every_threshold.insert(every_threshold.end(), thresholds[1].begin(), thresholds[1].end());
+    const CellHistogram hist = histogram(plain, grid, every_threshold, stop);
     const size_t cells = size_t{grid.cw} * grid.ch;
     const std::vector<double> plain_p = probabilities(hist.total_l);
-    parallel_for(k, 1, stop, [&](uint32_t lo, uint32_t hi) {
-        std::vector<double> mass(cells);
-        for (uint32_t b = lo; b < hi; ++b) {
-            std::vector<std::vector<double>> kinds[2];  // the candidates' cell probabilities, diffuse and glossy
-            for (int glossy = 0; glossy < 2; ++glossy) {
-                kinds[glossy].resize(alphas.size());
-                for (size_t j = 0; j < alphas.size(); ++j) {
-                    for (size_t c = 0; c < cells; ++c)
-                        mass[c] = geometry.weight(b, c, glossy) * hist.above(c, thresholds[b * alphas.size() + j]);
-                    kinds[glossy][j] = probabilities(mass);
+    for (uint32_t c = 0; c < classes; ++c) {
+        const bool glossy = c > 0;
+        const Geometry& geometry = geometries.of(c);
+        const uint32_t g = shape.side(c);
+        const float exponent = shape.lobe_exponents[c];
+        parallel_for(g * g, 1, stop, [&](uint32_t lo, uint32_t hi) {
+            std::vector<double> mass(cells);
+            for (uint32_t b = lo; b < hi; ++b) {
+                std::vector<std::vector<double>> p(count);  // the candidates' cell probabilities
+                for (size_t j = 0; j < count; ++j) {
+                    for (size_t cell = 0; cell < cells; ++cell)
+                        mass[cell] =
+                            geometry.weight(b, cell, glossy) * hist.above(cell, thresholds[glossy][b * count + j]);
+                    p[j] = probabilities(mass);
                 }
-            }
-            for (uint32_t cls = 0; cls < classes; ++cls) {
-                const std::vector<std::vector<double>>& p = kinds[options.lobe_exponents[cls] > 0];
-                std::vector<double> log_ratio(alphas.size(), 0);
-                for (const WeightedNormal& at : bin_samples(b, options.bins_per_side)) {
-                    const Lobe lobe = lobe_at(nodes, at.normal, options.lobe_exponents[cls]);
+                std::vector<double> log_ratio(count, 0);
+                for (const WeightedNormal& at : bin_samples(b, g)) {
+                    const Lobe lobe = lobe_at(nodes, at.normal, exponent);
                     const double base = mis_variance(nodes, lobe, plain_p, hist.total_l);
-                    for (size_t j = 0; j < alphas.size(); ++j) {
+                    for (size_t j = 0; j < count; ++j) {
                         const double v = p[j].empty() ? 0 : mis_variance(nodes, lobe, p[j], hist.total_l);
                         if (base > 0)
                             log_ratio[j] += at.weight * (v > 0 ? std::log(v / base) : (p[j].empty() ? 1e9 : 0));
                     }
                 }
                 const size_t best = std::min_element(log_ratio.begin(), log_ratio.end()) - log_ratio.begin();
-                choices[size_t{cls} * k + b] = log_ratio[best] < -1e-6
-                                                   ? BinChoice{alphas[best], thresholds[b * alphas.size() + best]}
-                                                   : BinChoice{-1, 0};
+                choices[shape.first(c) + b] = log_ratio[best] < -1e-6
+                                                  ? BinChoice{alphas[best], thresholds[glossy][b * count + best]}
+                                                  : BinChoice{-1, 0};
             }
-        }
-    });
+        });
+    }
     return choices;
 }
 
-std::vector<std::vector<float>> bin_masses(const EnvMap& plain, const CellGrid& grid, const Geometry& geometry,
+std::vector<std::vector<float>> bin_masses(const EnvMap& plain, const CellGrid& grid, const Geometries& geometries,
                                            const BinLayout& layout, StopFlag stop) {
     std::vector<float> thresholds;
     for (const BinChoice& c : layout.choices) thresholds.push_back(c.plain() ? 0.0f : c.threshold);
     const CellHistogram hist = histogram(plain, grid, thresholds, stop);
-    const size_t cells = size_t{grid.cw} * grid.ch, k = size_t{layout.bins_per_side} * layout.bins_per_side;
+    const size_t cells = size_t{grid.cw} * grid.ch;
     std::vector<std::vector<float>> masses(layout.choices.size(), std::vector<float>(cells));
     parallel_for(static_cast<uint32_t>(masses.size()), 1, stop, [&](uint32_t lo, uint32_t hi) {
-        for (uint32_t cb = lo; cb < hi; ++cb)
-            for (size_t c = 0; c < cells; ++c) {
-                const BinChoice& choice = layout.choices[cb];
-                const bool glossy = layout.lobe_exponents[cb / k] > 0;
-                const double bound = choice.plain() ? 1.0 : geometry.weight(static_cast<uint32_t>(cb % k), c, glossy);
-                const double s = hist.above(c, choice.plain() ? 0.0f : choice.threshold);
+        for (uint32_t cb = lo; cb < hi; ++cb) {
+            const uint32_t c = layout.class_of(cb), b = static_cast<uint32_t>(cb - layout.first(c));
+            const BinChoice& choice = layout.choices[cb];
+            for (size_t cell = 0; cell < cells; ++cell) {
+                const double bound = choice.plain() ? 1.0 : geometries.of(c).weight(b, cell, c > 0);
+                const double s = hist.above(cell, choice.plain() ? 0.0f : choice.threshold);
                 const auto m = static_cast<float>(bound * s);
-                masses[cb][c] = bound > 0 && s > 0 ? std::max(m, std::numeric_limits<float>::min()) : 0.0f;
+                masses[cb][cell] = bound > 0 && s > 0 ? std::max(m, std::numeric_limits<float>::min()) : 0.0f;
             }
+        }
     });
     return masses;
 }

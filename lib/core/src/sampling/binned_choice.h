@@ -35,6 +35,14 @@ struct Geometry {
     float weight(uint32_t bin, size_t cell, bool glossy) const noexcept;
 };
 
+// The two grids of normals a layout uses: the diffuse class's and the glossy classes'.
+struct Geometries {
+    Geometry diffuse, glossy;
+    Geometries(const CellGrid& grid, const BinLayout& layout)
+        : diffuse(grid, layout.diffuse_bins_per_side), glossy(grid, layout.bins_per_side) {}
+    const Geometry& of(uint32_t lobe_class) const noexcept { return lobe_class == 0 ? diffuse : glossy; }
+};
+
 // Thresholds are rounded to the edges of a luminance histogram whose buckets are the
 // float bit patterns shifted right by kHistogramShift (8 buckets an octave): the sum
 // over a cell of max(L - t, 0) is then exact from the buckets' sums.
@@ -47,15 +55,16 @@ inline bool on_histogram_edge(float t) noexcept {
     return (std::bit_cast<uint32_t>(t) & ((1u << kHistogramShift) - 1)) == 0;
 }
 
-// The choice of every (class, bin), class-major, as BinnedOptions asks. Both builds
-// throw Interrupted once `stop` is set (interrupt.h).
-std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, const Geometry& geometry,
-                                   const BinnedOptions& options, StopFlag stop);
+// The choice of every (class, bin), class-major, for the grids and classes of `shape`
+// (its choices unused), as BinnedOptions asks. Both builds throw Interrupted once `stop`
+// is set (interrupt.h).
+std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, const Geometries& geometries,
+                                   const BinLayout& shape, const BinnedOptions& options, StopFlag stop);
 
 // The cell masses (cw ch floats) of every (class, bin) of the layout: the weight times the sum
 // over the cell of max(L - threshold, 0) times the texels' relative solid angle, or the
 // plain mass for a plain choice. Deterministic: the same for any number of threads.
-std::vector<std::vector<float>> bin_masses(const EnvMap& plain, const CellGrid& grid, const Geometry& geometry,
+std::vector<std::vector<float>> bin_masses(const EnvMap& plain, const CellGrid& grid, const Geometries& geometries,
                                            const BinLayout& layout, StopFlag stop = nullptr);
 
 }  // namespace envmis::detail

@@ -37,11 +37,15 @@ constexpr uint32_t kFlagCompact = 2;  // payload: RGBE radiance only (TableEncod
 // Version 3 pads the metadata block with zeros to a multiple of this, so that the payload's
 // arrays are aligned in the file and a mapping of it can be used in place.
 constexpr uint32_t kMetadataAlignment = 8;
-// Version 4's bins section (BinLayout): four u32 (bins per side g, cell columns, cell
-// rows, classes C), C lobe exponents, then C g^2 (alpha, threshold) pairs, all 4 bytes.
+// The bins section (BinLayout): four u32 (bins per side g of the glossy classes, cell
+// columns, cell rows, classes C), from version 6 a fifth (the diffuse class's g_d; before,
+// g_d = g), C lobe exponents, then g_d^2 + (C - 1) g^2 (alpha, threshold) pairs, all 4 bytes.
 constexpr uint32_t kMaxBinsPerSide = 64, kMaxCellSide = 4096, kMaxLobeClasses = 8;
-constexpr uint32_t bins_section_size(uint32_t g, uint32_t classes) { return 16 + 4 * classes + 8 * classes * g * g; }
-constexpr uint32_t kMaxBinsSection = bins_section_size(kMaxBinsPerSide, kMaxLobeClasses);
+constexpr uint32_t bins_section_size(uint32_t version, uint32_t gd, uint32_t g, uint32_t classes) {
+    return (version >= 6 ? 20 : 16) + 4 * classes + 8 * (gd * gd + (classes - 1) * g * g);
+}
+constexpr uint32_t kMaxBinsSection = bins_section_size(6, kMaxBinsPerSide, kMaxBinsPerSide, kMaxLobeClasses);
+constexpr uint32_t kMinBinsSection = bins_section_size(5, 1, 1, 1);
 
 // RGBE (Ward 1991): three 8-bit mantissas sharing the exponent of the largest channel,
 // rounded to nearest. Byte 3 is the exponent + 128; 0 means black.
@@ -163,6 +167,7 @@ std::vector<std::byte> bins_section(const BinLayout& layout) {
     w.put(layout.cell_columns);
     w.put(layout.cell_rows);
     w.put(static_cast<uint32_t>(layout.lobe_exponents.size()));
+    w.put(layout.diffuse_bins_per_side);
     for (float e : layout.lobe_exponents) w.put(e);
     for (const BinChoice& c : layout.choices) {
         w.put(c.alpha);
@@ -302,9 +307,9 @@ void write_table(const std::filesystem::path& path, const BinnedEnvMap& binned, 
                  TableEncoding encoding, StopFlag stop) {
     // Never write what the reader would refuse (a default-constructed BinnedEnvMap has no bins).
     const BinLayout& layout = binned.layout();
-    const uint32_t g = layout.bins_per_side, classes = static_cast<uint32_t>(layout.lobe_exponents.size());
-    if (g < 1 || g > kMaxBinsPerSide || classes < 1 || classes > kMaxLobeClasses ||
-        layout.choices.size() != size_t{classes} * g * g)
+    const uint32_t g = layout.bins_per_side, gd = layout.diffuse_bins_per_side, classes = layout.classes();
+    if (g < 1 || g > kMaxBinsPerSide || gd < 1 || gd > kMaxBinsPerSide || classes < 1 || classes > kMaxLobeClasses ||
+        layout.choices.size() != layout.choice_count())
         throw TableError(path.string() + ": the binned map has no valid bins to write");
     write_map(path, binned.plain(), source, encoding, &binned.layout(), stop);
 }
@@ -327,7 +332,7 @@ struct Header {
 // against the file before anything is allocated for them.
 void check_payload_size(const Header& header, uint64_t left, const Cursor& in) {
     const uint32_t bins = header.bins_size;
-    if (bins != 0 && (bins < bins_section_size(1, 1) || bins > kMaxBinsSection || bins % 4 != 0))
+    if (bins != 0 && (bins < kMinBinsSection || bins > kMaxBinsSection || bins % 4 != 0))
         in.fail("invalid bins section size " + std::to_string(bins));
     const uint64_t texels = uint64_t{header.w} * header.h;
     const uint64_t payload = texels * (header.compact ? sizeof(uint32_t) : sizeof(float) + sizeof(Rgb)) + 8 +
@@ -502,7 +507,11 @@ BinLayout parse_bins(std::span<const std::byte> section, uint64_t digest, const 
     layout.cell_rows = in.take<uint32_t>("bin cell rows");
     const auto classes = in.take<uint32_t>("lobe classes");
     const uint32_t g = layout.bins_per_side;
+    layout.diffuse_bins_per_side = header.version >= 6 ? in.take<uint32_t>("diffuse bins per side") : g;
+    const uint32_t gd = layout.diffuse_bins_per_side;
     if (g < 1 || g > kMaxBinsPerSide) in.fail("bins section: " + std::to_string(g) + " bins per side, not 1 to 64");
+    if (gd < 1 || gd > kMaxBinsPerSide)
+        in.fail("bins section: " + std::to_string(gd) + " diffuse bins per side, not 1 to 64");
     if (layout.cell_columns < 1 || layout.cell_columns > std::min(header.w, kMaxCellSide) || layout.cell_rows < 1 ||
         layout.cell_rows > std::min(header.h, kMaxCellSide))
         in.fail("bins section: cell grid " + std::to_string(layout.cell_columns) + "x" +
@@ -510,17 +519,18 @@ BinLayout parse_bins(std::span<const std::byte> section, uint64_t digest, const 
                 std::to_string(header.h) + " map (at most 4096 a side)");
     if (classes < 1 || classes > kMaxLobeClasses)
         in.fail("bins section: " + std::to_string(classes) + " lobe classes, not 1 to 8");
-    if (section.size() != bins_section_size(g, classes))
+    const uint32_t expected = bins_section_size(header.version, gd, g, classes);
+    if (section.size() != expected)
         in.fail("bins section of " + std::to_string(section.size()) + " bytes does not hold " +
-                std::to_string(classes) + " lobe classes of " + std::to_string(g * g) + " bins (" +
-                std::to_string(bins_section_size(g, classes)) + " bytes)");
+                std::to_string(classes) + " lobe classes of " + std::to_string(gd * gd) + " diffuse and " +
+                std::to_string(g * g) + " glossy bins (" + std::to_string(expected) + " bytes)");
     for (uint32_t c = 0; c < classes; ++c) {
         const auto e = in.take<float>("lobe exponent");
         if (!std::isfinite(e) || (c == 0 ? e != 0 : !(e >= layout.lobe_exponents.back())))
             in.fail("bins section: lobe exponents must be finite, ascending, the first 0");
         layout.lobe_exponents.push_back(e);
     }
-    layout.choices.resize(size_t{classes} * g * g);
+    layout.choices.resize(layout.choice_count());
     for (BinChoice& choice : layout.choices) {
         choice.alpha = in.take<float>("bin alpha");
         choice.threshold = in.take<float>("bin threshold");

@@ -100,7 +100,10 @@ AlphaSweep run_alpha_sweep(const StudyInputs& inputs, std::span<const float> alp
         std::optional<BinnedEnvMap> binned;
         if (uses_bins(options.techniques)) {
             BinnedOptions bins;
-            if (inputs.binned) bins.bins_per_side = inputs.binned->layout().bins_per_side;
+            if (inputs.binned) {
+                bins.bins_per_side = inputs.binned->layout().bins_per_side;
+                bins.diffuse_bins_per_side = inputs.binned->layout().diffuse_bins_per_side;
+            }
             bins.auto_alpha = false;
             bins.alpha = alphas[i];
             binned.emplace(EnvMap(inputs.plain), bins);

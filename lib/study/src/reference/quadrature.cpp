@@ -190,7 +190,7 @@ double exact_variance(const BinnedEnvMap& binned, Technique technique, Allocatio
     const Vec3 axis = lobe_axis(lobe, point.normal, point.wo);
     // Each pick gives an unbiased estimator, so the variance is the weights' mixture of
     // the picks' (no spread of means between picks to add).
-    const BinBlend blend = normal_blend(to_canonical(binned.plain().options().axes, axis), view.bins_per_side);
+    const BinBlend blend = normal_blend(to_canonical(binned.plain().options().axes, axis), view.side(lobe));
     double variance = 0;
     for (int k = 0; k < 4; ++k) {
         if (!(blend.weight[k] > 0)) continue;
