@@ -11,6 +11,7 @@
 #include <string>
 
 #include "binned_choice.h"
+#include "detail/luminance.h"
 #include "detail/parallel.h"
 #include "detail/pipeline.h"
 
@@ -71,7 +72,34 @@ float square_radius(Vec3 centre, double s0, double s1, double t0, double t1, Dir
 
 }  // namespace
 
-Geometry::Geometry(const CellGrid& grid, uint32_t g) {
+// Per cell: the normalised sum over its texels of luminance times relative solid angle
+// times the texel centre's direction; the cell's centre where that is zero.
+std::vector<Vec3> cell_lights(const EnvMap& plain, const CellGrid& grid, const std::vector<Vec3>& centres) {
+    std::vector<Vec3> light(centres.size());
+    const Rgb* pixels = plain.radiance().pixels.data();
+    const LumaCoefficients luma = plain.options().luma;
+    parallel_for(grid.ch, 1, nullptr, [&](uint32_t lo, uint32_t hi) {
+        for (uint32_t cy = lo; cy < hi; ++cy)
+            for (uint32_t cx = 0; cx < grid.cw; ++cx) {
+                double sum[3] = {0, 0, 0};
+                for (uint32_t y = grid.row_edges[cy]; y < grid.row_edges[cy + 1]; ++y) {
+                    const double w = row_weight(grid.mapping, y, grid.h);
+                    for (uint32_t x = grid.column_edges[cx]; x < grid.column_edges[cx + 1]; ++x) {
+                        const double l = texel_luminance(pixels[size_t{y} * grid.w + x], luma) * w;
+                        if (!(l > 0)) continue;
+                        const Vec3 d = image_direction(grid.mapping, {(x + 0.5f) / grid.w, (y + 0.5f) / grid.h});
+                        sum[0] += l * d.x, sum[1] += l * d.y, sum[2] += l * d.z;
+                    }
+                }
+                const Vec3 s{static_cast<float>(sum[0]), static_cast<float>(sum[1]), static_cast<float>(sum[2])};
+                const size_t i = size_t{cy} * grid.cw + cx;
+                light[i] = length(s) > 0 ? normalize(s) : centres[i];
+            }
+    });
+    return light;
+}
+
+Geometry::Geometry(const EnvMap& plain, const CellGrid& grid, uint32_t g) {
     cell_direction.resize(size_t{grid.cw} * grid.ch);
     cell_radius.resize(cell_direction.size());
     const auto dir = [&](float u, float v) { return image_direction(grid.mapping, {u, v}); };
@@ -85,6 +113,7 @@ Geometry::Geometry(const CellGrid& grid, uint32_t g) {
             cell_direction[i] = dir(static_cast<float>(0.5 * (u0 + u1)), static_cast<float>(0.5 * (v0 + v1)));
             cell_radius[i] = square_radius(cell_direction[i], u0, u1, v0, v1, dir);
         }
+    cell_light = cell_lights(plain, grid, cell_direction);
     bin_normal.resize(size_t{g} * g);
     bin_radius.resize(bin_normal.size());
     for (uint32_t t = 0; t < g; ++t)
@@ -126,7 +155,7 @@ float Geometry::weight(uint32_t bin, size_t cell, bool glossy) const noexcept {
     // bin may see positive, as coverage needs.
     constexpr float kBinShare = 0.25f, kFloor = 0.1f;
     const float angle =
-        std::acos(std::clamp(dot(bin_normal[bin], cell_direction[cell]), -1.0f, 1.0f)) - kBinShare * bin_radius[bin];
+        std::acos(std::clamp(dot(bin_normal[bin], cell_light[cell]), -1.0f, 1.0f)) - kBinShare * bin_radius[bin];
     const float typical = angle <= 0 ? 1.0f : (angle >= kPiF / 2 ? 0.0f : std::cos(angle));
     return std::max({typical, kFloor * b, glossy ? kGlossyFloor : 0.0f});
 }
@@ -185,7 +214,7 @@ BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinnedOptions& options, StopFlag 
         options.diffuse_bins_per_side ? options.diffuse_bins_per_side : diffuse_side(options.bins_per_side);
     layout_.cell_columns = grid.cw, layout_.cell_rows = grid.ch;
     layout_.lobe_exponents = options.lobe_exponents;
-    const detail::Geometries geometries(grid, layout_);
+    const detail::Geometries geometries(plain_, grid, layout_);
     layout_.choices = detail::choose_bins(plain_, grid, geometries, layout_, options, stop);
     choice_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     build(detail::bin_masses(plain_, grid, geometries, layout_, stop), stop);
@@ -211,7 +240,7 @@ BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinLayout& layout) : plain_(std::
               detail::on_histogram_edge(c.threshold)))
             throw std::invalid_argument("bin layout: invalid alpha or threshold");
     const CellGrid grid(w, h, layout.cell_columns, layout.cell_rows, plain_.options().mapping);
-    build(detail::bin_masses(plain_, grid, detail::Geometries(grid, layout_), layout_), nullptr);
+    build(detail::bin_masses(plain_, grid, detail::Geometries(plain_, grid, layout_), layout_), nullptr);
 }
 
 void BinnedEnvMap::build(const std::vector<std::vector<float>>& masses, StopFlag stop) {

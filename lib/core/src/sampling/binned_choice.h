@@ -24,10 +24,12 @@ struct CellGrid {
 // bin's own square, and its blend support (normal_blend: the normals that may pick it,
 // those of its own and its eight neighbours' squares).
 struct Geometry {
-    std::vector<Vec3> cell_direction, bin_normal;
+    // cell_light: where a cell's light comes from, the normalised sum of its texels'
+    // directions weighted by luminance times solid angle (its centre where it is black).
+    std::vector<Vec3> cell_direction, cell_light, bin_normal;
     std::vector<float> cell_radius, bin_radius, support_radius;
 
-    Geometry(const CellGrid& grid, uint32_t bins_per_side);
+    Geometry(const EnvMap& plain, const CellGrid& grid, uint32_t bins_per_side);
     // c_b: an upper bound of cos+(omega . n) for omega in the cell and n in the bin's support.
     float bound(uint32_t bin, size_t cell) const noexcept;
     // The cosine factor a bin's cell masses carry: for the diffuse class > 0 exactly
@@ -38,8 +40,8 @@ struct Geometry {
 // The two grids of normals a layout uses: the diffuse class's and the glossy classes'.
 struct Geometries {
     Geometry diffuse, glossy;
-    Geometries(const CellGrid& grid, const BinLayout& layout)
-        : diffuse(grid, layout.diffuse_bins_per_side), glossy(grid, layout.bins_per_side) {}
+    Geometries(const EnvMap& plain, const CellGrid& grid, const BinLayout& layout)
+        : diffuse(plain, grid, layout.diffuse_bins_per_side), glossy(plain, grid, layout.bins_per_side) {}
     const Geometry& of(uint32_t lobe_class) const noexcept { return lobe_class == 0 ? diffuse : glossy; }
 };
 

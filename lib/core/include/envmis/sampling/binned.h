@@ -10,9 +10,10 @@
 //
 // where E_b / pi is the cosine-weighted mean radiance of the hemisphere around the bin's
 // centre normal n_b, and c_b the cosine factor of the cell: that of the angle from the
-// cell's centre to n_b, less a quarter of the bin's angular radius (a typical normal of
-// the bin rather than its centre: Lambert variance 0.142 of plain balance MIS's over the
-// 14 shared maps, against 0.145 with none and 0.151 with half the radius), and at least
+// direction the cell's light comes from (its texels' directions weighted by luminance
+// times solid angle: a sun's, not the centre of a cell 11 degrees tall whose cosine
+// near a normal's horizon may be a fifth of the sun's) to n_b, less a quarter of the
+// bin's angular radius (a typical normal of the bin rather than its centre), and at least
 // a tenth of a conservative bound (the angle less the cell's radius and that of the
 // normals that may pick the bin, its blend support; 0 beyond 90 degrees). So a diffuse
 // bin's density is > 0 wherever any normal that may pick the bin sees compensated light,
