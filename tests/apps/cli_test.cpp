@@ -161,7 +161,8 @@ INSTANTIATE_TEST_SUITE_P(
     Subcommands, CliHelp,
     testing::Values(HelpCase{"precompute", with_map_flags({"input", "-o,--output", "--bins", "--cell-columns"})},
                     HelpCase{"info", with_map_flags({"input"})},
-                    HelpCase{"sample", with_map_flags({"input", "-n,--count", "--seed", "-o,--output"})},
+                    HelpCase{"sample", with_map_flags({"input", "-n,--count", "--seed", "-o,--output", "--normal",
+                                                       "--view", "--lobe"})},
                     HelpCase{"visualize",
                              with_map_flags({"input", "-o,--output", "--panel-width", "--normal", "--bins", "--lobe"})},
                     HelpCase{"bench",
@@ -264,6 +265,33 @@ TEST_F(Cli, SampleWritesTheHeaderAndOneRowPerSampleToStdoutOrAFile) {
     ASSERT_EQ(to_file.exit_code, 0) << to_file;
     EXPECT_EQ(to_file.out, "");
     EXPECT_EQ(read_file(file("s.csv")), r.out);
+}
+
+TEST_F(Cli, SampleOnABinnedTableNeedsTheShadingPointAndDrawsFromItsBins) {
+    write_exr(file("map.exr"), gradient(64, 32));
+    ASSERT_EQ(envmis({"precompute", "map.exr", "-o", "binned.envmis", "--bins", "9"}).exit_code, 0);
+    const Result none = envmis({"sample", "binned.envmis", "-n", "5"});
+    EXPECT_NE(none.exit_code, 0);
+    EXPECT_TRUE(contains(none.err, "binned.envmis: a binned table samples per shading point: give --normal X,Y,Z"))
+        << none;
+    EXPECT_EQ(none.out, "");
+    const Result plain = envmis({"sample", "map.exr", "-n", "5", "--normal", "0,0,1"});
+    EXPECT_NE(plain.exit_code, 0);
+    EXPECT_TRUE(contains(plain.err, "map.exr: --normal samples a binned table's bins, and this is an image")) << plain;
+    EXPECT_NE(envmis({"sample", "binned.envmis", "--normal", "0,0,0"}).exit_code, 0);
+    EXPECT_NE(envmis({"sample", "binned.envmis", "--lobe", "phong:20"}).exit_code, 0);  // --lobe needs --normal
+    for (const std::vector<std::string>& point : {std::vector<std::string>{"--normal", "0,0,1"},
+                                                  {"--normal", "0.3,0.2,1", "--view", "1,0,1", "--lobe", "ggx:0.1"}}) {
+        std::vector<std::string> args = {"sample", "binned.envmis", "-n", "200", "--seed", "4"};
+        args.insert(args.end(), point.begin(), point.end());
+        const Result r = envmis(args);
+        ASSERT_EQ(r.exit_code, 0) << r;
+        std::string header;
+        const auto rows = csv_rows(r.out, &header);
+        EXPECT_EQ(header, "u,v,x,y,z,pdf");
+        ASSERT_EQ(rows.size(), 200u);
+        for (const auto& row : rows) EXPECT_GT(row[5], 0.0) << r;
+    }
 }
 
 TEST_F(Cli, VisualizeWritesAPngThatOpenImageIOReads) {
