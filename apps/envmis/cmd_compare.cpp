@@ -42,7 +42,8 @@ struct CompareArgs {
                        alpha_sweep;
     RenderOptions render;
     uint32_t spp = 1024, points = 16, threads = 0, env_samples = 1, bsdf_samples = 1, allocation_sweep = 0;
-    uint32_t bins = 0;  // --bins; 0: kDefaultBins where a -bins technique runs
+    double view_angle = 0;  // degrees between each --points normal and its view
+    uint32_t bins = 0;      // --bins; 0: kDefaultBins where a -bins technique runs
     uint64_t seed = 1;
     bool exact = false;
     // Library mode: hash_text of the file given, the key results_up_to_date checks (for a
@@ -150,6 +151,12 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
     sub.add_option("--points", args.points, "Shading points: K normals spread evenly over the sphere (1 to 10^6)")
         ->capture_default_str()
         ->check(in_range(uint32_t{1}, kMaxPoints));
+    sub.add_option("--view-angle", args.view_angle,
+                   "Degrees (0 to 89.9) between each --points normal and its view, towards azimuths that turn by "
+                   "the golden angle from point to point (default: 0, seen head-on)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 89.9))
+        ->excludes("--normal");
 }
 
 void add_output_flags(CLI::App& sub, CompareArgs& args) {
@@ -276,7 +283,7 @@ Setup prepare(const CompareArgs& args) {
         const Vec3 n = parse_vector(args.normal, "--normal");
         points = {{n, args.view.empty() ? n : parse_vector(args.view, "--view")}};
     } else {
-        points = sphere_points(args.points);
+        points = sphere_points(args.points, args.view_angle);
     }
     std::optional<AlphaChoice> choice;
     if (args.map.alpha_auto) {
@@ -416,6 +423,7 @@ std::string options_text(const CompareArgs& a) {
     text << "bsdf=" << a.bsdfs << " techniques=" << a.techniques << " bins=" << a.bins << " spp=" << a.spp
          << " env-samples=" << a.env_samples << " bsdf-samples=" << a.bsdf_samples << " seed=" << a.seed
          << " normal=" << a.normal << " view=" << a.view << " points=" << a.points;
+    if (a.view_angle != 0) text << " view-angle=" << a.view_angle;
     char alpha[32];
     std::snprintf(alpha, sizeof alpha, "%.9g", a.map.alpha);
     const bool alpha_given = a.alpha_flag && a.alpha_flag->count() > 0;

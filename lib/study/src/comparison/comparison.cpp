@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "envmis/study/shading/frame.h"
 #include "envmis/study/statistics/statistics.h"
 
 namespace envmis {
@@ -56,14 +57,25 @@ const TechniqueStats* BsdfComparison::find(std::string_view technique) const {
     return nullptr;
 }
 
-std::vector<ShadingPoint> sphere_points(uint32_t k) {
+std::vector<ShadingPoint> sphere_points(uint32_t k, double view_degrees) {
+    if (!(view_degrees >= 0 && view_degrees <= 89.9))
+        throw std::invalid_argument("a view angle must be 0 to 89.9 degrees, got " + std::to_string(view_degrees));
     constexpr double kGoldenAngle = 2.39996322972865332;
+    const double view = view_degrees * kPi / 180;
     std::vector<ShadingPoint> points(k);
     for (uint32_t i = 0; i < k; ++i) {
         const double z = 1 - (2 * i + 1.0) / k, r = std::sqrt(1 - z * z), phi = kGoldenAngle * i;
         const Vec3 n{static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
                      static_cast<float>(z)};
-        points[i] = {n, n};
+        if (view_degrees == 0) {
+            points[i] = {n, n};
+            continue;
+        }
+        const Frame f = Frame::from_normal(n);
+        const double psi = kGoldenAngle * (i + 1) * 7;
+        const Vec3 tangent = f.x * static_cast<float>(std::cos(psi)) + f.y * static_cast<float>(std::sin(psi));
+        points[i] = {n,
+                     normalize(n * static_cast<float>(std::cos(view)) + tangent * static_cast<float>(std::sin(view)))};
     }
     return points;
 }

@@ -73,8 +73,10 @@ struct Comparison {
 };
 
 // K normals spread evenly over the sphere (a spherical Fibonacci lattice), each viewed
-// head-on (wo = normal).
-std::vector<ShadingPoint> sphere_points(uint32_t k);
+// head-on (wo = normal), or `view_degrees` (0 to 89.9) away from it, towards an azimuth
+// about the normal that turns by the golden angle from point to point: renderers see
+// surfaces at every angle, and a glossy lobe's axis, the mirror direction, moves with it.
+std::vector<ShadingPoint> sphere_points(uint32_t k, double view_degrees = 0);
 
 // A map compensated with each BSDF's strength: one map per distinct alpha, and the one
 // each BSDF (in ComparisonOptions::bsdfs order) samples. Building one costs a new
