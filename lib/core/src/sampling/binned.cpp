@@ -114,6 +114,15 @@ Geometry::Geometry(const EnvMap& plain, const CellGrid& grid, uint32_t g) {
             cell_radius[i] = square_radius(cell_direction[i], u0, u1, v0, v1, dir);
         }
     cell_light = cell_lights(plain, grid, cell_direction);
+    set_bins(g);
+}
+
+Geometry::Geometry(const Geometry& cells, uint32_t g)
+    : cell_direction(cells.cell_direction), cell_light(cells.cell_light), cell_radius(cells.cell_radius) {
+    set_bins(g);
+}
+
+void Geometry::set_bins(uint32_t g) {
     bin_normal.resize(size_t{g} * g);
     bin_radius.resize(bin_normal.size());
     for (uint32_t t = 0; t < g; ++t)
@@ -303,7 +312,7 @@ BinnedEnvMapView BinnedEnvMap::view() const noexcept {
 
 bool BinnedEnvMap::complete(uint32_t lobe) const noexcept {
     lobe = std::min(lobe, classes() - 1);
-    const uint32_t k = lobe == 0 ? diffuse_bins() : bins();
+    const uint32_t k = layout_.side(lobe) * layout_.side(lobe);
     for (uint32_t b = 0; b < k; ++b) {
         const BinChoice& c = layout_.choices[layout_.first(lobe) + b];
         if (!c.plain() && c.threshold > 0) return false;

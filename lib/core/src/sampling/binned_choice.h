@@ -30,18 +30,24 @@ struct Geometry {
     std::vector<float> cell_radius, bin_radius, support_radius;
 
     Geometry(const EnvMap& plain, const CellGrid& grid, uint32_t bins_per_side);
+    // Another grid of bins over the cells of `cells` (their geometry and light, which a
+    // pass over the texels gives, computed once).
+    Geometry(const Geometry& cells, uint32_t bins_per_side);
     // c_b: an upper bound of cos+(omega . n) for omega in the cell and n in the bin's support.
     float bound(uint32_t bin, size_t cell) const noexcept;
     // The cosine factor a bin's cell masses carry: for the diffuse class > 0 exactly
     // where bound() is; for a glossy class (`glossy`) > 0 everywhere.
     float weight(uint32_t bin, size_t cell, bool glossy) const noexcept;
+
+private:
+    void set_bins(uint32_t bins_per_side);
 };
 
 // The two grids of normals a layout uses: the diffuse class's and the glossy classes'.
 struct Geometries {
     Geometry diffuse, glossy;
     Geometries(const EnvMap& plain, const CellGrid& grid, const BinLayout& layout)
-        : diffuse(plain, grid, layout.diffuse_bins_per_side), glossy(plain, grid, layout.bins_per_side) {}
+        : diffuse(plain, grid, layout.diffuse_bins_per_side), glossy(diffuse, layout.bins_per_side) {}
     const Geometry& of(uint32_t lobe_class) const noexcept { return lobe_class == 0 ? diffuse : glossy; }
 };
 
