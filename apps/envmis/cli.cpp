@@ -99,6 +99,25 @@ CLI::Validator bins_validator() {
     return CLI::Validator([](std::string& text) { return bins_problem(text); }, "K");
 }
 
+CLI::Option* add_bin_cost_flag(CLI::App& app, float& cost) {
+    return app
+        .add_option("--bin-cost", cost,
+                    "With --bins: time of an estimate with a compensated bin over one with the plain density; a "
+                    "bin keeps compensation only where it is predicted that much lower in variance (equal time). "
+                    "The default is a renderer's whose rays cost little; the variance study's is about 2-3, 1 "
+                    "chooses at equal samples")
+        ->type_name("R")
+        ->capture_default_str()
+        ->check(CLI::Validator(
+            [](std::string& text) -> std::string {
+                float value = 0;
+                const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+                if (error == std::errc() && end == text.data() + text.size() && value >= 1 && value <= 100) return {};
+                return "'" + text + "': expected a number from 1 to 100";
+            },
+            "R"));
+}
+
 std::optional<Vec3> parse_direction(const std::string& text) {
     float v[3];
     const char* p = text.data();

@@ -79,6 +79,8 @@ CLI::Validator size_validator(bool single, uint32_t min_side = 1, uint32_t max_s
 // A bin count flag (--bins K): a square number g^2 with g 1 to 64, as BinnedOptions
 // takes it (bins_problem in build.h); its side g.
 CLI::Validator bins_validator();
+// --bin-cost R (BinnedOptions::cost, 1 to 100), for the commands that build bins.
+CLI::Option* add_bin_cost_flag(CLI::App& app, float& cost);
 // A direction "X,Y,Z" (a shading normal, a view): three finite numbers, not all zero,
 // normalised; empty where the text is not one. The validator refuses what it refuses.
 std::optional<Vec3> parse_direction(const std::string& text);

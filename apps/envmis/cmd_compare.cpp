@@ -44,6 +44,7 @@ struct CompareArgs {
     uint32_t spp = 1024, points = 16, threads = 0, env_samples = 1, bsdf_samples = 1, allocation_sweep = 0;
     double view_angle = 0;  // degrees between each --points normal and its view
     uint32_t bins = 0;      // --bins; 0: kDefaultBins where a -bins technique runs
+    float bin_cost = BinnedOptions{}.cost;
     uint64_t seed = 1;
     bool exact = false;
     // Library mode: hash_text of the file given, the key results_up_to_date checks (for a
@@ -132,6 +133,7 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
     sub.add_option("--bins", args.bins,
                    "Normal bins K = g*g (1 to 4096; default 121) of the -bins techniques, which sample the bin of "
                    "each point's normal; alpha per bin by exact variance unless --alpha X fixes it");
+    add_bin_cost_flag(sub, args.bin_cost);
     sub.add_option("--spp", args.spp, "Estimates per shading point, BSDF and technique (1 to 2^32-1)")
         ->capture_default_str()
         ->check(in_range(uint32_t{1}, kMaxSpp));
@@ -260,6 +262,7 @@ std::shared_ptr<const BinnedEnvMap> build_bins(const CompareArgs& args, const En
     options.bins_per_side = g;
     options.auto_alpha = bins_auto_alpha(args);
     options.alpha = args.map.alpha;
+    options.cost = args.bin_cost;
     return std::make_shared<const BinnedEnvMap>(EnvMap(plain), options, &interrupted());
 }
 

@@ -42,6 +42,7 @@ struct PrecomputeArgs {
     bool compact = false;
     uint32_t bins = 0;  // K = g^2 normal bins (sampling/binned.h); 0: a single density
     uint32_t cell_columns = 0;
+    float bin_cost = BinnedOptions{}.cost;
     uint32_t jobs = 1;
     bool force = false, recursive = false;
 };
@@ -66,6 +67,7 @@ void add_precompute_flags(CLI::App& sub, PrecomputeArgs& args) {
         ->type_name("N")
         ->check(in_range(uint32_t{0}, uint32_t{4096}))
         ->needs(bins);
+    add_bin_cost_flag(sub, args.bin_cost)->needs(bins);
     add_jobs_flag(sub, args.jobs);
     sub.add_flag("--force", args.force,
                  "Library mode: rebuild every table, also those up to date (same source bytes and options)");
@@ -80,6 +82,7 @@ BuildRequest precompute_request(const PrecomputeArgs& args) {
     BuildRequest request = build_request(args.map);
     request.bins = args.bins;
     request.cell_columns = args.cell_columns;
+    request.bin_cost = args.bin_cost;
     request.compact = args.compact;
     return request;
 }

@@ -441,10 +441,10 @@ void bind_functions(py::module_& m) {
         "load",
         [](const std::filesystem::path& path, bool compensate, const py::object& alpha, std::string axes,
            std::string mapping, const py::object& colorspace, std::string working_space, uint32_t bins,
-           uint32_t cell_columns) {
+           uint32_t cell_columns, float bin_cost) {
             BuildRequest o = build_request(compensate, alpha, std::move(axes), std::move(mapping), colorspace,
                                            std::move(working_space));
-            o.bins = bins, o.cell_columns = cell_columns;
+            o.bins = bins, o.cell_columns = cell_columns, o.bin_cost = bin_cost;
             Built built;
             {
                 py::gil_scoped_release released;
@@ -454,7 +454,8 @@ void bind_functions(py::module_& m) {
         },
         py::arg("path"), py::kw_only(), py::arg("compensate") = true, py::arg("alpha") = py::none(),
         py::arg("axes") = "z-up", py::arg("mapping") = "equirect", py::arg("colorspace") = py::none(),
-        py::arg("working_space") = "lin_rec709", py::arg("bins") = 0, py::arg("cell_columns") = 0, docs::kLoad);
+        py::arg("working_space") = "lin_rec709", py::arg("bins") = 0, py::arg("cell_columns") = 0,
+        py::arg("bin_cost") = BinnedOptions{}.cost, docs::kLoad);
     m.def(
         "load_table",
         [](const std::filesystem::path& path, bool mapped) {

@@ -161,7 +161,8 @@ alpha: compensation strength, a number >= 0, or the str "auto" (choose_alpha: th
 axes: the world frame of directions: "z-up", "y-up" or a signed permutation like "x,z,-y".
 mapping: "equirect" (latitude-longitude) or "equal-area" (octahedral, a square image).
 bins: K = g^2 (g 1 to 64) gives a BinnedEnvMap as `precompute --bins K` builds it;
-   cell_columns its cell grid's columns (0: width / 32).
+   cell_columns its cell grid's columns (0: width / 32), bin_cost what a compensated bin's
+   estimate costs over a plain one (1 to 100; `precompute --bin-cost`).
 Returns EnvMap or BinnedEnvMap. The loader's notes (a square equirect image, an OpenEXR
 data window) are issued as UserWarning. Raises ImageError (the file), TableError (a
 corrupt table), ValueError (invalid options; a map whose power overflows float32), with

@@ -159,14 +159,14 @@ std::vector<std::string> with_map_flags(std::vector<std::string> options) {
 
 INSTANTIATE_TEST_SUITE_P(
     Subcommands, CliHelp,
-    testing::Values(HelpCase{"precompute", with_map_flags({"input", "-o,--output", "--bins", "--cell-columns"})},
-                    HelpCase{"info", with_map_flags({"input"})},
-                    HelpCase{"sample", with_map_flags({"input", "-n,--count", "--seed", "-o,--output", "--normal",
-                                                       "--view", "--lobe"})},
-                    HelpCase{"visualize",
-                             with_map_flags({"input", "-o,--output", "--panel-width", "--normal", "--bins", "--lobe"})},
-                    HelpCase{"bench",
-                             {"input", "--size", "--repeats", "--samples", "--no-compensate", "--bins", "--json"}}),
+    testing::Values(
+        HelpCase{"precompute", with_map_flags({"input", "-o,--output", "--bins", "--cell-columns", "--bin-cost"})},
+        HelpCase{"info", with_map_flags({"input"})},
+        HelpCase{"sample",
+                 with_map_flags({"input", "-n,--count", "--seed", "-o,--output", "--normal", "--view", "--lobe"})},
+        HelpCase{"visualize",
+                 with_map_flags({"input", "-o,--output", "--panel-width", "--normal", "--bins", "--lobe"})},
+        HelpCase{"bench", {"input", "--size", "--repeats", "--samples", "--no-compensate", "--bins", "--json"}}),
     [](const testing::TestParamInfo<HelpCase>& info) { return info.param.subcommand; });
 
 TEST_F(Cli, TopLevelHelpListsEverySubcommand) {

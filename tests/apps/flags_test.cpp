@@ -137,6 +137,14 @@ INSTANTIATE_TEST_SUITE_P(
         BadFlag{"PrecomputeCellColumnsAbove4096",
                 {"precompute", kStudio, "-o", "out.envmis", "--bins", "64", "--cell-columns", "4097"},
                 "--cell-columns"},
+        // --bin-cost 1 to 100, with --bins only.
+        BadFlag{"PrecomputeBinCostBelow1",
+                {"precompute", kStudio, "-o", "out.envmis", "--bins", "64", "--bin-cost", "0.5"},
+                "--bin-cost"},
+        BadFlag{"PrecomputeBinCostWithoutBins",
+                {"precompute", kStudio, "-o", "out.envmis", "--bin-cost", "2"},
+                "--bin-cost"},
+        BadFlag{"CompareNanBinCost", {"compare", kStudio, "--bin-cost", "nan"}, "--bin-cost"},
         BadFlag{"InfoNegativeAlpha", {"info", kStudio, "--alpha", "-1"}, "--alpha"},
         BadFlag{"VisualizeNegativeAlpha", visualize({"--alpha", "-1"}), "--alpha"}),
     [](const testing::TestParamInfo<BadFlag>& info) { return info.param.name; });

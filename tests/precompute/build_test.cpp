@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -33,6 +34,10 @@ TEST(CanonicalOptions, EveryFieldThatChangesTheTableChangesTheString) {
     EXPECT_NE(changed([](BuildRequest& r) { r.mapping = "equal-area"; }), text);
     EXPECT_NE(changed([](BuildRequest& r) { r.working_space = "ACEScg"; }), text);
     EXPECT_NE(changed([](BuildRequest& r) { r.cell_columns = 64; }), text);
+    // The bins' cost matters only to bins.
+    EXPECT_EQ(changed([](BuildRequest& r) { r.bin_cost = 3; }), text);
+    EXPECT_NE(changed([](BuildRequest& r) { r.bins = 9, r.bin_cost = 3; }),
+              changed([](BuildRequest& r) { r.bins = 9; }));
     // Each field is a field of its own: the same value in another is another string.
     EXPECT_NE(changed([](BuildRequest& r) { r.colorspace = "ACEScg"; }),
               changed([](BuildRequest& r) { r.working_space = "ACEScg"; }));
@@ -65,6 +70,11 @@ TEST(BuildRequestChecks, SayWhatTheCommandLineSays) {
         FAIL() << "bins 8 accepted";
     } catch (const std::invalid_argument& e) {
         EXPECT_EQ(std::string(e.what()).rfind("bins: 8: expected a square number", 0), 0u) << e.what();
+    }
+    request.bins = 9, request.cell_columns = 0;
+    for (float cost : {0.5f, 101.0f, std::nanf("")}) {
+        request.bin_cost = cost;
+        EXPECT_THROW(check(request), std::invalid_argument) << cost;
     }
 }
 

@@ -443,7 +443,7 @@ def test_a_plain_map_of_a_binned_one_records_its_own_build_options(park_binned, 
     plain = park_binned.plain
     options = plain.source["build_options"]
     assert "compensate=0 alpha=-" in options and options.endswith("bins=0 cell-columns=0"), options
-    assert park_binned.source["build_options"].endswith("bins=9 cell-columns=0")
+    assert park_binned.source["build_options"].endswith("bins=9 cell-columns=0 bin-cost=1.20000005")
     park_binned.save(tmp_path / "binned.envmis")
     # A table's request is not known beyond its options: its plain map records none.
     assert envmis.load_table(tmp_path / "binned.envmis").plain.source["build_options"] == ""

@@ -79,6 +79,11 @@ std::string canonical_options(const BuildRequest& r) {
          << " mapping=" << r.mapping << " colorspace=" << (r.colorspace.empty() ? "(file)" : r.colorspace)
          << " working-space=" << r.working_space << " axes=" << r.axes << " compact=" << r.compact << " bins=" << r.bins
          << " cell-columns=" << r.cell_columns;
+    if (r.bins) {
+        char cost[32];
+        std::snprintf(cost, sizeof cost, "%.9g", r.bin_cost);
+        text << " bin-cost=" << cost;
+    }
     return text.str();
 }
 
@@ -114,12 +119,15 @@ void check(const BuildRequest& r) {
         throw std::invalid_argument("cell_columns: Value " + std::to_string(r.cell_columns) + " not in range 0 to " +
                                     std::to_string(kMaxCellColumns));
     if (r.cell_columns != 0 && r.bins == 0) throw std::invalid_argument("cell_columns: needs bins");
+    if (!(r.bin_cost >= 1 && r.bin_cost <= 100))
+        throw std::invalid_argument("bin_cost: " + std::to_string(r.bin_cost) + " not in range 1 to 100");
 }
 
 BinnedOptions binned_options(const BuildRequest& r) {
     BinnedOptions o;
     o.bins_per_side = bins_side(r.bins);
     o.cell_columns = r.cell_columns;
+    o.cost = r.bin_cost;
     o.auto_alpha = (r.alpha_auto || !r.alpha) && r.compensate;
     o.alpha = r.compensate ? r.alpha.value_or(1.0f) : 0.0f;
     return o;

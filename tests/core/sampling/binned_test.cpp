@@ -101,10 +101,70 @@ TEST(Binned, CompensatedBinsAreIncomplete) {
     EXPECT_FALSE(BinnedEnvMap(plain_map(test::sun_sky_map(64, 32)), fixed).complete(0));
 }
 
-TEST(Binned, BatchCallsAreBitIdenticalToSingleCalls) {
-    ENVMIS_SKIP_IF_FORCED_PATH_UNAVAILABLE();
-    const BinnedEnvMap map(plain_map(test::sun_sky_map(64, 32)));
+// Counts of a lobe class's plain and compensated choices.
+struct ChoiceCounts {
+    uint32_t plain = 0, compensated = 0;
+};
+ChoiceCounts choice_counts(const BinnedEnvMap& map, uint32_t lobe) {
+    const BinLayout& l = map.layout();
+    ChoiceCounts counts;
+    for (size_t b = 0; b < size_t{l.side(lobe)} * l.side(lobe); ++b)
+        ++(l.choices[l.first(lobe) + b].plain() ? counts.plain : counts.compensated);
+    return counts;
+}
+
+BinnedOptions costing(float cost) {
+    BinnedOptions o;
+    o.cost = cost;
+    return o;
+}
+
+TEST(Binned, AHigherCostKeepsCompensationOnlyInTheBinsWhereItPaysMore) {
+    const EnvMap plain = plain_map(test::sun_sky_map(64, 32));
+    for (uint32_t lobe : {0u, 1u, 2u}) {
+        uint32_t previous = ~0u;
+        for (float cost : {1.0f, 1.5f, 3.0f, 100.0f}) {
+            const ChoiceCounts c = choice_counts(BinnedEnvMap(plain, costing(cost)), lobe);
+            EXPECT_LE(c.compensated, previous) << "lobe " << lobe << " cost " << cost;
+            previous = c.compensated;
+            if (cost == 1.0f) {
+                EXPECT_GT(c.compensated, 0u) << "lobe " << lobe;
+            }
+            if (cost == 100.0f) {
+                EXPECT_EQ(c.compensated, 0u) << "lobe " << lobe;
+            }
+        }
+    }
+}
+
+TEST(Binned, APlainChoiceSamplesAndWeighsExactlyAsThePlainMapDoes) {
+    const BinnedEnvMap map(plain_map(test::sun_sky_map(64, 32)), costing(100));
     const BinnedEnvMapView view = map.view();
+    const EnvMapView plain = map.plain().view();
+    Rng rng(21);
+    for (int i = 0; i < 2000; ++i) {
+        const Vec3 n = octahedral_normal(rng.uniform(), rng.uniform());
+        const Vec2 u = rng.uniform2();
+        const float c = rng.uniform();
+        const EnvSample a = view.sample(n, i % 3, c, u), b = plain.sample(u);
+        ASSERT_EQ(a.pdf, b.pdf);
+        ASSERT_EQ(a.direction.x, b.direction.x);
+        ASSERT_EQ(a.direction.z, b.direction.z);
+        const Vec3 d = equirect_direction(rng.uniform2());
+        ASSERT_EQ(view.pdf(n, i % 3, c, d), plain.pdf(d));
+    }
+}
+
+TEST(Binned, TablesMixingPlainAndCompensatedBinsFollowTheirPdf) {
+    const BinnedEnvMap map(plain_map(test::sun_sky_map(64, 32)), costing(1.5f));
+    const ChoiceCounts mixed = choice_counts(map, 1);
+    ASSERT_GT(mixed.plain, 0u);
+    ASSERT_GT(mixed.compensated, 0u);
+    uint64_t seed = 300;
+    for (Vec3 n : test_normals(map.layout().side(1))) expect_samples_follow_pdf(map, n, 1, ++seed);
+}
+
+void expect_batch_bit_identical(const BinnedEnvMapView& view) {
     constexpr uint32_t n = 257;
     Rng rng(4);
     float nx[n], ny[n], nz[n], c[n], ux[n], uy[n], dx[n], dy[n], dz[n];
@@ -131,6 +191,14 @@ TEST(Binned, BatchCallsAreBitIdenticalToSingleCalls) {
         const EnvMapView::Lookup l = view.lookup({nx[i], ny[i], nz[i]}, 1, c[i], {dx[i], dy[i], dz[i]});
         ASSERT_EQ(l.pdf, pdf[i]);
         ASSERT_EQ(l.radiance.b, b[i]);
+    }
+}
+
+TEST(Binned, BatchCallsAreBitIdenticalToSingleCalls) {
+    ENVMIS_SKIP_IF_FORCED_PATH_UNAVAILABLE();
+    for (float cost : {1.0f, 1.5f}) {  // compensated bins; plain and compensated ones mixed
+        const BinnedEnvMap map(plain_map(test::sun_sky_map(64, 32)), costing(cost));
+        expect_batch_bit_identical(map.view());
     }
 }
 
@@ -326,6 +394,8 @@ TEST(Binned, RejectsCompensatedMapsAndInvalidOptionsAndLayouts) {
     o = {};
     o.candidates = {-1};
     EXPECT_THROW(BinnedEnvMap(plain, o), std::invalid_argument);
+    for (float cost : {0.5f, 101.0f, std::nanf("")})
+        EXPECT_THROW(BinnedEnvMap(plain, costing(cost)), std::invalid_argument);
     BinLayout layout = BinnedEnvMap(plain).layout();
     layout.choices.pop_back();
     EXPECT_THROW(BinnedEnvMap(plain, layout), std::invalid_argument);

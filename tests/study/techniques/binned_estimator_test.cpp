@@ -84,6 +84,33 @@ TEST(BinnedEstimator, IsUnbiasedOnALossyExrWithNegativePixels) {
     expect_unbiased("city.exr", load_plain("city.exr"), 2000);
 }
 
+// Bins that a cost makes plain sample through the plain map, in batches through its
+// batch functions where every lane's bin is plain (estimator.cpp, BinLanes).
+TEST(BinnedEstimator, BatchesAreUnbiasedWithPlainAndCompensatedBinsMixed) {
+    const EnvMap plain = plain_map(test::sun_sky_map(256, 128));
+    uint64_t seed = 500;
+    for (float cost : {1.5f, 100.0f}) {
+        BinnedOptions options;
+        options.cost = cost;
+        const BinnedEnvMap binned(EnvMap(plain), options);
+        const DirectLightingEstimator estimator(binned, Technique::parse("mis-balance-bins"));
+        for (const Bsdf& bsdf : kBsdfs)
+            for (const ShadingPoint& p : points()) {
+                const double reference = reflected_radiance(plain, bsdf, p, {1e-5, 32}).luminance;
+                Pcg32 rng(seed++);
+                PointState state;
+                RunningStats stats;
+                std::vector<Rgb> out(250);
+                for (int i = 0; i < 160; ++i) {
+                    estimator.estimate(p, bsdf, rng, state, out);
+                    for (const Rgb& e : out) stats.add(luminance(e, plain.options().luma));
+                }
+                EXPECT_NEAR(stats.mean(), reference, 4 * standard_error(binned, bsdf, p, stats) + 1e-6 * reference)
+                    << "cost " << cost << " " << bsdf.name() << " normal.z=" << p.normal.z;
+            }
+    }
+}
+
 TEST(BinnedEstimator, MapsWithBlackBesideLitGiveFiniteEstimatesNeverNaN) {
     for (const RgbImage& image : {test::single_texel_map(64, 32, 10, 3), test::softboxes_map(128, 64),
                                   test::black_ground_map(128, 64, 5), test::sparse_map(96, 48, 6, 0.01f)}) {
@@ -105,8 +132,7 @@ TEST(BinnedEstimator, MapsWithBlackBesideLitGiveFiniteEstimatesNeverNaN) {
     }
 }
 
-TEST(BinnedEstimator, ManyEstimatesAtOnceEqualTheSameEstimatesOneAtATime) {
-    const BinnedEnvMap binned{plain_map(test::sun_sky_map(128, 64))};
+void expect_batches_equal_single(const BinnedEnvMap& binned) {
     for (const Bsdf& bsdf : kBsdfs)
         for (const ShadingPoint& point : points())
             for (const Allocation a : {Allocation{1, 1}, Allocation{2, 3}, Allocation{5, 4}})
@@ -116,6 +142,14 @@ TEST(BinnedEstimator, ManyEstimatesAtOnceEqualTheSameEstimatesOneAtATime) {
                         estimator, point, bsdf,
                         t.name() + " " + bsdf.name() + " " + std::to_string(a.env) + "+" + std::to_string(a.bsdf));
                 }
+}
+
+TEST(BinnedEstimator, ManyEstimatesAtOnceEqualTheSameEstimatesOneAtATime) {
+    for (float cost : {1.2f, 100.0f}) {  // some bins plain; every bin plain
+        BinnedOptions options;
+        options.cost = cost;
+        expect_batches_equal_single(BinnedEnvMap(plain_map(test::sun_sky_map(128, 64)), options));
+    }
 }
 
 TEST(BinnedEstimator, ABinsTechniqueNeedsABinnedMapAndOthersRefuseOne) {

@@ -189,6 +189,8 @@ void check_options(const BinnedOptions& o) {
     if (o.auto_alpha ? (o.candidates.empty() || !std::all_of(o.candidates.begin(), o.candidates.end(), valid_alpha))
                      : !valid_alpha(o.alpha))
         throw std::invalid_argument("bin alphas must be finite, 0 to 1000");
+    if (!(o.cost >= 1 && o.cost <= 100))
+        throw std::invalid_argument("the binned cost must be 1 to 100, got " + std::to_string(o.cost));
 }
 
 // A bin's cells form one CDF, whose uint16 guide entries name at most 65536 cells.
@@ -257,6 +259,8 @@ void BinnedEnvMap::build(const std::vector<std::vector<float>>& masses, StopFlag
                         plain_.options().mapping);
     column_edges_ = grid.column_edges;
     row_edges_ = grid.row_edges;
+    plain_bins_.clear();
+    for (const BinChoice& c : layout_.choices) plain_bins_.push_back(c.plain() ? 1 : 0);
     const size_t cells = size_t{grid.cw} * grid.ch;
     cell_start_.resize(cells * masses.size());
     cell_guide_.resize(cells * masses.size());
@@ -301,6 +305,7 @@ BinnedEnvMapView BinnedEnvMap::view() const noexcept {
             rows_guide_.data(),
             column_edges_.data(),
             row_edges_.data(),
+            plain_bins_.data(),
             layout_.cell_columns,
             layout_.cell_rows,
             classes(),
@@ -323,7 +328,7 @@ bool BinnedEnvMap::complete(uint32_t lobe) const noexcept {
 size_t BinnedEnvMap::bytes() const noexcept {
     return (cell_start_.size() + rows_start_.size()) * sizeof(uint32_t) +
            (cell_guide_.size() + rows_guide_.size()) * sizeof(uint16_t) +
-           (column_edges_.size() + row_edges_.size()) * sizeof(uint32_t);
+           (column_edges_.size() + row_edges_.size()) * sizeof(uint32_t) + plain_bins_.size();
 }
 
 namespace {
@@ -385,20 +390,25 @@ void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axe
         for (uint32_t j = 0; j < m; ++j) {
             const uint32_t i = first + j;
             bins[j] = env.bin({axes.x[i], axes.y[i], axes.z[i]}, lobe, choices[i]);
+            if (bins[j].plain) continue;
             const CdfView& c = bins[j].cells;
             const uint32_t k = c.bucket(in.x[i]);
             ENVMIS_PREFETCH(c.guide + k);
             ENVMIS_PREFETCH(c.start + k);
         }
         for (uint32_t j = 0; j < m; ++j) {
+            if (bins[j].plain) continue;
             cells[j] = bins[j].find_cell(in.x[first + j]);
             prefetch_row(env, cells[j], in.y[first + j]);
         }
-        for (uint32_t j = 0; j < m; ++j) rows[j] = bins[j].find_row(cells[j], in.y[first + j]);
-        for (uint32_t j = 0; j < m; ++j) texels[j] = bins[j].find_texel(cells[j], rows[j]);
+        for (uint32_t j = 0; j < m; ++j)
+            if (!bins[j].plain) rows[j] = bins[j].find_row(cells[j], in.y[first + j]);
+        for (uint32_t j = 0; j < m; ++j)
+            if (!bins[j].plain) texels[j] = bins[j].find_texel(cells[j], rows[j]);
         for (uint32_t j = 0; j < m; ++j) {
             const uint32_t i = first + j;
-            const EnvSample s = bins[j].sample_at(cells[j], rows[j], texels[j]);
+            const EnvSample s =
+                bins[j].plain ? env.plain.sample({in.x[i], in.y[i]}) : bins[j].sample_at(cells[j], rows[j], texels[j]);
             out.x[i] = s.direction.x, out.y[i] = s.direction.y, out.z[i] = s.direction.z, out.pdf[i] = s.pdf;
             out.r[i] = s.radiance.r, out.g[i] = s.radiance.g, out.b[i] = s.radiance.b;
             if (out.u) out.u[i] = s.uv.x;

@@ -305,7 +305,9 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
                     p[j] = probabilities(mass);
                 }
                 std::vector<double> log_ratio(count, 0);
+                double weights = 0;
                 for (const WeightedNormal& at : bin_samples(b, g)) {
+                    weights += at.weight;
                     const Lobe lobe = lobe_at(nodes, at.normal, exponent);
                     const double base = mis_variance(nodes, lobe, plain_p, hist.total_l);
                     for (size_t j = 0; j < count; ++j) {
@@ -315,7 +317,7 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
                     }
                 }
                 const size_t best = std::min_element(log_ratio.begin(), log_ratio.end()) - log_ratio.begin();
-                choices[shape.first(c) + b] = log_ratio[best] < -1e-6
+                choices[shape.first(c) + b] = log_ratio[best] / weights < -std::log(options.cost) - 1e-6
                                                   ? BinChoice{alphas[best], thresholds[glossy][b * count + best]}
                                                   : BinChoice{-1, 0};
             }

@@ -127,13 +127,20 @@ constexpr uint32_t kLanes = 32;
 // as a single estimate does, then samples and weighs with it alone.
 struct BinLanes {
     const BinnedEnvMapView* map;
-    Vec3 axis;
-    uint32_t lobe;
+    BinBlend blend;  // map->blend(axis, lobe) of the point
     mutable BinView bins[kLanes];
 
-    void pick(uint32_t lane, float choice) const noexcept { bins[lane] = map->bin(axis, lobe, choice); }
+    void pick(uint32_t lane, float choice) const noexcept { bins[lane] = map->bin(blend, choice); }
+    // Lanes whose bins are all plain take the plain map's batch functions (bit-identical
+    // to its single calls), so that a plain bin costs what the plain map does.
+    bool plain(uint32_t n) const noexcept {
+        for (uint32_t l = 0; l < n; ++l)
+            if (!bins[l].plain) return false;
+        return true;
+    }
 };
 void sample_lanes(const BinLanes& env, PointArrays u, SampleArrays out, uint32_t n) noexcept {
+    if (env.plain(n)) return sample_many(env.map->plain, u, out, n);
     for (uint32_t l = 0; l < n; ++l) {
         const EnvSample e = env.bins[l].sample({u.x[l], u.y[l]});
         out.x[l] = e.direction.x, out.y[l] = e.direction.y, out.z[l] = e.direction.z, out.pdf[l] = e.pdf;
@@ -141,6 +148,7 @@ void sample_lanes(const BinLanes& env, PointArrays u, SampleArrays out, uint32_t
     }
 }
 void lookup_lanes(const BinLanes& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
+    if (env.plain(n)) return lookup_many(env.map->plain, in, out, n);
     for (uint32_t l = 0; l < n; ++l) {
         const EnvMapView::Lookup e = env.bins[l].lookup({in.x[l], in.y[l], in.z[l]});
         out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b, out.pdf[l] = e.pdf;
@@ -468,7 +476,7 @@ void DirectLightingEstimator::estimate(const ShadingPoint& point, const Bsdf& bs
     };
     if (technique_.bins) {
         const uint32_t lobe = binned_->lobe_class(bsdf.phong_exponent());
-        run(BinLanes{&binned_view_, lobe_axis(lobe, point.normal, point.wo), lobe, {}});
+        run(BinLanes{&binned_view_, binned_view_.blend(lobe_axis(lobe, point.normal, point.wo), lobe), {}});
     } else {
         run(env_);
     }

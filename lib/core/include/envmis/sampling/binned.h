@@ -45,8 +45,12 @@
 // variance of 1 + 1 balance MIS, view along the normal, at nine normals of the bin's
 // blend support (weighted as the blend weighs them), on a 64-column copy of the map
 // (texels grouped inside cells), over that of the plain density; the candidate with the
-// lowest weighted geometric mean wins, and the plain density (alpha < 0 in BinChoice)
-// where no candidate is predicted better. docs/table-format.md defines every quantity
+// lowest weighted geometric mean wins where that mean is below 1 / cost (BinnedOptions:
+// what a binned estimate costs over a plain one), the plain density (alpha < 0 in
+// BinChoice) elsewhere, so that each bin holds what is predicted best at equal time. A
+// plain bin samples and weighs through the plain map's functions, at their cost (and the
+// study's batch paths take the plain map's SIMD kernels when every lane's bin is plain).
+// docs/table-format.md defines every quantity
 // (centres, radii, bounds, thresholds, the choice, the blend) so that a bin's density
 // can be recomputed independently.
 //
@@ -213,6 +217,14 @@ struct BinnedOptions {
     bool auto_alpha = true;
     float alpha = 1;
     std::vector<float> candidates = {0, 0.5f, 1, 1.5f, 2, 3};
+    // Time of an estimate that samples a compensated bin over one that samples the plain
+    // density (whole time per estimate; 1 to 100): auto mode keeps a candidate only where
+    // its predicted variance is lower than the plain density's by more than this factor,
+    // so that each bin holds what is predicted best at equal time. The default is that of
+    // a renderer whose rays cost little (the example renderer's); the variance study's
+    // estimates, which do nothing but sample and shade, cost more than twice as much with
+    // bins (docs/performance.md); 1 chooses at equal samples.
+    float cost = 1.2f;
 };
 
 // What one (class, bin) samples. alpha < 0 marks the plain density (no compensation
@@ -252,6 +264,9 @@ struct BinView {
     // Over all cells of the grid, row-major (cell cy cells_w + cx): one CDF rather than a
     // marginal and a conditional, so that a sample waits on two dependent loads, not four.
     CdfView cells;
+    // A plain choice (BinChoice::plain): the bin samples and weighs through the plain
+    // map's own functions, at the plain map's cost, its cells unused.
+    bool plain = false;
 
     // sample(u) in stages, each ending on prefetches of what the next one loads, so that
     // sample_many can interleave the stages of several samples (bit-identical to sample).
@@ -290,6 +305,7 @@ struct BinnedEnvMapView {
     const uint16_t* rows_guide = nullptr;
     const uint32_t* column_edges = nullptr;  // cells_w + 1 texel columns
     const uint32_t* row_edges = nullptr;     // cells_h + 1 texel rows
+    const uint8_t* plain_bins = nullptr;     // per (class, bin): 1 for a plain choice
     uint32_t cells_w = 0, cells_h = 0, classes = 0;
     uint32_t bins_per_side = 0, bins = 0;                  // of each glossy class (1 and up)
     uint32_t diffuse_bins_per_side = 0, diffuse_bins = 0;  // of the diffuse class (0)
@@ -299,8 +315,18 @@ struct BinnedEnvMapView {
     // (normal_blend). A renderer draws `choice` once per shading point and keeps the
     // returned view for its light samples and its BSDF samples' MIS weights alike.
     ENVMIS_HD BinView bin(Vec3 axis, uint32_t lobe, float choice) const noexcept {
-        const uint32_t b = pick_bin(normal_blend(to_canonical(plain.axes, axis), side(lobe)), choice);
-        return bin_at(class_bin(lobe, b));
+        return bin(blend(axis, lobe), choice);
+    }
+    // The same in two steps, for a shading point that draws several choices: the bins
+    // around `axis` (their indices among all, class_bin) with their weights, and the
+    // one a choice picks among them.
+    ENVMIS_HD BinBlend blend(Vec3 axis, uint32_t lobe) const noexcept {
+        BinBlend b = normal_blend(to_canonical(plain.axes, axis), side(lobe));
+        for (uint32_t& k : b.bin) k = class_bin(lobe, k);
+        return b;
+    }
+    ENVMIS_HD BinView bin(const BinBlend& blend, float choice) const noexcept {
+        return bin_at(pick_bin(blend, choice));
     }
     // The bin whose square holds `axis`, without blending (for showing one bin's density).
     ENVMIS_HD BinView nearest_bin(Vec3 axis, uint32_t lobe) const noexcept {
@@ -315,7 +341,7 @@ struct BinnedEnvMapView {
     ENVMIS_HD BinView bin_at(uint32_t class_bin) const noexcept {
         const uint32_t cells = cells_w * cells_h;
         const size_t at = size_t{class_bin} * cells;
-        return {this, {cell_start + at, cell_guide + at, cells}};
+        return {this, {cell_start + at, cell_guide + at, cells}, plain_bins[class_bin] != 0};
     }
     ENVMIS_HD EnvSample sample(Vec3 axis, uint32_t lobe, float choice, Vec2 u) const noexcept {
         return bin(axis, lobe, choice).sample(u);
@@ -402,6 +428,7 @@ private:
     LargeVector<uint32_t> cell_start_, rows_start_;
     LargeVector<uint16_t> cell_guide_, rows_guide_;
     std::vector<uint32_t> column_edges_, row_edges_;
+    std::vector<uint8_t> plain_bins_;
     double choice_seconds_ = 0;
 };
 
@@ -474,6 +501,7 @@ ENVMIS_HD inline EnvSample BinView::sample_at(const Cell& c, const Row& r, const
 
 // u.x picks the cell and, by its offset there, the texel inside the row; u.y the row.
 ENVMIS_HD inline EnvSample BinView::sample(Vec2 u) const noexcept {
+    if (plain) return map->plain.sample(u);
     const Cell c = find_cell(u.x);
     prefetch_row(*map, c, u.y);
     const Row r = find_row(c, u.y);
@@ -482,6 +510,7 @@ ENVMIS_HD inline EnvSample BinView::sample(Vec2 u) const noexcept {
 
 ENVMIS_HD inline float BinView::pdf_uv(Vec2 uv) const noexcept {
     const BinnedEnvMapView& m = *map;
+    if (plain) return m.plain.pdf_uv(uv);
     const uint32_t x = detail::cell_of(uv.x, m.plain.distribution.w), y = detail::cell_of(uv.y, m.plain.distribution.h);
     const uint32_t cx = m.cell_column(x), cy = m.cell_row(y);
     const uint32_t row_width = m.cell_rows(cx, cy).width(y - m.row_edges[cy]);

@@ -30,9 +30,10 @@ struct BuildRequest {
     std::string mapping = "equirect";  // or "equal-area" (a square image)
     std::string colorspace;            // input colour space; empty: from the file (an array: the working space)
     std::string working_space = "lin_rec709";
-    uint32_t bins = 0;          // K = g^2 normal bins (binned.h); 0: one density
-    uint32_t cell_columns = 0;  // of the bins' cell grid; 0: width / 32
-    bool compact = false;       // RGBE radiance in the table (TableEncoding::compact); the build ignores it
+    uint32_t bins = 0;                      // K = g^2 normal bins (binned.h); 0: one density
+    uint32_t cell_columns = 0;              // of the bins' cell grid; 0: width / 32
+    float bin_cost = BinnedOptions{}.cost;  // BinnedOptions::cost
+    bool compact = false;                   // RGBE radiance in the table (TableEncoding::compact); the build ignores it
 };
 
 inline constexpr uint32_t kMaxCellColumns = 4096;
@@ -51,7 +52,7 @@ std::string bins_problem(std::string_view text);
 
 // Throws std::invalid_argument naming the field ("bins: 5: expected a square number
 // ...", "alpha: ...", "cell_columns: Value 5000 not in range 0 to 4096", "cell_columns:
-// needs bins") where the request is not one that precompute accepts.
+// needs bins", "bin_cost: ...") where the request is not one that precompute accepts.
 void check(const BuildRequest& request);
 
 // The bins that precompute --bins builds for the request: alpha auto per bin and lobe
