@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -32,6 +33,90 @@ struct ReportArgs {
     bool no_timing = false;  // leave out what measured time decides (--no-timing)
 };
 
+// The schema of what report reads from a compare run (each field it reads, of the type
+// it reads it as): anything else is refused naming the file and the field, before any
+// of it is used.
+struct Schema {
+    const std::string& path;
+
+    void require(bool ok, const std::string& field, const char* expected) const {
+        if (!ok) throw std::runtime_error(path + ": " + field + ": expected " + expected);
+    }
+    // Optional fields that, where present, have the type given.
+    void strings(const json& o, const std::string& where, std::initializer_list<const char*> keys) const {
+        for (const char* k : keys) require(!o.contains(k) || o[k].is_string(), where + "." + k, "a string");
+    }
+    // A number, or null: what compare writes for a value that is not finite, read as NaN.
+    void numbers(json& o, const std::string& where, std::initializer_list<const char*> keys) const {
+        for (const char* k : keys) {
+            if (!o.contains(k)) continue;
+            if (o[k].is_null()) o[k] = std::numeric_limits<double>::quiet_NaN();
+            require(o[k].is_number(), where + "." + k, "a number");
+        }
+    }
+    void integers(const json& o, const std::string& where, std::initializer_list<const char*> keys) const {
+        for (const char* k : keys) require(!o.contains(k) || o[k].is_number_integer(), where + "." + k, "an integer");
+    }
+    // Required fields.
+    void has(const json& o, const std::string& where, std::initializer_list<const char*> keys) const {
+        for (const char* k : keys) require(o.contains(k), where + "." + k, "present");
+    }
+    // The array at `key` (where present), each element an object; calls check on each.
+    template <class Check>
+    void objects(json& run, const char* key, Check&& check) const {
+        if (!run.contains(key)) return;
+        require(run[key].is_array(), key, "an array");
+        for (size_t i = 0; i < run[key].size(); ++i) {
+            const std::string where = std::string(key) + "[" + std::to_string(i) + "]";
+            require(run[key][i].is_object(), where, "an object");
+            check(run[key][i], where);
+        }
+    }
+    void number_array(json& o, const std::string& where, const char* key) const {
+        if (!o.contains(key)) return;
+        json& a = o[key];
+        require(a.is_array(), where + "." + key, "an array of numbers");
+        for (json& v : a) {
+            if (v.is_null()) v = std::numeric_limits<double>::quiet_NaN();
+            require(v.is_number(), where + "." + key, "an array of numbers");
+        }
+    }
+};
+
+void check_schema(json& j, const std::string& path) {
+    const Schema s{path};
+    s.require(j["inputs"].is_object(), "inputs", "an object");
+    s.strings(j["inputs"], "inputs", {"map"});
+    s.numbers(j["inputs"], "inputs", {"alpha"});
+    s.integers(j["inputs"], "inputs", {"width", "height", "points_done", "spp", "env_samples", "bsdf_samples"});
+    s.objects(j, "results", [&](json& r, const std::string& where) {
+        s.has(r, where, {"bsdf", "technique", "variance_ratio_vs_mis"});
+        s.strings(r, where, {"bsdf", "technique"});
+        s.has(r, where, {"mean", "reference", "variance", "std_error", "rel_mse", "ns_per_estimate", "efficiency"});
+        s.numbers(r, where,
+                  {"mean", "reference", "variance", "std_error", "rel_mse", "ns_per_estimate", "efficiency",
+                   "variance_ratio_vs_mis"});
+        s.number_array(r, where, "point_variances");
+        s.number_array(r, where, "point_variance_rel_se");
+        s.require(
+            r.contains("point_variances") == r.contains("point_variance_rel_se") &&
+                (!r.contains("point_variances") || r["point_variances"].size() == r["point_variance_rel_se"].size()),
+            where + ".point_variance_rel_se", "one per point of point_variances");
+    });
+    s.objects(j, "sweep_best", [&](json& b, const std::string& where) {
+        s.has(b, where, {"bsdf", "best_alpha", "best_ratio"});
+        if (b.contains("auto_alpha")) s.has(b, where, {"auto_vs_best", "auto_vs_alpha0"});
+        s.strings(b, where, {"bsdf"});
+        s.numbers(b, where, {"best_alpha", "best_ratio", "auto_alpha", "auto_vs_best", "auto_vs_alpha0"});
+    });
+    s.objects(j, "allocation", [&](json& a, const std::string& where) {
+        s.has(a, where, {"bsdf", "technique", "efficiency", "env_samples", "bsdf_samples"});
+        s.strings(a, where, {"bsdf", "technique"});
+        s.numbers(a, where, {"efficiency"});
+        s.integers(a, where, {"env_samples", "bsdf_samples"});
+    });
+}
+
 // The results of one compare run; empty for the summary of a library run
 // (envmis compare --out-dir DIR writes it next to the maps' JSON, so DIR/*.json holds it).
 std::optional<json> read_results(const std::string& path) {
@@ -48,6 +133,7 @@ std::optional<json> read_results(const std::string& path) {
         (j.contains("results") && j["results"].is_array()) || j.contains("sweep") || j.contains("allocation");
     if (!j.contains("inputs") || !measured)
         throw std::runtime_error(path + ": not the JSON of envmis compare (no inputs and results)");
+    check_schema(j, path);
     return j;
 }
 

@@ -131,4 +131,54 @@ TEST_F(Report, RejectsFilesThatAreNotCompareResults) {
     EXPECT_FALSE(fs::exists(dir_ / "r.md"));
 }
 
+// Each field report reads, missing or of another type: refused naming the file and the
+// field, with no report and no temporary file left (an empty result once read past a buffer).
+TEST_F(Report, RejectsCompareResultsWithAMissingOrMistypedFieldNamingIt) {
+    const json good = json::parse(read(write_run("good", {{"mis-balance", 1.0}})));
+    const auto broken = [&](auto change) {
+        json j = good;
+        change(j);
+        return j;
+    };
+    const std::pair<json, std::string> cases[] = {
+        {json::parse(R"({"inputs": {}, "results": [{}]})"), "results[0].bsdf: expected present"},
+        {broken([](json& j) { j["results"][0] = 3; }), "results[0]: expected an object"},
+        {broken([](json& j) { j["results"][0]["bsdf"] = 7; }), "results[0].bsdf: expected a string"},
+        {broken([](json& j) { j["results"][0]["mean"] = "high"; }), "results[0].mean: expected a number"},
+        {broken([](json& j) { j["results"][0]["point_variance_rel_se"] = {0.1}; }),
+         "results[0].point_variance_rel_se: expected one per point"},
+        {broken([](json& j) { j["inputs"] = 5; }), "inputs: expected an object"},
+        {broken([](json& j) { j["inputs"]["spp"] = "many"; }), "inputs.spp: expected an integer"},
+        {broken([](json& j) {
+             j["sweep_best"] = {{{"bsdf", "lambert"}, {"best_alpha", 1}, {"best_ratio", 1}, {"auto_alpha", 1}}};
+         }),
+         "sweep_best[0].auto_vs_best: expected present"},
+        {broken([](json& j) {
+             j["allocation"] = {{{"bsdf", "lambert"},
+                                 {"technique", "mis-balance"},
+                                 {"efficiency", 1},
+                                 {"env_samples", "1"},
+                                 {"bsdf_samples", 1}}};
+         }),
+         "allocation[0].env_samples: expected an integer"},
+    };
+    for (const auto& [j, message] : cases) {
+        std::ofstream(dir_ / "bad.json") << j.dump();
+        std::string out;
+        EXPECT_NE(run((dir_ / "bad.json").string() + " -o " + (dir_ / "r.md").string(), &out), 0) << j.dump();
+        EXPECT_NE(out.find("bad.json: " + message), std::string::npos) << out;
+        for (const auto& entry : fs::directory_iterator(dir_))
+            EXPECT_EQ(entry.path().extension() == ".md", false) << entry.path();
+    }
+}
+
+TEST_F(Report, ReadsNullFiguresAsNotANumber) {
+    json j = json::parse(read(write_run("nulls", {{"mis-balance", 1.0}, {"env", 2.0}})));
+    j["results"][1]["efficiency"] = nullptr;
+    std::ofstream(dir_ / "nulls.json") << j.dump();
+    std::string out;
+    EXPECT_EQ(run((dir_ / "nulls.json").string() + " -o " + (dir_ / "r.md").string(), &out), 0) << out;
+    EXPECT_NE(read(dir_ / "r.md").find("nan"), std::string::npos);
+}
+
 }  // namespace
