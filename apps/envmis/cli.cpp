@@ -37,7 +37,8 @@ void add_map_flags(CLI::App& app, MapFlags& flags) {
            "variance (alpha.h; compare chooses per BSDF)")
         ->type_name("ALPHA|auto")
         ->default_str("1")
-        ->check(alpha_value);
+        ->check(alpha_value)
+        ->excludes("--no-compensate");
     app.add_option("--mapping", flags.mapping,
                    "Image mapping: equirect (latitude-longitude) or equal-area (octahedral, square)")
         ->capture_default_str()
@@ -93,6 +94,10 @@ CLI::Validator size_validator(bool single, uint32_t min_side, uint32_t max_side)
             return "'" + text + "': expected " + expected;
         },
         "");
+}
+
+CLI::Validator non_empty() {
+    return CLI::Validator([](std::string& text) { return text.empty() ? "expected a path, got ''" : ""; }, "");
 }
 
 CLI::Validator bins_validator() {
@@ -454,6 +459,36 @@ void Progress::update(uint64_t done) {
     shown_ = percent;
     std::fprintf(stderr, terminal_ ? "\r%s %3d%%" : "%s %3d%%\n", label_.c_str(), percent);
     std::fflush(stderr);
+}
+
+namespace {
+
+// One file: by device and inode where both exist, else by their absolute paths with
+// symbolic links resolved as far as they exist.
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
+    std::error_code ec;
+    if (const bool same = std::filesystem::equivalent(a, b, ec); !ec) return same;
+    std::error_code ea, eb;
+    const std::filesystem::path ca = std::filesystem::weakly_canonical(std::filesystem::absolute(a, ea), ea),
+                                cb = std::filesystem::weakly_canonical(std::filesystem::absolute(b, eb), eb);
+    return !ea && !eb && ca == cb;
+}
+
+}  // namespace
+
+void check_outputs(const std::vector<std::filesystem::path>& inputs, const std::vector<NamedOutput>& outputs) {
+    for (size_t i = 0; i < outputs.size(); ++i) {
+        const NamedOutput& out = outputs[i];
+        if (out.path.empty()) continue;
+        for (const std::filesystem::path& input : inputs)
+            if (same_file(out.path, input))
+                throw std::runtime_error(out.flag + " " + out.path.string() + ": is the input " + input.string() +
+                                         "; refusing to overwrite an input (name another output)");
+        for (size_t j = 0; j < i; ++j)
+            if (!outputs[j].path.empty() && same_file(out.path, outputs[j].path))
+                throw std::runtime_error(out.flag + " " + out.path.string() + ": is also " + outputs[j].flag +
+                                         "'s file; two outputs cannot share a file");
+    }
 }
 
 void prepare_output(const std::filesystem::path& path) {

@@ -79,6 +79,8 @@ CLI::Validator size_validator(bool single, uint32_t min_side = 1, uint32_t max_s
 // A bin count flag (--bins K): a square number g^2 with g 1 to 64, as BinnedOptions
 // takes it (bins_problem in build.h); its side g.
 CLI::Validator bins_validator();
+// An output path flag given an empty value ("-o ''") is refused, not taken as "none".
+CLI::Validator non_empty();
 // --bin-cost R (BinnedOptions::cost, 1 to 100), for the commands that build bins.
 CLI::Option* add_bin_cost_flag(CLI::App& app, float& cost);
 // A direction "X,Y,Z" (a shading normal, a view): three finite numbers, not all zero,
@@ -188,6 +190,16 @@ private:
 // one line on stderr for each ("envmis: removed ..."). The writer itself does both again
 // (silently), for the files that commands write into folders (--plots, --images).
 void prepare_output(const std::filesystem::path& path);
+
+// An output named by a flag (`flag`: "-o", "--json", ...); an empty path is one not given.
+struct NamedOutput {
+    std::string flag;
+    std::filesystem::path path;
+};
+// Throws std::runtime_error, before any work, where an output is one of the run's inputs
+// (the same file by device and inode: through symbolic and hard links) or two outputs
+// are one file: writing would destroy an input, or one output would replace another.
+void check_outputs(const std::vector<std::filesystem::path>& inputs, const std::vector<NamedOutput>& outputs);
 
 // Standard output whose every write is checked (a full disk, /dev/full): a report that
 // did not arrive is an error. While one exists, std::cout writes through it to C's stdout

@@ -100,14 +100,6 @@ struct Outcome {
     size_t alphas_swept = 0;  // --alpha-sweep's values with auto's choices and 0
 };
 
-Vec3 parse_vector(const std::string& text, const char* what) {
-    float x = 0, y = 0, z = 0;
-    char tail = 0;
-    if (std::sscanf(text.c_str(), "%f,%f,%f%c", &x, &y, &z, &tail) != 3 || !(x * x + y * y + z * z > 0))
-        throw std::runtime_error(std::string(what) + " '" + text + "': expected a non-zero vector x,y,z");
-    return normalize(Vec3{x, y, z});
-}
-
 std::vector<std::string> split(const std::string& text) {
     std::vector<std::string> items;
     std::stringstream in(text);
@@ -132,7 +124,9 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
         "one-sample[-comp])");
     sub.add_option("--bins", args.bins,
                    "Normal bins K = g*g (1 to 4096; default 121) of the -bins techniques, which sample the bin of "
-                   "each point's normal; alpha per bin by exact variance unless --alpha X fixes it");
+                   "each point's normal; alpha per bin by exact variance unless --alpha X fixes it")
+        ->type_name("K")
+        ->check(bins_validator());
     add_bin_cost_flag(sub, args.bin_cost);
     sub.add_option("--spp", args.spp, "Estimates per shading point, BSDF and technique (1 to 2^32-1)")
         ->capture_default_str()
@@ -148,11 +142,15 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
                    "Worker threads, 1 to 1024, at most 4 per hardware thread (more are reduced to that, with a "
                    "note; default: all cores); results do not depend on it")
         ->check(in_range(uint32_t{1}, kMaxThreads));
-    sub.add_option("--normal", args.normal, "One shading point with this normal x,y,z");
-    sub.add_option("--view", args.view, "View direction x,y,z for --normal (default: the normal)");
+    CLI::Option* normal = sub.add_option("--normal", args.normal, "One shading point with this normal x,y,z")
+                              ->check(direction_validator());
+    sub.add_option("--view", args.view, "View direction x,y,z for --normal (default: the normal)")
+        ->check(direction_validator())
+        ->needs(normal);
     sub.add_option("--points", args.points, "Shading points: K normals spread evenly over the sphere (1 to 10^6)")
         ->capture_default_str()
-        ->check(in_range(uint32_t{1}, kMaxPoints));
+        ->check(in_range(uint32_t{1}, kMaxPoints))
+        ->excludes(normal);
     sub.add_option("--view-angle", args.view_angle,
                    "Degrees (0 to 89.9) between each --points normal and its view, towards azimuths that turn by "
                    "the golden angle from point to point (default: 0, seen head-on)")
@@ -173,12 +171,14 @@ void add_output_flags(CLI::App& sub, CompareArgs& args) {
                    "Estimates per pixel of the reference render (mis-power; 1 to 2^20)")
         ->capture_default_str()
         ->check(in_range(uint32_t{1}, kMaxReferenceSpp));
-    sub.add_option("--json", args.json, "Write the results as JSON");
-    sub.add_option("--csv", args.csv, "Write the results as CSV");
-    sub.add_option("--images", args.images, "Folder for EXR and PNG pictures (renders, errors, montage)");
+    sub.add_option("--json", args.json, "Write the results as JSON")->check(non_empty());
+    sub.add_option("--csv", args.csv, "Write the results as CSV")->check(non_empty());
+    sub.add_option("--images", args.images, "Folder for EXR and PNG pictures (renders, errors, montage)")
+        ->check(non_empty());
     sub.add_option(
-        "--plots", args.plots,
-        "Folder for PNG plots: variance_vs_balance.png, or alpha_sweep.png and allocation.png with the sweeps");
+           "--plots", args.plots,
+           "Folder for PNG plots: variance_vs_balance.png, or alpha_sweep.png and allocation.png with the sweeps")
+        ->check(non_empty());
 }
 
 void add_sweep_flags(CLI::App& sub, CompareArgs& args) {
@@ -233,6 +233,7 @@ ComparisonOptions comparison_options(const CompareArgs& args, std::vector<Techni
     options.seed = args.seed;
     options.bsdfs.clear();
     for (const std::string& b : split(args.bsdfs)) options.bsdfs.push_back(Bsdf::parse(b));
+    if (options.bsdfs.empty()) throw std::runtime_error("--bsdf '" + args.bsdfs + "': expected at least one BSDF");
     for (const std::string& t : split(args.techniques)) requested.push_back(Technique::parse(t));
     if (!requested.empty()) options.techniques = requested;
     options.allocation = {args.env_samples, args.bsdf_samples};
@@ -275,6 +276,7 @@ Setup prepare(const CompareArgs& args) {
     std::vector<Technique> alpha_techniques, allocation_techniques;
     if (!swept.empty()) alpha_techniques = alpha_sweep_techniques(requested);
     if (args.allocation_sweep) allocation_techniques = allocation_sweep_techniques(requested);
+    check_outputs({args.input}, {{"--json", args.json}, {"--csv", args.csv}});
     for (const std::string* output : {&args.csv, &args.json})
         if (!output->empty()) prepare_output(*output);
     if (!args.images.empty()) std::filesystem::create_directories(args.images);
@@ -283,8 +285,8 @@ Setup prepare(const CompareArgs& args) {
     auto [plain, fixed_alpha] = load_plain(args, map_name, source_hash);
     std::vector<ShadingPoint> points;
     if (!args.normal.empty()) {
-        const Vec3 n = parse_vector(args.normal, "--normal");
-        points = {{n, args.view.empty() ? n : parse_vector(args.view, "--view")}};
+        const Vec3 n = *parse_direction(args.normal);  // the flags' validators checked both
+        points = {{n, args.view.empty() ? n : *parse_direction(args.view)}};
     } else {
         points = sphere_points(args.points, args.view_angle);
     }
@@ -601,12 +603,14 @@ namespace {
 void add_library_flags(CLI::App& sub, CompareArgs& args) {
     sub.add_option("--out-dir", args.out_dir,
                    "Library mode (several inputs or a folder): each map's JSON to DIR/<stem>.json, and "
-                   "DIR/summary.json; --csv, --plots and --images then name folders receiving each map's files");
+                   "DIR/summary.json; --csv, --plots and --images then name folders receiving each map's files")
+        ->check(non_empty());
     add_jobs_flag(sub, args.jobs);
     sub.add_flag("--force", args.force, "Library mode: run every map, also those whose JSON is up to date");
     sub.add_flag("--recursive", args.recursive, "Library mode: also the maps in subfolders of a folder input");
     sub.add_option("--summary", args.summary,
-                   "Library mode: the JSON summary of every map's result (default: DIR/summary.json)");
+                   "Library mode: the JSON summary of every map's result (default: DIR/summary.json)")
+        ->check(non_empty());
 }
 
 // One map's study, start to end; `out` takes what it prints.

@@ -22,7 +22,7 @@ struct ConvertArgs {
 
 void add_convert_flags(CLI::App& sub, ConvertArgs& args) {
     sub.add_option("input", args.input, "HDR image")->required();
-    sub.add_option("-o,--output", args.output, "OpenEXR file to write (float RGB)")->required();
+    sub.add_option("-o,--output", args.output, "OpenEXR file to write (float RGB)")->required()->check(non_empty());
     const auto mappings = CLI::IsMember({"equirect", "equal-area"});
     sub.add_option("--from", args.from, "Mapping of the input")->capture_default_str()->check(mappings);
     sub.add_option("--to", args.to, "Mapping of the output")->capture_default_str()->check(mappings);
@@ -79,6 +79,7 @@ void print_conversion(const ConvertArgs& args, const io::LoadedImage& image, con
 }
 
 void run_convert(const ConvertArgs& args) {
+    check_outputs({args.input}, {{"-o", args.output}});
     prepare_output(args.output);
     const Mapping from = parse_mapping(args.from), to = parse_mapping(args.to);
     Size size = requested_size(args.size, to);

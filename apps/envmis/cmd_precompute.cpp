@@ -53,7 +53,8 @@ void add_precompute_flags(CLI::App& sub, PrecomputeArgs& args) {
                    "several or a folder: OUT is a folder receiving OUT/<stem>.envmis each")
         ->required();
     sub.add_option("-o,--output", args.output, "Table file to write (.envmis), or with several inputs a folder")
-        ->required();
+        ->required()
+        ->check(non_empty());
     sub.add_flag("--compact", args.compact,
                  "Store the radiance in RGBE (4 bytes/texel instead of 16; density rebuilt on load); prints the error");
     CLI::Option* bins =
@@ -73,7 +74,8 @@ void add_precompute_flags(CLI::App& sub, PrecomputeArgs& args) {
                  "Library mode: rebuild every table, also those up to date (same source bytes and options)");
     sub.add_flag("--recursive", args.recursive, "Library mode: also the images in subfolders of a folder input");
     sub.add_option("--summary", args.summary,
-                   "Library mode: the JSON summary of every map's result (default: OUT/summary.json)");
+                   "Library mode: the JSON summary of every map's result (default: OUT/summary.json)")
+        ->check(non_empty());
     add_map_flags(sub, args.map);
 }
 
@@ -192,6 +194,7 @@ void run_precompute(const PrecomputeArgs& args) {
     if (args.inputs.size() == 1 && !std::filesystem::is_directory(args.inputs.front(), ec)) {
         const LibraryItem item{args.inputs.front(), args.output};
         if (!args.summary.empty()) return precompute_items(args, {item}, args.summary);
+        check_outputs({item.input}, {{"-o", item.output}});
         prepare_output(args.output);
         precompute_one(args, item, std::cout, std::cerr, true);
         return;

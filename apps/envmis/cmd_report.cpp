@@ -418,6 +418,7 @@ void write_report(std::ostream& out, const std::vector<json>& runs, const Report
 }
 
 void run_report(const ReportArgs& args) {
+    check_outputs({args.inputs.begin(), args.inputs.end()}, {{"-o", args.output}});
     prepare_output(args.output);
     std::vector<json> runs;
     for (const std::string& path : args.inputs) {
@@ -438,7 +439,7 @@ Subcommand add_report(CLI::App& app) {
     auto args = std::make_shared<ReportArgs>();
     CLI::App* sub = app.add_subcommand("report", "Markdown report from the JSON of envmis compare runs (one per map)");
     sub->add_option("results", args->inputs, "JSON files written by envmis compare --json")->required();
-    sub->add_option("-o,--output", args->output, "Markdown file to write")->required();
+    sub->add_option("-o,--output", args->output, "Markdown file to write")->required()->check(non_empty());
     sub->add_option("--title", args->title, "Title of the report")->capture_default_str();
     sub->add_option("--command", args->command, "The command that made the results, quoted in the report");
     sub->add_flag("--no-timing", args->no_timing,

@@ -69,7 +69,7 @@ void add_sample_flags(CLI::App& sub, SampleArgs& args) {
         ->capture_default_str()
         ->check(in_range(uint64_t{1}, kMaxSamples));
     sub.add_option("--seed", args.seed, "Random seed")->capture_default_str()->check(any_seed());
-    sub.add_option("-o,--output", args.output, "CSV file to write (default: standard output)");
+    sub.add_option("-o,--output", args.output, "CSV file to write (default: standard output)")->check(non_empty());
     CLI::Option* normal =
         sub.add_option("--normal", args.normal,
                        "A binned table's shading normal (world frame; normalised), required for one: each sample "
@@ -117,6 +117,7 @@ void write_map_samples(std::ostream& out, const SampleArgs& args, const LoadedMa
 }
 
 void run_sample(const SampleArgs& args) {
+    check_outputs({args.input}, {{"-o", args.output}});
     if (!args.output.empty()) prepare_output(args.output);
     const LoadedMap loaded = load_map(args.input, args.map);
     if (loaded.bins && args.normal.empty())

@@ -43,7 +43,7 @@ struct VisualizeArgs {
 
 void add_visualize_flags(CLI::App& sub, VisualizeArgs& args) {
     sub.add_option("input", args.input, "HDR image or table")->required();
-    sub.add_option("-o,--output", args.output, "PNG file to write")->required();
+    sub.add_option("-o,--output", args.output, "PNG file to write")->required()->check(non_empty());
     sub.add_option("--panel-width", args.panel_width,
                    "Width of each panel in pixels (panels keep the map's aspect and are at most 4096 high: a tall "
                    "map's are narrower; a map over 64 times taller than wide is refused)")
@@ -175,6 +175,7 @@ Visualization visualize(const std::string& name, const Densities& d, const std::
 }
 
 void run_visualize(const VisualizeArgs& args) {
+    check_outputs({args.input}, {{"-o", args.output}});
     prepare_output(args.output);
     const LoadedMap loaded = load_map(args.input, args.map);
     const PanelSize panel = panel_size(args.input, loaded.map.width(), loaded.map.height(), args.panel_width);

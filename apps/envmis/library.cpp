@@ -226,6 +226,11 @@ void write_summary(const LibraryRun& run, const std::vector<nlohmann::json>& ent
 }  // namespace
 
 void run_library(const std::vector<LibraryItem>& items, const LibraryRun& run, const MapJob& job) {
+    std::vector<std::filesystem::path> inputs;
+    std::vector<NamedOutput> outputs{{"--summary", run.summary}};
+    for (const LibraryItem& item : items)
+        inputs.push_back(item.input), outputs.push_back({"the output of " + item.input.string(), item.output});
+    check_outputs(inputs, outputs);
     prepare_output(run.summary);
     std::vector<nlohmann::json> entries(items.size());
     for (size_t i = 0; i < items.size(); ++i)

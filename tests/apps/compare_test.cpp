@@ -166,7 +166,7 @@ TEST(Compare, BinsThatAreNotASquareNumberAreRefused) {
     for (const std::string value : {"50", "2", "4097"}) {
         const CliRun r = run_compare(dir, "--bins " + value + " --points 1 --spp 1 --techniques mis-balance-bins");
         EXPECT_NE(r.exit_code, 0) << value << "\n" << r.out;
-        EXPECT_NE(r.out.find("--bins " + value + ": expected a square number"), std::string::npos) << r.out;
+        EXPECT_NE(r.out.find("--bins: " + value + ": expected a square number"), std::string::npos) << r.out;
         EXPECT_EQ(r.out.find("envmis compare:"), std::string::npos) << "--bins " << value << " started a run";
     }
     fs::remove_all(dir);

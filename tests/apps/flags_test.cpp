@@ -145,6 +145,18 @@ INSTANTIATE_TEST_SUITE_P(
                 {"precompute", kStudio, "-o", "out.envmis", "--bin-cost", "2"},
                 "--bin-cost"},
         BadFlag{"CompareNanBinCost", {"compare", kStudio, "--bin-cost", "nan"}, "--bin-cost"},
+        // Empty outputs, directions that are not finite, absent lists, conflicting flags.
+        BadFlag{"SampleEmptyOutput", {"sample", kStudio, "-o", ""}, "--output"},
+        BadFlag{"CompareEmptyJson", {"compare", kStudio, "--json", ""}, "--json"},
+        BadFlag{"CompareEmptyCsv", {"compare", kStudio, "--csv", ""}, "--csv"},
+        BadFlag{"CompareInfiniteNormal", {"compare", kStudio, "--normal", "inf,0,0"}, "--normal"},
+        BadFlag{"CompareNormalBeyondFloat", {"compare", kStudio, "--normal", "1e39,0,0"}, "--normal"},
+        BadFlag{"CompareInfiniteView", {"compare", kStudio, "--normal", "0,0,1", "--view", "inf,0,0"}, "--view"},
+        BadFlag{"CompareViewWithoutNormal", {"compare", kStudio, "--view", "0,0,1"}, "--view"},
+        BadFlag{"CompareNormalWithPoints", {"compare", kStudio, "--normal", "0,0,1", "--points", "4"}, "--points"},
+        BadFlag{"CompareEmptyBsdf", {"compare", kStudio, "--bsdf", ""}, "--bsdf"},
+        BadFlag{"CompareZeroBins", {"compare", kStudio, "--bins", "0"}, "--bins"},
+        BadFlag{"SampleAlphaWithoutCompensation", sample({"--no-compensate", "--alpha", "0.5"}), "--alpha"},
         BadFlag{"InfoNegativeAlpha", {"info", kStudio, "--alpha", "-1"}, "--alpha"},
         BadFlag{"VisualizeNegativeAlpha", visualize({"--alpha", "-1"}), "--alpha"}),
     [](const testing::TestParamInfo<BadFlag>& info) { return info.param.name; });

@@ -189,6 +189,50 @@ std::vector<std::string> writer_args(const Writer& w, const std::string& output,
     return {w.subcommand, input, "-o", output};
 }
 
+// Every writer, and compare's and report's outputs, named as the input itself, through a
+// symbolic link to it and through a hard link: refused, the input's bytes kept.
+TEST_F(OutputFaults, AnOutputThatIsTheInputIsRefusedAndTheInputKept) {
+    fs::copy_file(kStudio, file("map.exr"));
+    fs::create_symlink("map.exr", file("link.exr"));
+    fs::create_hard_link(file("map.exr"), file("hard.exr"));
+    const std::string original = read_file(file("map.exr"));
+    for (const std::string name : {"map.exr", "link.exr", "hard.exr"}) {
+        std::vector<std::vector<std::string>> runs;
+        for (const Writer& w : kWriters) runs.push_back(writer_args(w, name, "map.exr"));
+        runs.push_back({"convert", "map.exr", "-o", name});
+        runs.push_back({"compare", "map.exr", "--points", "1", "--spp", "4", "--json", name});
+        runs.push_back({"compare", "map.exr", "--points", "1", "--spp", "4", "--csv", name});
+        runs.push_back({"report", "map.exr", "-o", name});
+        for (const auto& args : runs) {
+            expect_one_line_error(envmis(args), name, "is the input map.exr; refusing to overwrite an input");
+            ASSERT_EQ(read_file(file("map.exr")), original) << args[0] << " " << name;
+        }
+    }
+    EXPECT_TRUE(fs::is_symlink(file("link.exr")));
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 3);
+}
+
+TEST_F(OutputFaults, TwoOutputsOfOneRunThatAreOneFileAreRefused) {
+    expect_one_line_error(
+        envmis({"compare", kStudio, "--points", "1", "--spp", "4", "--json", "r.txt", "--csv", "./r.txt"}), "r.txt",
+        "is also --json's file");
+    EXPECT_TRUE(fs::is_empty(dir_));
+}
+
+// Library mode: the summary is an output like the maps' (a map named summary.exr would
+// write summary.json over it) and is never one of the inputs.
+TEST_F(OutputFaults, LibraryModeRefusesASummaryThatIsAnInputOrAMapsOutput) {
+    fs::create_directory(file("maps"));
+    fs::copy_file(kStudio, file("maps/summary.exr"));
+    const Result compare =
+        envmis({"compare", "maps", "--out-dir", "out", "--points", "1", "--spp", "4", "--bsdf", "lambert"});
+    expect_one_line_error(compare, "summary.json", "is also --summary's file");
+    expect_one_line_error(envmis({"precompute", "maps", "-o", "tables", "--summary", "maps/summary.exr"}),
+                          "maps/summary.exr", "refusing to overwrite an input");
+    EXPECT_EQ(read_file(file("maps/summary.exr")), read_file(kStudio));
+    EXPECT_FALSE(fs::exists(file("out/summary.json")));
+}
+
 TEST_F(OutputFaults, AFifoAsOutputIsRefusedAndStaysAFifo) {
     for (const Writer& w : kWriters) {
         ASSERT_EQ(::mkfifo(file(w.output).c_str(), 0644), 0);
