@@ -16,6 +16,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <optional>
@@ -393,8 +394,24 @@ void bind_binned(py::module_& m) {
         .def_property_readonly("classes", &BinnedEnvMap::classes, "The lobe classes (lobe arguments 0 to classes - 1).")
         .def_property_readonly(
             "lobe_exponents", [](const BinnedEnvMap& map) { return map.layout().lobe_exponents; }, docs::kExponents)
-        .def("lobe_class", &BinnedEnvMap::lobe_class, py::arg("phong_exponent"), docs::kLobeClass)
-        .def("complete", &BinnedEnvMap::complete, py::arg("lobe"), docs::kBinnedComplete)
+        .def(
+            "lobe_class",
+            [](const BinnedEnvMap& map, float exponent) {
+                if (!(exponent >= 0 && std::isfinite(exponent)))
+                    throw py::value_error("phong_exponent: expected a finite number >= 0, got " +
+                                          std::to_string(exponent));
+                return map.lobe_class(exponent);
+            },
+            py::arg("phong_exponent"), docs::kLobeClass)
+        .def(
+            "complete",
+            [](const BinnedEnvMap& map, uint32_t lobe) {
+                if (lobe >= map.classes())
+                    throw py::value_error("lobe: " + std::to_string(lobe) + " is not a class (0 to " +
+                                          std::to_string(map.classes() - 1) + ")");
+                return map.complete(lobe);
+            },
+            py::arg("lobe"), docs::kBinnedComplete)
         .def_property_readonly(
             "source", [](const std::shared_ptr<BinnedEnvMap>& map) { return source_dict(provenance_of(map).source); },
             docs::kSource)

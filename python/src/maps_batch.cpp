@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -23,6 +25,14 @@ void interleave(float (*in)[kChunk], uint32_t m, float* out, size_t first) noexc
         for (size_t k = 0; k < K; ++k) row[k] = in[k][i];
 }
 
+// A direction (or normal) that names one: finite and not zero. Others give NaN results:
+// NaN in, NaN out, where the core maps them to some texel.
+bool names_a_direction(const float (*d)[kChunk], uint32_t i) noexcept {
+    return std::isfinite(d[0][i]) && std::isfinite(d[1][i]) && std::isfinite(d[2][i]) &&
+           (d[0][i] != 0 || d[1][i] != 0 || d[2][i] != 0);
+}
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
 // Runs `batch(points, normals, outputs, m, first)` chunk by chunk over n points with the
 // chunk's inputs deinterleaved (normals only when given) and stores its outputs.
 template <class Batch>
@@ -36,6 +46,12 @@ void sample_chunks(const float* u, const float* normals, InterleavedSamples out,
               SampleArrays{direction[0], direction[1], direction[2], out.pdf + first, radiance[0], radiance[1],
                            radiance[2], uv[0], uv[1]},
               m, first);
+        if (normals)
+            for (uint32_t i = 0; i < m; ++i)
+                if (!names_a_direction(normal, i)) {
+                    for (auto* c : {direction, radiance}) c[0][i] = c[1][i] = c[2][i] = kNaN;
+                    uv[0][i] = uv[1][i] = out.pdf[first + i] = kNaN;
+                }
         interleave<3>(direction, m, out.direction, first);
         interleave<3>(radiance, m, out.radiance, first);
         interleave<2>(uv, m, out.uv, first);
@@ -53,6 +69,11 @@ void lookup_chunks(const float* directions, const float* normals, InterleavedLoo
         batch(DirectionArrays{direction[0], direction[1], direction[2]},
               DirectionArrays{normal[0], normal[1], normal[2]},
               LookupArrays{radiance[0], radiance[1], radiance[2], out.pdf ? out.pdf + first : pdf}, m, first);
+        for (uint32_t i = 0; i < m; ++i)
+            if (!names_a_direction(direction, i) || (normals && !names_a_direction(normal, i))) {
+                radiance[0][i] = radiance[1][i] = radiance[2][i] = kNaN;
+                if (out.pdf) out.pdf[first + i] = kNaN;
+            }
         if (out.radiance) interleave<3>(radiance, m, out.radiance, first);
     }
 }

@@ -103,11 +103,12 @@ inline constexpr const char* kPdf = R"(The solid-angle pdf (per steradian) of sa
 directions: float32 (N, 3), unit vectors in the map's world frame. They are not
    normalised here (nor in C++): a vector of another length reads as another direction
    (its azimuth kept, its z taken as the cosine). Returns float32 (N,), bit-identical to
-   Samples.pdf for the samples' own directions up to their float rounding; O(N), GIL
-   released.)";
+   Samples.pdf for the samples' own directions up to their float rounding; NaN for a
+   direction that is not finite or is zero (NaN in, NaN out); O(N), GIL released.)";
 inline constexpr const char* kEval =
     "The radiance arriving from each direction, float32 (N, 3) linear RGB in the working space (the nearest "
-    "texel's). directions: float32 (N, 3) unit vectors in the world frame (not normalised). O(N), GIL released.";
+    "texel's). directions: float32 (N, 3) unit vectors in the world frame (not normalised); NaN for a direction "
+    "that is not finite or is zero. O(N), GIL released.";
 inline constexpr const char* kSave = R"(Writes the map as a table file (envmis::write_table).
 
 compact=False stores the float32 density and radiance (16 bytes a texel; loads
@@ -134,20 +135,23 @@ inline constexpr const char* kPlain =
 inline constexpr const char* kExponents = "The lobe classes' Phong exponents, ascending; 0 is diffuse (Lambert).";
 inline constexpr const char* kLobeClass =
     "The lobe class of a BSDF with this Phong exponent (0 for Lambert): the nearest class on the scale "
-    "log(1 + exponent).";
+    "log(1 + exponent). Raises ValueError for a negative or non-finite exponent.";
 inline constexpr const char* kBinnedComplete =
-    "True if every bin of lobe class `lobe` samples wherever its normals see light (no texel zeroed by compensation).";
+    "True if every bin of lobe class `lobe` samples wherever its normals see light (no texel zeroed by compensation). "
+    "Raises ValueError for a class the map does not have.";
 inline constexpr const char* kBinnedSample = R"(Directions drawn for N (point, normal) pairs.
 
 u: float32 (N, 2) in [0, 1)^2 (checked as EnvMap.sample checks it); normals: float32 (N, 3), the shading normals in the world
 frame (or lobe axes); choices: float32 (N,) in [0, 1), each point's pick among the bins
 around its normal; lobe: the lobe class (0 to classes - 1). Returns Samples as EnvMap.sample does, bit-identical to N single calls
-of the C++ BinnedEnvMapView::sample; out as EnvMap.sample's. O(N), GIL released.)";
+of the C++ BinnedEnvMapView::sample; out as EnvMap.sample's; NaN throughout for a normal that is not
+finite or is zero (NaN in, NaN out). O(N), GIL released.)";
 inline constexpr const char* kBinnedPdf = R"(The solid-angle pdf (per steradian) of each direction under the bin
 its normal and choice pick (lobe class `lobe`): what sample() with them would have drawn.
 
 directions, normals: float32 (N, 3), world frame; directions unit length (not
-normalised); choices: float32 (N,) in [0, 1). Returns float32 (N,). O(N), GIL released.)";
+normalised); choices: float32 (N,) in [0, 1). Returns float32 (N,), NaN where a direction or
+normal is not finite or is zero. O(N), GIL released.)";
 
 inline constexpr const char* kLoad = R"(Loads an HDR image (or a table file) as `envmis precompute` builds it.
 

@@ -287,9 +287,31 @@ def test_directions_and_radiance_of_another_shape_are_rejected(small_maps):
         envmis.EnvMap(np.zeros((8, 16, 4), np.float32))
 
 
+def test_directions_and_normals_that_are_not_finite_or_zero_give_nan_and_the_others_do_not():
+    binned = envmis.load(PARK, bins=9)
+    plain = binned.plain
+    bad = np.array([[np.nan, 0, 1], [np.inf, 0, 0], [0, 0, 0], [0, 0, 1]], np.float32)
+    for pdf in (plain.pdf(bad), binned.pdf(bad, np.tile([0, 0, 1], (4, 1)).astype(np.float32),
+                                           np.full(4, 0.5, np.float32))):
+        assert np.isnan(pdf[:3]).all() and np.isfinite(pdf[3]), pdf
+    radiance = plain.eval(bad)
+    assert np.isnan(radiance[:3]).all() and np.isfinite(radiance[3]).all()
+    samples = binned.sample(np.full((4, 2), 0.5, np.float32), bad, np.full(4, 0.5, np.float32))
+    assert np.isnan(samples.pdf[:3]).all() and np.isnan(samples.direction[:3]).all()
+    assert samples.pdf[3] > 0 and np.isfinite(samples.direction[3]).all()
+    pdf = binned.pdf(np.tile([0, 0, 1], (4, 1)).astype(np.float32), bad, np.full(4, 0.5, np.float32))
+    assert np.isnan(pdf[:3]).all() and np.isfinite(pdf[3])
+
+
 def test_a_binned_map_samples_with_the_pdf_it_reports_and_checks_its_normals():
     binned = envmis.load(PARK, bins=9)
     assert binned.lobe_class(0) == 0 and binned.lobe_class(200) == 2
+    for exponent in (float("nan"), -1.0, float("inf")):
+        with pytest.raises(ValueError, match="phong_exponent"):
+            binned.lobe_class(exponent)
+    assert binned.complete(binned.classes - 1) in (True, False)
+    with pytest.raises(ValueError, match="lobe: 99 is not a class"):
+        binned.complete(99)
     rng = np.random.default_rng(3)
     normals = rng.normal(size=(5000, 3)).astype(np.float32)
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)

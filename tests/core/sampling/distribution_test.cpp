@@ -471,4 +471,13 @@ TEST(Distribution1D, RejectsInvalidInput) {
 }
 
 }  // namespace
+// A NaN coordinate (a NaN direction's) must not become an integer by an undefined
+// conversion (UBSan: float-cast-overflow); out-of-range ones clamp.
+TEST(Distribution, CellOfANaNOrOutOfRangeCoordinateIsAnEdgeCell) {
+    EXPECT_EQ(detail::cell_of(std::nanf(""), 16), 0u);
+    EXPECT_EQ(detail::cell_of(-3.0f, 16), 0u);
+    EXPECT_EQ(detail::cell_of(7.0f, 16), 15u);
+    EXPECT_EQ(detail::cell_of(std::numeric_limits<float>::infinity(), 16), 15u);
+}
+
 }  // namespace envmis

@@ -255,9 +255,11 @@ struct CdfView {
 
 namespace detail {
 
-// Cell of x in [0,1); exact, because a float times n <= 2^31 is exact in double.
+// Cell of x in [0,1); exact, because a float times n <= 2^31 is exact in double. A NaN
+// (from a NaN direction) gets cell 0: converting it to an integer is undefined.
 ENVMIS_HD inline uint32_t cell_of(float x, uint32_t n) noexcept {
-    const auto i = static_cast<uint32_t>(static_cast<double>(clamp(x, 0.0f, 1.0f)) * n);
+    const float inside = x > 0 ? min(x, 1.0f) : 0.0f;
+    const auto i = static_cast<uint32_t>(static_cast<double>(inside) * n);
     return i < n ? i : n - 1;
 }
 
