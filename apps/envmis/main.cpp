@@ -1,5 +1,8 @@
 // envmis: precompute, inspect, sample, visualise and benchmark environment-map samplers.
+#include <cerrno>
 #include <csignal>
+#include <cstdio>
+#include <cstring>
 #include <exception>
 #include <iostream>
 #include <new>
@@ -27,7 +30,14 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        const int status = app.exit(e);
+        // --help and --version print to standard output: one that cannot take it (full,
+        // closed) makes the run a failure, as it does for every command's output.
+        if (status == 0 && (std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout)) {
+            std::cerr << "envmis: standard output: " << std::strerror(errno) << "\n";
+            return 1;
+        }
+        return status;
     }
     try {
         StandardOutput standard_output;

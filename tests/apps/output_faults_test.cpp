@@ -12,6 +12,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -174,8 +175,16 @@ TEST_P(FullStandardOutput, ExitsNonZeroSayingSo) {
 INSTANTIATE_TEST_SUITE_P(Commands, FullStandardOutput,
                          testing::Values(std::vector<std::string>{"info", kStudio},
                                          std::vector<std::string>{"precompute", kStudio, "-o", "x.envmis"},
-                                         kComparePoint),
-                         [](const testing::TestParamInfo<std::vector<std::string>>& info) { return info.param[0]; });
+                                         kComparePoint, std::vector<std::string>{"--help"},
+                                         std::vector<std::string>{"--version"},
+                                         std::vector<std::string>{"sample", "--help"}),
+                         [](const testing::TestParamInfo<std::vector<std::string>>& info) {
+                             std::string name;
+                             for (const std::string& a : info.param)
+                                 if (a[0] != '/') name += a;
+                             std::erase_if(name, [](char c) { return !std::isalnum(static_cast<unsigned char>(c)); });
+                             return name;
+                         });
 
 // ---------------------------------------------------------------------------------
 // Outputs that are not regular files are refused, before any work, and left as they are.
