@@ -18,6 +18,7 @@
 #include <sstream>
 #include <string_view>
 
+#include "envmis/io/image_io.h"
 #include "envmis/study/shading/bsdf.h"
 #include "envmis/table/atomic_file.h"
 
@@ -190,7 +191,7 @@ void throw_if_interrupted() {
 int exit_interrupted(const std::string& detail) {
     const int signal = interrupting_signal();
     std::cerr << "envmis: interrupted by " << (signal == SIGTERM ? "SIGTERM" : "SIGINT")
-              << (detail.empty() || detail == Interrupted().what() ? "" : ": " + detail) << "\n";
+              << (detail.empty() || detail == Interrupted().what() ? "" : ": " + printable(detail)) << "\n";
     return 128 + (signal ? signal : SIGINT);
 }
 
@@ -304,6 +305,27 @@ std::string resident_memory() {
            "), peak " + mb("VmHWM:");
 }
 
+uint64_t header_texels(const std::filesystem::path& input) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(input, ec)) return 0;
+    try {
+        if (looks_like_table(input)) {
+            const TableHeader header = read_table_header(input);
+            return uint64_t{header.width} * header.height;
+        }
+        return io::read_image_size(input).largest_texels;
+    } catch (const std::exception&) {
+        return 0;
+    }
+}
+
+void check_map_memory(const std::filesystem::path& input, uint64_t bytes_per_texel) {
+    if (looks_like_table(input)) return;
+    const io::ImageSize size = io::read_image_size(input);
+    check_memory(input.string() + " (" + std::to_string(size.width) + "x" + std::to_string(size.height) + ")",
+                 size.largest_texels * bytes_per_texel);
+}
+
 LoadedMap load_map(const std::string& path, const MapFlags& flags, std::ostream& notes) {
     if (looks_like_table(path)) {
         const auto start = std::chrono::steady_clock::now();
@@ -315,8 +337,9 @@ LoadedMap load_map(const std::string& path, const MapFlags& flags, std::ostream&
         loaded.load_ms = milliseconds_since(start);
         return loaded;
     }
+    check_map_memory(path, kBuildPeak);
     BuiltMap built = build_map(path, build_request(flags), &interrupted());
-    for (const std::string& notice : built.notices) notes << "note: " << notice << "\n";
+    for (const std::string& notice : built.notices) notes << "note: " << printable(notice) << "\n";
     return loaded_map(built);
 }
 
@@ -494,7 +517,8 @@ void check_outputs(const std::vector<std::filesystem::path>& inputs, const std::
 void prepare_output(const std::filesystem::path& path) {
     check_destination(path);
     for (const std::filesystem::path& removed : remove_stale_temporaries(path))
-        std::cerr << "envmis: removed " << removed.string() << ", the temporary file of an interrupted earlier run\n";
+        std::cerr << "envmis: removed " << printable(removed.string())
+                  << ", the temporary file of an interrupted earlier run\n";
 }
 
 // Writes through C's stdout, as libstdc++'s own synchronised buffer does, but keeps the

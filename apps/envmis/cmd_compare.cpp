@@ -213,7 +213,7 @@ std::pair<EnvMap, float> load_plain(const CompareArgs& args, std::string& map_na
                                                          : 0.0f;
     EnvMapOptions plain_options = loaded.map.options();
     plain_options.compensation.enabled = false;
-    if (loaded.from_table) return {EnvMap(to_image(loaded.map.radiance()), plain_options), fixed_alpha};
+    if (loaded.from_table) return {EnvMap(to_image(loaded.map.radiance()), plain_options, &interrupted()), fixed_alpha};
     return {std::move(loaded.map), fixed_alpha};
 }
 
@@ -300,7 +300,7 @@ Setup prepare(const CompareArgs& args) {
     }
     const float map_alpha = choice ? choice->alpha : fixed_alpha;
     std::vector<float> bsdf_alphas = choice ? choice->bsdf_alphas : std::vector<float>(options.bsdfs.size(), map_alpha);
-    CompensatedMaps compensated = compensated_maps(plain, bsdf_alphas);
+    CompensatedMaps compensated = compensated_maps(plain, bsdf_alphas, &interrupted());
     std::shared_ptr<const BinnedEnvMap> binned = build_bins(args, plain, g);
     return {std::move(map_name),
             std::move(plain),
@@ -485,18 +485,23 @@ void write_comparison(std::ostream& out, const CompareArgs& args, const Setup& s
 
 // --exact: per BSDF, each fixed-weight technique's exact variance over mis-balance's,
 // the geometric mean over points and the worst point.
-void write_exact(std::ostream& out, const Setup& s, Written& w) {
+void write_exact(std::ostream& out, const CompareArgs& args, const Setup& s, Written& w) {
     const StudyInputs inputs = s.inputs();
     const Technique balance = Technique::parse("mis-balance");
     out << "exact var/mis: exact variance / that of mis-balance (quadrature, one subdivision), geometric mean "
            "over points (worst point)\n";
-    for (size_t b = 0; b < s.options.bsdfs.size(); ++b) {
-        const std::vector<double> baseline = exact_point_variances(inputs, balance, b, 1);
+    const size_t nb = s.options.bsdfs.size(), nt = s.options.techniques.size();
+    std::optional<Progress> progress;
+    if (args.show_progress) progress.emplace("exact variances", nb * (nt + 1));
+    for (size_t b = 0; b < nb; ++b) {
+        const std::vector<double> baseline = exact_point_variances(inputs, balance, b, 1, &interrupted());
+        if (progress) progress->update(b * (nt + 1) + 1);
         out << "  " << s.options.bsdfs[b].name() << ":";
-        for (const Technique& t : s.options.techniques) {
+        for (size_t i = 0; i < nt; ++i) {
+            const Technique& t = s.options.techniques[i];
+            if (progress) progress->update(b * (nt + 1) + 1 + i);
             if (t.adaptive() || t.mixture) continue;
-            throw_if_interrupted();  // each technique's quadrature over every point takes up to seconds
-            const std::vector<double> v = exact_point_variances(inputs, t, b, 1);
+            const std::vector<double> v = exact_point_variances(inputs, t, b, 1, &interrupted());
             double worst = 0;
             for (size_t p = 0; p < v.size(); ++p)
                 if (v[p] > 0 && baseline[p] > 0) worst = std::max(worst, v[p] / baseline[p]);
@@ -558,7 +563,8 @@ void write_compare(std::ostream& out, const CompareArgs& args, const Setup& s, c
     if (s.choice) print_alpha_choice(out, *s.choice, s.options.bsdfs);
     Written w{{{"inputs", inputs_json(args, s, points_done)}}, {}, {}};
     if (outcome.comparison) write_comparison(out, args, s, *outcome.comparison, w);
-    if (outcome.comparison && args.exact && outcome.comparison->points_done == s.points.size()) write_exact(out, s, w);
+    if (outcome.comparison && args.exact && outcome.comparison->points_done == s.points.size())
+        write_exact(out, args, s, w);
     if (outcome.alpha) write_alpha_sweep(out, args, s, *outcome.alpha, outcome.alphas_swept, w);
     if (outcome.allocation) write_allocation_sweep(out, args, s, *outcome.allocation, w);
     if ((outcome.alpha || outcome.allocation) && !args.csv.empty()) {

@@ -84,8 +84,9 @@ void run_convert(const ConvertArgs& args) {
     const Mapping from = parse_mapping(args.from), to = parse_mapping(args.to);
     Size size = requested_size(args.size, to);
     if (size.width != 0) check_image_size("--size " + args.size, size, kBytesPerTexel);
+    check_map_memory(args.input, 2 * sizeof(Rgb));  // the pixels read and the map
     const io::LoadedImage image = io::load_image(args.input, {args.colorspace, args.working_space, &interrupted()});
-    for (const std::string& notice : image.notices) std::cerr << "note: " << notice << "\n";
+    for (const std::string& notice : image.notices) std::cerr << "note: " << printable(notice) << "\n";
     if (size.width == 0) {
         size = default_size(image.image, to);
         check_image_size(args.input + ": output of " + std::to_string(size.width) + "x" + std::to_string(size.height),

@@ -119,6 +119,11 @@ void print_precompute(std::ostream& out, const PrecomputeArgs& args, const Libra
         << loaded.build_ms << " ms, write " << write_ms << " ms\n";
 }
 
+// A map's peak resident memory per texel in precompute, above the process's own: a
+// full table's is kBuildPeak (cli.h); a compact one's about 54 (the source map, the
+// rounded one and the error report's), rounded up.
+constexpr uint64_t kFullPeak = kBuildPeak, kCompactPeak = 64;
+
 // One map: its table written, what precompute prints on `out` and its notices on
 // `notes`, and its summary details. With --bins the table's texels hold the plain map,
 // and the compensation the flags ask for goes into the bins.
@@ -128,11 +133,12 @@ nlohmann::json precompute_one(const PrecomputeArgs& args, const LibraryItem& ite
         read_table_header(item.input);  // a broken table says what is wrong with it
         throw std::runtime_error(item.input.string() + ": is already a table; give an image");
     }
+    check_map_memory(item.input, args.compact ? kCompactPeak : kFullPeak);
     std::optional<Progress> progress;
     if (show_progress && args.bins != 0) progress.emplace("building bins", 1);
     BuiltMap built = build_map(item.input, precompute_request(args), &interrupted());
     progress.reset();
-    for (const std::string& notice : built.notices) notes << "note: " << notice << "\n";
+    for (const std::string& notice : built.notices) notes << "note: " << printable(notice) << "\n";
     const LoadedMap loaded = loaded_map(built);
     const BinnedEnvMap* binned = built.binned ? &*built.binned : nullptr;
     const EnvMap& map = binned ? binned->plain() : loaded.map;
@@ -161,11 +167,6 @@ bool up_to_date(const std::filesystem::path& output, uint64_t hash, const std::s
         return false;
     }
 }
-
-// A map's peak resident memory per texel in precompute, above the process's own: measured
-// on a 4096x2048 map (/usr/bin/time -v), about 17 full (with --bins 256: 25) and 54
-// compact (the source map, the rounded one and the error report's), rounded up.
-constexpr uint64_t kFullPeak = 32, kCompactPeak = 64;
 
 // Each map of `items` on the pool of --jobs, skipping those up to date, with a summary.
 void precompute_items(const PrecomputeArgs& args, const std::vector<LibraryItem>& items,

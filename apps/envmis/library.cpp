@@ -122,26 +122,6 @@ std::string naming(const fs::path& input, const std::string& message) {
     return message.find(input.string()) == std::string::npos ? input.string() + ": " + message : message;
 }
 
-// The texels of an input's map, from its header alone (a table's, or an image's display
-// window, which load_image reads); 0 where that cannot be read: the job then fails and says why.
-uint64_t header_texels(const fs::path& input) {
-    if (looks_like_table(input)) {
-        try {
-            const TableHeader header = read_table_header(input);
-            return uint64_t{header.width} * header.height;
-        } catch (const std::exception&) {
-            return 0;
-        }
-    }
-    const auto in = OIIO::ImageInput::open(input.string());
-    if (!in) {
-        OIIO::geterror();  // clears this thread's message, which the job's own load reports
-        return 0;
-    }
-    const OIIO::ImageSpec& spec = in->spec();
-    return uint64_t(std::max(spec.full_width, 0)) * uint64_t(std::max(spec.full_height, 0));
-}
-
 // Admits maps to run while their estimated needs fit together in the memory that was
 // available when no map ran; a map that does not fit waits for running ones to finish.
 // Nothing running, a map is checked alone against the memory available then, as
@@ -187,6 +167,14 @@ private:
     uint32_t running_ = 0;
 };
 
+// The output of a map whose job failed, an earlier run's, no longer matches its input
+// (the input changed or became unreadable, or the options changed): removed, so that
+// the folder never holds an output that looks valid beside a failure. True if removed.
+bool remove_stale_output(const fs::path& output) {
+    std::error_code ec;
+    return fs::is_regular_file(fs::symlink_status(output, ec)) && fs::remove(output, ec);
+}
+
 // One map through `job` once the gate admits it, timed, its failure caught: the summary's entry.
 nlohmann::json run_one(const LibraryItem& item, const MapJob& job, MemoryGate& gate, uint64_t bytes_per_texel,
                        MapOutcome& outcome, std::string& error) {
@@ -209,7 +197,14 @@ nlohmann::json run_one(const LibraryItem& item, const MapJob& job, MemoryGate& g
         entry["status"] = "interrupted";
     } catch (const std::exception& e) {
         entry["status"] = interrupted() ? "interrupted" : "failed";
-        if (!interrupted()) entry["error"] = error = naming(item.input, e.what());
+        if (!interrupted()) {
+            error = naming(item.input, e.what());
+            if (remove_stale_output(item.output)) {
+                error += " (its earlier output " + item.output.string() + " was removed: it no longer matches)";
+                entry["removed_output"] = true;
+            }
+            entry["error"] = error;
+        }
     }
     entry["seconds"] = milliseconds_since(start) / 1e3;
     return entry;
@@ -250,7 +245,7 @@ void run_library(const std::vector<LibraryItem>& items, const LibraryRun& run, c
             if (!entry.contains("status")) continue;  // a signal arrived while it waited: not started
             const std::lock_guard guard(lock);
             std::cerr << outcome.notes;
-            if (!error.empty()) std::cerr << "envmis: " << error << "\n", ++failed;
+            if (!error.empty()) std::cerr << "envmis: " << printable(error) << "\n", ++failed;
             std::cout << outcome.printed << std::flush;
             // A map stopped by the signal is not done: the message after the run says so.
             if (entry["status"] != "interrupted") progress->update(++done);

@@ -70,7 +70,8 @@ struct LibraryRun {
 // does not fit alone fails with check_memory's message ("FILE: needs N MB of memory, more
 // than the M MB available"). An estimate, from the headers alone: other processes' use
 // changes under it, and bytes_per_texel is measured, not a bound. A map that fails is reported at once on stderr
-// ("envmis: FILE: problem") and in the summary, and the others go on. Writes the summary
+// ("envmis: FILE: problem") and in the summary, and the others go on; an earlier run's
+// output for it is removed (it no longer matches), and the message and summary say so. Writes the summary
 // atomically: per map its input and output paths, status ("written", "up-to-date",
 // "failed", or "interrupted" and "not started" after Ctrl-C), error, seconds, source hash,
 // input bytes and the job's details. Then throws Interrupted once a signal arrived (the

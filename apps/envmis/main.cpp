@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
     app.set_version_flag("--version", "envmis 0.1.0");
     // A usage error is one line, naming the flag: "envmis: -n: Value -5 not in range 1 to ...".
     app.failure_message(
-        [](const CLI::App*, const CLI::Error& e) { return "envmis: " + std::string(e.what()) + " (see --help)\n"; });
+        [](const CLI::App*, const CLI::Error& e) { return "envmis: " + printable(e.what()) + " (see --help)\n"; });
     const std::vector<Subcommand> subcommands = {add_compare(app), add_report(app), add_precompute(app),
                                                  add_info(app),    add_sample(app), add_visualize(app),
                                                  add_bench(app),   add_convert(app)};
@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
         // A failure caused by the interruption (a library's read stopped half-way) is the
         // interruption's.
         if (interrupted()) return exit_interrupted(e.what());
-        std::cerr << "envmis: " << e.what() << "\n";
+        std::cerr << "envmis: " << printable(e.what()) << "\n";
         return 1;
     }
     // A signal during the last of the work, after its last check, still says so: the

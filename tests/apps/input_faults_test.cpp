@@ -4,6 +4,8 @@
 // real binary (ENVMIS_CLI) in a temporary folder of its own.
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <regex>
 #include <stdexcept>
@@ -97,8 +99,56 @@ TEST_F(InputFaults, AnOverscanExrIsCroppedToItsDisplayWindowWithANote) {
     EXPECT_TRUE(contains(r.err, R"(^note: overscan\.exr: .*data outside it cropped)")) << r;
 }
 
+// An input that is not a regular file would block (a FIFO without a writer) or never end
+// (/dev/zero): refused before any read, naming it.
+TEST_F(InputFaults, AnInputThatIsAFifoOrADeviceIsRefusedNamingIt) {
+    ASSERT_EQ(::mkfifo(file("pipe.exr").c_str(), 0644), 0);
+    for (const std::string& input : {file("pipe.exr").string(), std::string("/dev/zero")})
+        for (const std::vector<std::string>& args : {std::vector<std::string>{"info", input},
+                                                     {"precompute", input, "-o", "t.envmis"},
+                                                     {"sample", input, "-n", "1"},
+                                                     {"compare", input, "--points", "1", "--spp", "1"}}) {
+            expect_one_line_error(envmis(args), input, "not a regular file");
+            EXPECT_FALSE(fs::exists(file("t.envmis")));
+        }
+}
+
+// A file this process may not read says why, not just that the reader failed (root
+// reads everything: skipped there).
+TEST_F(InputFaults, AnUnreadableInputSaysPermissionDenied) {
+    if (::geteuid() == 0) GTEST_SKIP() << "root may read a file of mode 000";
+    write_exr(file("locked.exr"), constant(16, 8, 1.0f));
+    fs::permissions(file("locked.exr"), fs::perms::none);
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"info", "locked.exr"}, {"precompute", "locked.exr", "-o", "t.envmis"}})
+        expect_one_line_error(envmis(args), "locked.exr", R"(cannot read \(Permission denied\))");
+}
+
 // ---------------------------------------------------------------------------------
 // Sizes: each checked against its documented limit and free memory before allocating.
+
+// A header can declare any size: the map it would make is checked against the memory
+// available from the header alone, before a pixel is read, naming the file and its size.
+class HugeHeader : public InputFaults, public testing::WithParamInterface<std::string> {};
+
+TEST_P(HugeHeader, IsRefusedFromItsHeaderNamingTheFileAndItsSize) {
+    if (kAddressSanitizer) GTEST_SKIP() << "needs ulimit -v, which AddressSanitizer cannot run under";
+    // A Radiance header of 30000 x 30000 (no pixels follow), and an EXR whose display
+    // window is 32768 x 32768 around one stored texel.
+    envmis::test::write_text(file("huge.hdr"), "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 30000 +X 30000\n");
+    write_exr(file("window.exr"), constant(1, 1, 1.0f), 0, 0, 32768, 32768);
+    for (const auto& [name, size] : {std::pair{"huge.hdr", "30000x30000"}, {"window.exr", "32768x32768"}}) {
+        std::vector<std::string> args = {GetParam(), name};
+        if (GetParam() == "precompute" || GetParam() == "convert") args.insert(args.end(), {"-o", "out"});
+        if (GetParam() == "compare") args.insert(args.end(), {"--points", "1", "--spp", "1"});
+        const Result r = envmis_within(4096, args);
+        expect_one_line_error(r, std::string(name) + " (" + size + ")",
+                              R"(needs \d+ MB of memory, more than the \d+ MB available)");
+        EXPECT_FALSE(fs::exists(file("out")));
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Commands, HugeHeader, testing::Values("info", "precompute", "compare", "sample", "convert"));
 
 // The panels keep the map's aspect, at most 4096 pixels high: a map too tall for that is refused.
 TEST_F(InputFaults, VisualizeRefusesAMapFarTallerThanWideNamingItAndTheLimit) {
@@ -185,6 +235,20 @@ TEST_F(InputFaults, InfoEscapesControlCharactersInTheSourceName) {
     EXPECT_EQ(r.out.find('\x1b'), std::string::npos) << r;
     EXPECT_EQ(r.out.find('\x07'), std::string::npos) << r;
     EXPECT_NE(r.out.find(R"(source        evil\x1b]0;owned\x07\x1b[2J.exr (envmis table)"), std::string::npos) << r;
+}
+
+// Error messages name files as given; their control characters (which can retitle or
+// clear a terminal) are escaped like those of names read from tables.
+TEST_F(InputFaults, AnErrorNamingAFileEscapesItsControlCharacters) {
+    const std::string name = "evil\x1b]0;owned\x07.exr";
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"info", name}, {"precompute", name, "-o", "t.envmis"}}) {
+        const Result r = envmis(args);
+        EXPECT_NE(r.exit_code, 0) << r;
+        EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r;
+        EXPECT_EQ(r.err.find('\x07'), std::string::npos) << r;
+        EXPECT_NE(r.err.find(R"(evil\x1b]0;owned\x07.exr)"), std::string::npos) << r;
+    }
 }
 
 }  // namespace

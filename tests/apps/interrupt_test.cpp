@@ -77,7 +77,8 @@ public:
     // Runs envmis `args` in the test's folder, sends `signal` once stderr shows `phase`
     // and kIntoThePhase more have passed, and waits for the run to end (killing it if it
     // has not after kStopWithin and as long again).
-    Stopped interrupt(const std::vector<std::string>& args, const std::string& phase, int signal) const {
+    Stopped interrupt(const std::vector<std::string>& args, const std::string& phase, int signal,
+                      Clock::duration reach_within = kReachWithin) const {
         const std::string cli = ENVMIS_CLI, out = (dir_ / "..stdout").string(), err = (dir_ / "..stderr").string();
         std::vector<const char*> argv = {cli.c_str()};
         for (const std::string& a : args) argv.push_back(a.c_str());
@@ -103,7 +104,7 @@ public:
         Stopped s;
         int status = 0;
         bool ended = false;
-        for (const auto deadline = Clock::now() + kReachWithin; Clock::now() < deadline;) {
+        for (const auto deadline = Clock::now() + reach_within; Clock::now() < deadline;) {
             if (::waitpid(pid, &status, WNOHANG) == pid) {
                 ended = true;
                 break;
@@ -204,6 +205,18 @@ TEST_F(Interrupt, ACompareSignalledWithSigtermExits143AndWritesNoResults) {
     expect_stopped_by(s, SIGTERM);
     EXPECT_EQ(listing(), (std::set<std::string>{"map.exr", "plots"}));
     EXPECT_TRUE(fs::is_empty(file("plots")));
+}
+
+// The exact variances' quadratures (--exact) run over every texel at every point: on a
+// 2048x1024 map and 128 points, about 3 s per technique, stopped within a row. The study
+// before them takes about 9 s (its references are quadratures too).
+TEST_F(Interrupt, ACompareSignalledInItsExactVariancesExits130) {
+    write_exr(file("map.exr"), 2048, 1024);
+    const Stopped s = interrupt({"compare", path("map.exr"), "--exact", "--spp", "16", "--points", "128", "--bsdf",
+                                 "lambert", "--techniques", "mis-balance,mis-balance-comp", "--json", path("r.json")},
+                                "exact variances", SIGINT, 60s);
+    expect_stopped_by(s, SIGINT);
+    EXPECT_EQ(listing(), std::set<std::string>{"map.exr"});
 }
 
 // ---------------------------------------------------------------------------------

@@ -160,6 +160,22 @@ TEST_F(Library, ChangingAnOptionOrASourcesBytesRebuildsWhatChangedOnly) {
     EXPECT_EQ(statuses("tables/summary.json"), expected);
 }
 
+// A map that had a table and now fails (here: its bytes are no longer an image) leaves no
+// table that looks valid beside the failure: the old one is removed, and the run says so.
+TEST_F(Library, AMapThatNowFailsLosesItsEarlierTableAndTheRunSaysSo) {
+    make_maps(false);
+    ASSERT_EQ(envmis({"precompute", "maps", "-o", "tables"}).exit_code, 0);
+    ASSERT_TRUE(fs::exists(file("tables/studio.envmis")));
+    write_text(file("maps/studio.exr"), "not an image any more");
+    const Result r = envmis({"precompute", "maps", "-o", "tables"});
+    EXPECT_EQ(r.exit_code, 1) << r;
+    EXPECT_NE(r.err.find("its earlier output tables/studio.envmis was removed"), std::string::npos) << r;
+    EXPECT_FALSE(fs::exists(file("tables/studio.envmis")));
+    EXPECT_TRUE(fs::exists(file("tables/city.envmis")));
+    for (const json& entry : summary("tables/summary.json")["results"])
+        EXPECT_EQ(entry.value("removed_output", false), entry["input"] == "maps/studio.exr") << entry;
+}
+
 TEST_F(Library, TwoInputsWithTheSameStemAreRefusedBeforeAnyWork) {
     make_maps(false);
     fs::create_directories(file("other"));

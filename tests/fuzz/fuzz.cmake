@@ -1,5 +1,6 @@
 # libFuzzer targets (included from tests/CMakeLists.txt): the table reader on bytes in
-# memory, the mapped loading path, and (with ENVMIS_BUILD_IO) the image reader.
+# memory, the mapped loading path, and (with ENVMIS_BUILD_IO) the image reader and the
+# report's JSON reader and writer.
 #
 # libFuzzer ships with clang only, so this is a separate clang build, e.g.:
 #   CC=clang CXX=clang++ cmake -S . -B build-fuzz -DENVMIS_FUZZ=ON -DENVMIS_BUILD_APPS=OFF \
@@ -19,7 +20,7 @@ endif()
 set(envmis_fuzz_sanitizers -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
 set(envmis_fuzzed_libraries envmis_core)
 if(TARGET envmis_io)
-  list(APPEND envmis_fuzzed_libraries envmis_io)
+  list(APPEND envmis_fuzzed_libraries envmis_io envmis_report)
 endif()
 foreach(library ${envmis_fuzzed_libraries})
   target_compile_options(${library} PRIVATE -fsanitize=fuzzer-no-link ${envmis_fuzz_sanitizers})
@@ -62,4 +63,9 @@ if(TARGET envmis_io)
   # (envmis's own leaks are caught by the ASan unit tests), and a slow input may take
   # minutes under ASan without being called a hang.
   envmis_fuzz_target(image_fuzz envmis_make_image_fuzz_seed envmis::io -detect_leaks=0 -rss_limit_mb=0 -timeout=300)
+
+  # The report's reader and writer (nlohmann/json inside): inputs are text, so a
+  # dictionary of the field names helps the fuzzer past the schema.
+  add_executable(envmis_make_report_fuzz_seed ${CMAKE_CURRENT_LIST_DIR}/make_report_fuzz_seed.cpp)
+  envmis_fuzz_target(report_fuzz envmis_make_report_fuzz_seed envmis::report -dict=${CMAKE_CURRENT_LIST_DIR}/report_fuzz.dict)
 endif()

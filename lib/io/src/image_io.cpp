@@ -3,8 +3,12 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <climits>
+#include <cstring>
 #include <fstream>
 #include <span>
 
@@ -47,12 +51,21 @@ std::string input_space(const fs::path& path, const OIIO::ImageSpec& spec, const
     return require_space(path, colour, spec.format.is_floating_point() ? "lin_rec709" : "sRGB");
 }
 
-std::unique_ptr<OIIO::ImageInput> open_image(const fs::path& path) {
+// An input must be a regular file (through symbolic links) that this process may read:
+// a FIFO without a writer or a device such as /dev/zero would block or never end a read,
+// and the readers' own messages for a file they may not open do not say why.
+void require_regular_file(const fs::path& path) {
     std::error_code ec;
     const fs::file_status status = fs::status(path, ec);
     if (status.type() == fs::file_type::not_found) fail(path, "no such file");
     if (ec) fail(path, ec.message());
-    if (fs::is_directory(status)) fail(path, "is a directory, not an image file");
+    if (fs::is_directory(status)) fail(path, "is a directory, not a regular file");
+    if (!fs::is_regular_file(status)) fail(path, "not a regular file");
+    if (::access(path.c_str(), R_OK) != 0) fail(path, std::string("cannot read (") + std::strerror(errno) + ")");
+}
+
+std::unique_ptr<OIIO::ImageInput> open_image(const fs::path& path) {
+    require_regular_file(path);
     auto in = OIIO::ImageInput::open(path.string());
     if (!in) fail(path, "not a readable image file (" + OIIO::geterror() + ")");
     const OIIO::ImageSpec& spec = in->spec();
@@ -60,6 +73,9 @@ std::unique_ptr<OIIO::ImageInput> open_image(const fs::path& path) {
         fail(path, "image has no pixels (" + std::to_string(spec.width) + "x" + std::to_string(spec.height) + ")");
     if (static_cast<uint64_t>(spec.width) * static_cast<uint64_t>(spec.height) > kMaxPixels)
         fail(path, "image too large (" + std::to_string(spec.width) + "x" + std::to_string(spec.height) + ")");
+    if (uint64_t(std::max(spec.full_width, 0)) * uint64_t(std::max(spec.full_height, 0)) > kMaxPixels)
+        fail(path, "display window too large (" + std::to_string(spec.full_width) + "x" +
+                       std::to_string(spec.full_height) + ")");
     if (spec.depth != 1 || spec.deep) fail(path, "volume and deep images are not supported");
     if (spec.nchannels < 1) fail(path, "unsupported channel count " + std::to_string(spec.nchannels));
     return in;
@@ -128,8 +144,6 @@ RgbImage read_pixels(const fs::path& path, OIIO::ImageInput& in, std::vector<std
     if (display.width <= 0 || display.height <= 0 ||
         (display.x == data.x && display.y == data.y && display.width == data.width && display.height == data.height))
         return read_data_window(path, in, stop);
-    if (static_cast<uint64_t>(display.width) * static_cast<uint64_t>(display.height) > kMaxPixels)
-        fail(path, "display window too large (" + display.to_string() + ")");
     const RgbImage stored = read_data_window(path, in, stop);
     RgbImage image{static_cast<uint32_t>(display.width), static_cast<uint32_t>(display.height), {}};
     image.pixels.resize(size_t{image.width} * image.height);
@@ -199,13 +213,9 @@ void write_atomically(const fs::path& path, const char* format, const OIIO::Imag
 }  // namespace
 
 uint64_t hash_file(const fs::path& path, StopFlag stop) {
-    std::error_code ec;
-    const fs::file_status status = fs::status(path, ec);
-    if (status.type() == fs::file_type::not_found) fail(path, "no such file");
-    if (ec) fail(path, ec.message());
-    if (!fs::is_regular_file(status)) fail(path, "not a regular file");
+    require_regular_file(path);
     std::ifstream in(path, std::ios::binary);
-    if (!in) fail(path, "cannot open to hash");
+    if (!in) fail(path, std::string("cannot open to hash (") + std::strerror(errno) + ")");
     Hasher hasher;
     std::vector<char> chunk(size_t{1} << 20);
     do {
@@ -215,6 +225,17 @@ uint64_t hash_file(const fs::path& path, StopFlag stop) {
     } while (in);
     if (in.bad()) fail(path, "read error while hashing");
     return hasher.digest();
+}
+
+ImageSize read_image_size(const fs::path& path) {
+    const auto in = open_image(path);
+    const OIIO::ImageSpec& spec = in->spec();
+    const bool windowed = spec.full_width > 0 && spec.full_height > 0;
+    ImageSize size;
+    size.width = static_cast<uint32_t>(windowed ? spec.full_width : spec.width);
+    size.height = static_cast<uint32_t>(windowed ? spec.full_height : spec.height);
+    size.largest_texels = std::max(uint64_t{size.width} * size.height, uint64_t(spec.width) * uint64_t(spec.height));
+    return size;
 }
 
 LoadedImage load_image(const fs::path& path, const LoadOptions& options) {

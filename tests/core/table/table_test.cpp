@@ -473,6 +473,57 @@ TEST_F(TableTest, ImpossibleStatisticsAreRejectedNamingTheField) {
     edited(kReservedAt, uint32_t{1}, "reserved field is 1");
 }
 
+// Recomputes the payload checksum (a table without bins: it ends the file) after an edit
+// of the payload.
+void reseal_payload(std::vector<char>& bytes) {
+    const size_t payload = kPreamble + u32_at(bytes, kMetadataSizeAt) + 8, end = bytes.size() - 8;
+    const uint64_t digest = hash64(std::as_bytes(std::span(bytes.data() + payload, end - payload)));
+    std::memcpy(bytes.data() + end, &digest, sizeof digest);
+}
+
+constexpr size_t kLumaAt = kPreamble + 20;
+
+// A crafted table whose checksums were recomputed states facts that its payload must
+// confirm: luminance weights in range and summing to 1, the statistics the radiance's,
+// each density value the radiance's.
+TEST_F(TableTest, HeaderFactsThatThePayloadContradictsAreRejectedNamingThem) {
+    const fs::path path = saved_table();
+    const std::vector<char> good = bytes_of(path);
+    const size_t payload = kPreamble + u32_at(good, kMetadataSizeAt) + 8, texels = 96 * 48;
+    const auto rejected = [&](std::vector<char> bytes, const std::string& problem) {
+        reseal(bytes);
+        reseal_payload(bytes);
+        write_bytes(path, bytes);
+        SCOPED_TRACE(problem);
+        expect_rejected(path, problem);
+    };
+    const auto with = [&](size_t offset, auto value) {
+        std::vector<char> bytes = good;
+        std::memcpy(bytes.data() + offset, &value, sizeof value);
+        return bytes;
+    };
+    const EnvMapStats& stats = map_.stats();
+    ASSERT_GT(stats.threshold, 0) << "a compensated map";
+    rejected(with(kThresholdAt, 1e30f), "threshold");
+    rejected(with(kThresholdAt, stats.threshold * 1.01f), "threshold");
+    rejected(with(kThresholdAt, stats.threshold * 1.01f), "is not the radiance's");
+    rejected(with(kLumaAt, 1e30f), "invalid luma coefficient red 1e+30");
+    rejected(with(kLumaAt, 0.5f), "invalid luma coefficients summing to");
+    rejected(with(kMeanAt, stats.mean_luminance * 1.01), "mean luminance");
+    rejected(with(kMaxAt, stats.max_luminance * 1.01f), "max luminance");
+    rejected(with(kMinAt, stats.min_positive_luminance * 1.01f), "min luminance");
+    std::vector<char> zeros = good;
+    std::fill_n(zeros.begin() + static_cast<std::ptrdiff_t>(payload), 4 * texels, char{0});
+    rejected(zeros, "density values are not those of the radiance");
+    std::vector<char> bright = good;
+    const float top = std::numeric_limits<float>::max();
+    for (size_t c = 0; c < 3; ++c) std::memcpy(bright.data() + payload + 4 * texels + 12 * 100 + 4 * c, &top, 4);
+    rejected(bright, "is not the radiance's");
+    // The untouched table, resealed, still reads.
+    write_bytes(path, good);
+    EXPECT_NO_THROW(read_table(path));
+}
+
 // The statistics of a black map and of a constant one (fallbacks) are what the reader expects.
 TEST_F(TableTest, FallbackTablesPassTheStatisticsChecks) {
     for (const Rgb c : {Rgb{0, 0, 0}, Rgb{0.5f, 0.5f, 0.5f}}) {

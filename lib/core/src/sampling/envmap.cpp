@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 
@@ -206,6 +207,78 @@ uint32_t fill_density_row(const uint32_t* luminance, uint32_t w, float weight, f
     return zeroed;
 }
 
+// Whether a and b differ by more than `relative` of the larger.
+bool differ(double a, double b, double relative) noexcept {
+    return !(std::abs(a - b) <= relative * std::max(std::abs(a), std::abs(b)));
+}
+
+// The facts a stored map (a table's payload) states, checked against its radiance before
+// it is used, so that a crafted table whose checksums were recomputed is refused: every
+// channel finite and >= 0; the mean, largest and smallest positive luminance those of the
+// radiance (to 1e-3: builds of older format versions summed in other orders); the
+// threshold alpha times the mean; each density value the build's from its texel (to 1e-4
+// of the texel's luminance plus the threshold, times its row's weight). One pass over the
+// radiance and the density, parallel over rows. Throws std::invalid_argument naming the
+// first fact that differs.
+void check_stored(RgbImageView radiance, const uint32_t* density, const EnvMapOptions& options,
+                  const EnvMapStats& stats) {
+    const uint32_t w = radiance.width, h = radiance.height;
+    const bool uniform = stats.fallback == DensityFallback::uniform;
+    std::vector<RowStats> rows(h);
+    std::vector<uint64_t> bad(h), wrong(h);
+    detail::parallel_for(h, kRowsPerChunk, [&](uint32_t lo, uint32_t hi) {
+        std::vector<uint32_t> luminance(w);
+        std::vector<float> expected(w);
+        for (uint32_t y = lo; y < hi; ++y) {
+            const Rgb* pixels = radiance.pixels.data() + size_t{y} * w;
+            if (!scan_row(pixels, w, options.luma, luminance.data(), rows[y])) {
+                for (uint32_t x = 0; x < w; ++x) {
+                    BadPixels b;
+                    Rgb copy = pixels[x];
+                    sanitize_pixel(copy, b);
+                    bad[y] += b.total();
+                }
+                continue;
+            }
+            if (!std::isfinite(rows[y].sum)) rows[y].sum = exact_row_sum(luminance.data(), w);
+            const float weight = row_weight(options.mapping, y, h);
+            fill_density_row(luminance.data(), w, weight, stats.threshold, uniform, expected.data());
+            const uint32_t* stored = density + size_t{y} * w;
+            for (uint32_t x = 0; x < w; ++x) {
+                const float l = uniform ? 1.0f : std::bit_cast<float>(luminance[x]) + stats.threshold;
+                wrong[y] += !(std::abs(std::bit_cast<float>(stored[x]) - expected[x]) <= 1e-4f * l * weight);
+            }
+        }
+    });
+    const auto total = [](const std::vector<uint64_t>& v) { return std::accumulate(v.begin(), v.end(), uint64_t{0}); };
+    if (const uint64_t n = total(bad))
+        throw std::invalid_argument(std::to_string(n) + " radiance values are negative, NaN or infinite");
+    std::vector<double> row_sums(h);
+    float max = 0, min_positive = std::numeric_limits<float>::infinity();
+    for (uint32_t y = 0; y < h; ++y)
+        row_sums[y] = rows[y].sum, max = std::max(max, rows[y].max),
+        min_positive = std::min(min_positive, rows[y].min_positive);
+    const double mean = solid_angle_mean_of_rows(row_sums, w, options.mapping);
+    check_power(mean);
+    const auto fact = [](bool ok, const char* name, double stated, double actual) {
+        if (ok) return;
+        char text[160];
+        std::snprintf(text, sizeof text, "%s %.9g is not the radiance's (%.9g)", name, stated, actual);
+        throw std::invalid_argument(text);
+    };
+    fact(!differ(stats.mean_luminance, mean, 1e-3), "mean luminance", stats.mean_luminance, mean);
+    fact(!differ(stats.max_luminance, max, 1e-3), "max luminance", stats.max_luminance, max);
+    if (!std::isfinite(min_positive)) min_positive = 0;
+    fact(!differ(stats.min_positive_luminance, min_positive, 1e-3), "min luminance", stats.min_positive_luminance,
+         min_positive);
+    // The threshold is 0 where nothing is compensated (the table reader checks that).
+    const bool thresholded = options.compensation.enabled && stats.fallback == DensityFallback::none;
+    const float threshold = compensation_threshold(stats.mean_luminance, options.compensation.alpha);
+    fact(!thresholded || !differ(stats.threshold, threshold, 1e-5), "threshold", stats.threshold, threshold);
+    if (const uint64_t n = total(wrong))
+        throw std::invalid_argument(std::to_string(n) + " density values are not those of the radiance");
+}
+
 }  // namespace
 
 EnvMap::EnvMap(RgbImage image, const EnvMapOptions& options, StopFlag stop) : options_(options) {
@@ -297,14 +370,7 @@ RgbPixels& EnvMap::adopt(RgbImage image) {
 void EnvMap::rebuild(LargeVector<uint32_t> density_bits) {
     check_image(radiance_, options_.mapping);
     check_options(options_);
-    size_t bad = 0;
-    for (const Rgb& p : radiance_.pixels) {
-        BadPixels b;
-        Rgb copy = p;
-        sanitize_pixel(copy, b);
-        bad += b.total();
-    }
-    if (bad) throw std::invalid_argument(std::to_string(bad) + " radiance values are negative, NaN or infinite");
+    check_stored(radiance_, density_bits.data(), options_, stats_);
     const uint32_t w = radiance_.width;
     distribution_ = Distribution2D(w, radiance_.height, std::move(density_bits),
                                    [w](uint32_t, std::span<const uint32_t> bits, std::span<float> row) {

@@ -78,13 +78,13 @@ RgbImage downsample(RgbImageView image, uint32_t max_width, Mapping mapping) {
 }
 
 std::vector<double> exact_variances(const EnvMap& env, Technique technique, Allocation allocation,
-                                    std::span<const Bsdf> bsdfs, std::span<const ShadingPoint> points,
-                                    int subdivisions) {
+                                    std::span<const Bsdf> bsdfs, std::span<const ShadingPoint> points, int subdivisions,
+                                    StopFlag stop) {
     std::vector<double> variances;
     variances.reserve(bsdfs.size() * points.size());
     for (const Bsdf& bsdf : bsdfs)
         for (const ShadingPoint& point : points)
-            variances.push_back(exact_variance(env, technique, allocation, bsdf, point, subdivisions));
+            variances.push_back(exact_variance(env, technique, allocation, bsdf, point, subdivisions, stop));
     return variances;
 }
 

@@ -106,7 +106,7 @@ DirectLightingEstimator study_estimator(const EnvMap& plain, const EnvMap& compe
 }
 
 std::vector<double> exact_point_variances(const StudyInputs& inputs, const Technique& technique, size_t bsdf,
-                                          int subdivisions) {
+                                          int subdivisions, StopFlag stop) {
     const Bsdf& b = inputs.options.bsdfs.at(bsdf);
     if (technique.bins && !inputs.binned)
         throw std::invalid_argument("exact_point_variances: " + technique.name() + " needs the binned map");
@@ -116,8 +116,8 @@ std::vector<double> exact_point_variances(const StudyInputs& inputs, const Techn
     for (const ShadingPoint& point : inputs.points)
         variances.push_back(
             technique.bins
-                ? exact_variance(*inputs.binned, technique, inputs.options.allocation, b, point, subdivisions)
-                : exact_variance(sampled, technique, inputs.options.allocation, b, point, subdivisions));
+                ? exact_variance(*inputs.binned, technique, inputs.options.allocation, b, point, subdivisions, stop)
+                : exact_variance(sampled, technique, inputs.options.allocation, b, point, subdivisions, stop));
     return variances;
 }
 
@@ -172,6 +172,21 @@ TechniqueStats technique_stats(const CellTable& table, size_t b, size_t t, size_
     return s;
 }
 
+// Appends the point's reference for each BSDF; false, with nothing appended, once `stop`
+// is set (an 8k map's quadrature takes seconds: it stops within a row).
+bool add_references(const EnvMap& plain, const ShadingPoint& point, const ComparisonOptions& options, StopFlag stop,
+                    std::vector<double>& references) {
+    const size_t first = references.size();
+    try {
+        for (const Bsdf& bsdf : options.bsdfs)
+            references.push_back(reflected_radiance(plain, bsdf, point, options.quadrature, stop).luminance);
+        return true;
+    } catch (const Interrupted&) {
+        references.resize(first);
+        return false;
+    }
+}
+
 // The study with one compensated map for every BSDF.
 Comparison compare_one(const EnvMap& plain, const EnvMap& compensated, const BinnedEnvMap* binned,
                        std::span<const ShadingPoint> points, const ComparisonOptions& options,
@@ -192,8 +207,7 @@ Comparison compare_one(const EnvMap& plain, const EnvMap& compensated, const Bin
     if (progress) progress(0, points.size());
     for (; done < points.size() && !(stop && stop->load()); ++done) {
         const ShadingPoint& point = points[done];
-        for (const Bsdf& bsdf : options.bsdfs)
-            references.push_back(reflected_radiance(plain, bsdf, point, options.quadrature).luminance);
+        if (!add_references(plain, point, options, stop, references)) break;
         const size_t first = cells.size();
         cells.resize(first + nb * nt);
         std::atomic<size_t> next{0};
@@ -255,20 +269,20 @@ Comparison compare_one(const EnvMap& plain, const EnvMap& compensated, const Bin
 
 }  // namespace
 
-EnvMap compensated_map(const EnvMap& plain, float alpha) {
+EnvMap compensated_map(const EnvMap& plain, float alpha, StopFlag stop) {
     EnvMapOptions options = plain.options();
     options.compensation = {true, alpha};
-    return EnvMap(to_image(plain.radiance()), options);
+    return EnvMap(to_image(plain.radiance()), options, stop);
 }
 
-CompensatedMaps compensated_maps(const EnvMap& plain, std::span<const float> bsdf_alphas) {
+CompensatedMaps compensated_maps(const EnvMap& plain, std::span<const float> bsdf_alphas, StopFlag stop) {
     CompensatedMaps result;
     for (float alpha : bsdf_alphas) {
         const size_t i =
             static_cast<size_t>(std::find(result.alphas.begin(), result.alphas.end(), alpha) - result.alphas.begin());
         if (i == result.alphas.size()) {
             result.alphas.push_back(alpha);
-            result.maps.push_back(compensated_map(plain, alpha));
+            result.maps.push_back(compensated_map(plain, alpha, stop));
         }
         result.of_bsdf.push_back(i);
     }

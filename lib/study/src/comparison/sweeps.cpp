@@ -91,8 +91,18 @@ AlphaSweep run_alpha_sweep(const StudyInputs& inputs, std::span<const float> alp
     const std::span<const ShadingPoint> points = inputs.points;
     AlphaSweep sweep;
     sweep.allocation = options.allocation;
+    // The quadratures stop as the runs do: a sweep cut short keeps the alphas completed.
+    const auto exact_ratios_to = [&](const EnvMap& env, const Technique& technique, std::vector<double>& out) {
+        try {
+            out = exact_variances(env, technique, options.allocation, options.bsdfs, points, 1, control.stop);
+            return true;
+        } catch (const Interrupted&) {
+            sweep.interrupted = true;
+            return false;
+        }
+    };
     std::vector<double> baseline;
-    if (exact) baseline = exact_variances(inputs.plain, kBalance, options.allocation, options.bsdfs, points, 1);
+    if (exact && !exact_ratios_to(inputs.plain, kBalance, baseline)) return sweep;
     for (size_t i = 0; i < alphas.size(); ++i) {
         const CompensatedMaps compensated =
             compensated_maps(inputs.plain, std::vector<float>(options.bsdfs.size(), alphas[i]));
@@ -114,10 +124,10 @@ AlphaSweep run_alpha_sweep(const StudyInputs& inputs, std::span<const float> alp
             sweep.interrupted = true;
             break;
         }
-        if (exact)
-            sweep.exact.push_back(geometric_mean_ratios(
-                exact_variances(compensated.maps.front(), kBalanceComp, options.allocation, options.bsdfs, points, 1),
-                baseline, options.bsdfs.size()));
+        if (std::vector<double> variances; exact) {
+            if (!exact_ratios_to(compensated.maps.front(), kBalanceComp, variances)) break;
+            sweep.exact.push_back(geometric_mean_ratios(variances, baseline, options.bsdfs.size()));
+        }
         sweep.alphas.push_back(alphas[i]);
         sweep.comparisons.push_back(std::move(c));
     }

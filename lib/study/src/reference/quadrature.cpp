@@ -21,9 +21,10 @@ struct Node {
 
 // Sums fn(acc, node) over the midpoints of s x s sub-cells of every non-black texel
 // whose sub-cell lies above the surface. Rows are summed separately and then in order,
-// so the result does not depend on the number of threads.
+// so the result does not depend on the number of threads. Throws Interrupted once `stop`
+// is set, a row later at most.
 template <class Acc, class Fn>
-Acc integrate(const EnvMap& map, const ShadingPoint& point, int s, Fn&& fn) {
+Acc integrate(const EnvMap& map, const ShadingPoint& point, int s, StopFlag stop, Fn&& fn) {
     const uint32_t w = map.width(), h = map.height(), ws = w * static_cast<uint32_t>(s);
     const Frame frame = Frame::from_normal(point.normal);
     std::vector<float> cos_phi(ws), sin_phi(ws);
@@ -38,7 +39,7 @@ Acc integrate(const EnvMap& map, const ShadingPoint& point, int s, Fn&& fn) {
     if (map.options().mapping == Mapping::equal_area) {
         // Every sub-cell of an equal-area map covers the same solid angle.
         const double solid_angle = 4 * kPi / (static_cast<double>(ws) * h * s);
-        detail::parallel_for(h, 1, [&](uint32_t lo, uint32_t hi) {
+        detail::parallel_for(h, 1, stop, [&](uint32_t lo, uint32_t hi) {
             for (uint32_t y = lo; y < hi; ++y)
                 for (uint32_t x = 0; x < w; ++x) {
                     const Rgb l = radiance[size_t{y} * w + x];
@@ -53,7 +54,7 @@ Acc integrate(const EnvMap& map, const ShadingPoint& point, int s, Fn&& fn) {
                 }
         });
     } else {
-        detail::parallel_for(h, 1, [&](uint32_t lo, uint32_t hi) {
+        detail::parallel_for(h, 1, stop, [&](uint32_t lo, uint32_t hi) {
             for (uint32_t y = lo; y < hi; ++y)
                 for (int b = 0; b < s; ++b) {
                     const double v = (y + (b + 0.5) / s) / h, theta = kPi * v;
@@ -91,11 +92,11 @@ Rgb multiply(Rgb a, Rgb b) { return {a.r * b.r, a.g * b.g, a.b * b.b}; }
 }  // namespace
 
 QuadratureResult reflected_radiance(const EnvMap& map, const Bsdf& bsdf, const ShadingPoint& point,
-                                    const QuadratureOptions& options) {
+                                    const QuadratureOptions& options, StopFlag stop) {
     const Vec3 wo = Frame::from_normal(point.normal).to_local(point.wo);
     const LumaCoefficients luma = map.options().luma;
     auto at = [&](int s) {
-        const RgbSum sum = integrate<RgbSum>(map, point, s, [&](RgbSum& acc, const Node& n) {
+        const RgbSum sum = integrate<RgbSum>(map, point, s, stop, [&](RgbSum& acc, const Node& n) {
             const Rgb f = multiply(n.radiance, bsdf.eval(wo, n.wi));
             acc.r += f.r * n.solid_angle, acc.g += f.g * n.solid_angle, acc.b += f.b * n.solid_angle;
         });
@@ -119,7 +120,7 @@ namespace {
 // radiance of `env`.
 template <class EnvPdf>
 double exact_variance_with(const EnvMap& env, EnvPdf&& env_pdf, Technique technique, Allocation allocation,
-                           const Bsdf& bsdf, const ShadingPoint& point, int subdivisions) {
+                           const Bsdf& bsdf, const ShadingPoint& point, int subdivisions, StopFlag stop) {
     // First and second moments of the weighted contributions of each sampling technique.
     struct Moments {
         double env1 = 0, env2 = 0, bsdf1 = 0, bsdf2 = 0;
@@ -139,7 +140,7 @@ double exact_variance_with(const EnvMap& env, EnvPdf&& env_pdf, Technique techni
     const double n_bsdf = strategy == Strategy::bsdf ? allocation.total() : (both ? allocation.bsdf : 0);
     const Vec3 wo = Frame::from_normal(point.normal).to_local(point.wo);
     const LumaCoefficients luma = env.options().luma;
-    const Moments m = integrate<Moments>(env, point, subdivisions, [&](Moments& acc, const Node& n) {
+    const Moments m = integrate<Moments>(env, point, subdivisions, stop, [&](Moments& acc, const Node& n) {
         const double f = luminance(multiply(n.radiance, bsdf.eval(wo, n.wi)), luma);
         if (f == 0) return;
         const double p_env = env_pdf(n.uv), p_bsdf = bsdf.pdf(wo, n.wi);
@@ -174,15 +175,15 @@ double exact_variance_with(const EnvMap& env, EnvPdf&& env_pdf, Technique techni
 }  // namespace
 
 double exact_variance(const EnvMap& env, Technique technique, Allocation allocation, const Bsdf& bsdf,
-                      const ShadingPoint& point, int subdivisions) {
+                      const ShadingPoint& point, int subdivisions, StopFlag stop) {
     if (technique.bins)
         throw std::invalid_argument("exact_variance: " + technique.name() + " samples a binned map: pass it");
     return exact_variance_with(
-        env, [&](Vec2 uv) { return env.pdf_uv(uv); }, technique, allocation, bsdf, point, subdivisions);
+        env, [&](Vec2 uv) { return env.pdf_uv(uv); }, technique, allocation, bsdf, point, subdivisions, stop);
 }
 
 double exact_variance(const BinnedEnvMap& binned, Technique technique, Allocation allocation, const Bsdf& bsdf,
-                      const ShadingPoint& point, int subdivisions) {
+                      const ShadingPoint& point, int subdivisions, StopFlag stop) {
     if (!technique.bins)
         throw std::invalid_argument("exact_variance: " + technique.name() + " does not sample a binned map");
     const BinnedEnvMapView view = binned.view();
@@ -197,7 +198,7 @@ double exact_variance(const BinnedEnvMap& binned, Technique technique, Allocatio
         const BinView bin = view.bin_at(view.class_bin(lobe, blend.bin[k]));
         variance += blend.weight[k] * exact_variance_with(
                                           binned.plain(), [&](Vec2 uv) { return bin.pdf_uv(uv); }, technique,
-                                          allocation, bsdf, point, subdivisions);
+                                          allocation, bsdf, point, subdivisions, stop);
     }
     return variance;
 }

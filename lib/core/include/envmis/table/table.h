@@ -133,7 +133,8 @@ Table parse_table(std::span<const std::byte> bytes, std::string_view name);
 // naming the table, if it has no bins or they do not fit its map.
 BinnedEnvMap binned_map(Table&& table);
 
-// True if the file starts with the table magic (cheap; does not validate the rest).
+// True if the file is a regular file that starts with the table magic (cheap; does not
+// validate the rest).
 bool looks_like_table(const std::filesystem::path& path) noexcept;
 
 }  // namespace envmis

@@ -59,6 +59,16 @@ struct LoadedImage {
 
 LoadedImage load_image(const std::filesystem::path& path, const LoadOptions& options = {});
 
+// What load_image would make of a file, from its header alone (no pixel is read): the
+// map's size (the display window) and the texels of its largest buffer (the display or
+// the data window), for a caller to check against the memory it has before loading.
+// Throws ImageError as load_image does for a file it cannot open.
+struct ImageSize {
+    uint32_t width = 0, height = 0;
+    uint64_t largest_texels = 0;
+};
+ImageSize read_image_size(const std::filesystem::path& path);
+
 // envmis::hash64 (math/hash.h) of a file's bytes, any file: LoadedImage::content_hash, the
 // source hash a table records, and library mode's key for an up-to-date output. Reads the
 // file once in 1 MiB blocks (about a second per GB, mostly the disk's); once `stop` is

@@ -47,10 +47,10 @@ namespace envmis {
 RgbImage downsample(RgbImageView image, uint32_t max_width, Mapping mapping = Mapping::equirect);
 
 // The exact variance (exact_variance, at `subdivisions`) of `technique` sampling `env`,
-// at every (BSDF, point): element b * points.size() + p.
+// at every (BSDF, point): element b * points.size() + p. Throws Interrupted once `stop` is set.
 std::vector<double> exact_variances(const EnvMap& env, Technique technique, Allocation allocation,
-                                    std::span<const Bsdf> bsdfs, std::span<const ShadingPoint> points,
-                                    int subdivisions);
+                                    std::span<const Bsdf> bsdfs, std::span<const ShadingPoint> points, int subdivisions,
+                                    StopFlag stop = nullptr);
 
 // The geometric mean, over points, of variances[b, p] / baseline[b, p] for each BSDF b,
 // both laid out as exact_variances() returns them for `bsdfs` BSDFs; pairs in which

@@ -89,10 +89,11 @@ struct CompensatedMaps {
     float alpha_of(size_t bsdf) const { return alphas[of_bsdf[bsdf]]; }
 };
 
-// `plain` compensated with strength alpha (a new build from its radiance).
-EnvMap compensated_map(const EnvMap& plain, float alpha);
+// `plain` compensated with strength alpha (a new build from its radiance; throws
+// Interrupted once `stop` is set, as EnvMap's build does).
+EnvMap compensated_map(const EnvMap& plain, float alpha, StopFlag stop = nullptr);
 // One map per distinct value of bsdf_alphas, each BSDF's alpha.
-CompensatedMaps compensated_maps(const EnvMap& plain, std::span<const float> bsdf_alphas);
+CompensatedMaps compensated_maps(const EnvMap& plain, std::span<const float> bsdf_alphas, StopFlag stop = nullptr);
 
 // What a study runs on: the same map without compensation (`plain`, sampled by the
 // techniques that do not compensate, and the quadrature references' radiance) and with
@@ -120,9 +121,9 @@ DirectLightingEstimator study_estimator(const EnvMap& plain, const EnvMap& compe
 // The exact variance (quadrature.h, `subdivisions`) of one estimate by `technique` at
 // every point for BSDF number `bsdf` of inputs.options, over the map it samples (the
 // BSDF's compensated map, the plain map or inputs.binned, which a -bins technique
-// needs). Throws std::invalid_argument as exact_variance does.
+// needs). Throws std::invalid_argument as exact_variance does, and Interrupted once `stop` is set.
 std::vector<double> exact_point_variances(const StudyInputs& inputs, const Technique& technique, size_t bsdf,
-                                          int subdivisions);
+                                          int subdivisions, StopFlag stop = nullptr);
 
 // How a long run is watched and stopped: `stop` is checked between points and every
 // 4096 estimates within one (the run returns the points completed; a point cut short

@@ -8,9 +8,11 @@
 // the error estimate. Black texels and directions below the surface are skipped.
 //
 // Cost: O(w h s^2) BSDF evaluations, parallel over rows; deterministic for any number of
-// threads.
+// threads. Seconds on an 8k map: each call takes an optional StopFlag (interrupt.h) and
+// throws Interrupted a row after it is set.
 #pragma once
 
+#include "envmis/interrupt.h"
 #include "envmis/sampling/envmap.h"
 #include "envmis/study/shading/bsdf.h"
 #include "envmis/study/techniques/estimator.h"
@@ -31,7 +33,7 @@ struct QuadratureResult {
 
 // Reflected radiance L_o = integral of L(wi) f(wo, wi) cos(theta_i) dwi.
 QuadratureResult reflected_radiance(const EnvMap& map, const Bsdf& bsdf, const ShadingPoint& point,
-                                    const QuadratureOptions& options = {});
+                                    const QuadratureOptions& options = {}, StopFlag stop = nullptr);
 
 // The exact variance of one estimate's luminance by `technique` with `allocation`
 // (estimator.h), sampling `env` (plain or compensated, as the technique says) and
@@ -41,12 +43,12 @@ QuadratureResult reflected_radiance(const EnvMap& map, const Bsdf& bsdf, const S
 // s. Throws std::invalid_argument for an adaptive technique (its weights are learnt)
 // and for the mixture (it samples two maps).
 double exact_variance(const EnvMap& env, Technique technique, Allocation allocation, const Bsdf& bsdf,
-                      const ShadingPoint& point, int subdivisions);
+                      const ShadingPoint& point, int subdivisions, StopFlag stop = nullptr);
 // The same for a -bins technique: the environment density is a bin around the point's
 // lobe axis in the BSDF's lobe class, picked at random with the blend's weights
 // (binned.h), so the variance is the weights' sum of the bins' variances; the radiance
 // the binned map's plain one.
 double exact_variance(const BinnedEnvMap& binned, Technique technique, Allocation allocation, const Bsdf& bsdf,
-                      const ShadingPoint& point, int subdivisions);
+                      const ShadingPoint& point, int subdivisions, StopFlag stop = nullptr);
 
 }  // namespace envmis
