@@ -21,7 +21,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (!run) return 0;
     // Two runs of one map: the cases, their means and the plots' links across runs.
     std::ostringstream out;
-    envmis::write_markdown(out, {*run, *run}, {.title = "fuzz", .command = "", .plots = "plots", .no_timing = false});
-    envmis::write_markdown(out, {*run}, {.no_timing = true});
+    envmis::MarkdownOptions options;
+    options.plots = "plots";
+    envmis::write_markdown(out, {*run, *run}, options);
+    options.no_timing = true;
+    envmis::write_markdown(out, {*run}, options);
     return 0;
 }

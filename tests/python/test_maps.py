@@ -335,11 +335,13 @@ def test_a_binned_map_samples_with_the_pdf_it_reports_and_checks_its_normals():
 
 
 @needs_cli
-@pytest.mark.parametrize("case", ["missing", "not an image", "corrupt table"])
+@pytest.mark.parametrize("case", ["missing", "not an image", "corrupt table", "fifo"])
 def test_a_bad_file_raises_the_message_the_command_prints(tmp_path, case):
     path = tmp_path / "input.hdr"
     if case == "not an image":
         path.write_text("this is not an image\n")
+    elif case == "fifo":  # a read would wait for a writer for ever
+        os.mkfifo(path)
     elif case == "corrupt table":
         path = tmp_path / "map.envmis"
         envmis.EnvMap(random_radiance(16, 8, seed=1)).save(path)
