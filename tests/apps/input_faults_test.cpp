@@ -99,6 +99,16 @@ TEST_F(InputFaults, AnOverscanExrIsCroppedToItsDisplayWindowWithANote) {
     EXPECT_TRUE(contains(r.err, R"(^note: overscan\.exr: .*data outside it cropped)")) << r;
 }
 
+// The display window's black border beside the data's lit texels: the bins' densities
+// stay finite there (a black cell beside a lit one), and so does every estimate.
+TEST_F(InputFaults, ACroppedExrGivesFiniteBinnedEstimates) {
+    write_exr(file("crop.exr"), constant(4, 2, 1.0f), 2, 1, 16, 8);
+    const Result r = envmis({"compare", "crop.exr", "--bins", "16", "--points", "8", "--spp", "64", "--bsdf",
+                             "lambert,ggx:0.1", "--techniques", "mis-balance,mis-balance-bins"});
+    ASSERT_EQ(r.exit_code, 0) << r;
+    EXPECT_FALSE(contains(r.out, "(nan|inf)")) << r;
+}
+
 // An input that is not a regular file would block (a FIFO without a writer) or never end
 // (/dev/zero): refused before any read, naming it.
 TEST_F(InputFaults, AnInputThatIsAFifoOrADeviceIsRefusedNamingIt) {
