@@ -27,8 +27,16 @@ add_test(NAME consumer.core-contents
     -P ${CMAKE_CURRENT_LIST_DIR}/core_contents.cmake)
 set_tests_properties(consumer.core-contents PROPERTIES FIXTURES_REQUIRED envmis_installed LABELS consumer)
 
+# Each consumer asks for its own component alone. The core and study consumers also
+# hide the third-party packages the other components need (OpenImageIO and OpenColorIO
+# through pkg-config, nlohmann_json): their configuration must not look for them.
+set(envmis_hidden_packages -DCMAKE_DISABLE_FIND_PACKAGE_PkgConfig=ON -DCMAKE_DISABLE_FIND_PACKAGE_nlohmann_json=ON)
 foreach(kind core study io)
   set(build ${envmis_consumer_dir}/build-${kind})
+  set(hidden ${envmis_hidden_packages})
+  if(kind STREQUAL "io")
+    set(hidden)
+  endif()
   add_test(NAME consumer.${kind}
     COMMAND ${CMAKE_CTEST_COMMAND} --build-and-test ${CMAKE_CURRENT_LIST_DIR} ${build}
       --build-generator ${CMAKE_GENERATOR}
@@ -36,7 +44,7 @@ foreach(kind core study io)
       --build-project envmis_consumer
       --build-target consumer_${kind}
       --build-options -DCMAKE_PREFIX_PATH=${envmis_consumer_prefix} -DCMAKE_BUILD_TYPE=$<CONFIG>
-        -DCMAKE_CXX_COMPILER=${CMAKE_CXX_COMPILER}
+        -DCMAKE_CXX_COMPILER=${CMAKE_CXX_COMPILER} -DENVMIS_CONSUMER_COMPONENTS=${kind} ${hidden}
       --test-command consumer_${kind} ${build}/work)
   # $OCIO points at the installed config: the library would otherwise find the one in
   # this source tree first.
