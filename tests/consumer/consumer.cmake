@@ -51,4 +51,17 @@ foreach(kind core study io)
   set_tests_properties(consumer.${kind} PROPERTIES FIXTURES_REQUIRED envmis_installed LABELS consumer TIMEOUT 600
     ENVIRONMENT OCIO=${envmis_consumer_prefix}/${CMAKE_INSTALL_DATADIR}/envmis/ocio/config.ocio)
 endforeach()
+# The runtime through pkg-config alone, as a Makefile would build it (--define-prefix:
+# the test installs into a prefix other than the configured one).
+find_program(envmis_pkg_config pkg-config)
+if(envmis_pkg_config)
+  set(build ${envmis_consumer_dir}/build-pkgconfig)
+  add_test(NAME consumer.core-pkgconfig
+    COMMAND sh -c "mkdir -p '${build}/work' && \"$0\" -std=c++20 '${CMAKE_CURRENT_LIST_DIR}/main.cpp' \
+      $(PKG_CONFIG_PATH='${envmis_consumer_prefix}/${CMAKE_INSTALL_LIBDIR}/pkgconfig' \"$1\" --define-prefix \
+      --cflags --libs --static envmis-core) -o '${build}/consumer_core' && '${build}/consumer_core' '${build}/work'"
+      ${CMAKE_CXX_COMPILER} ${envmis_pkg_config})
+  set_tests_properties(consumer.core-pkgconfig PROPERTIES FIXTURES_REQUIRED envmis_installed LABELS consumer
+    TIMEOUT 300)
+endif()
 set_tests_properties(consumer.clean consumer.install PROPERTIES LABELS consumer)
