@@ -320,13 +320,23 @@ uint64_t header_texels(const std::filesystem::path& input) {
 }
 
 void check_map_memory(const std::filesystem::path& input, uint64_t bytes_per_texel) {
-    if (looks_like_table(input)) return;
+    const auto check = [&](uint32_t w, uint32_t h, uint64_t texels, uint64_t per_texel) {
+        check_memory(input.string() + " (" + std::to_string(w) + "x" + std::to_string(h) + ")", texels * per_texel);
+    };
+    if (looks_like_table(input)) {
+        // A mapped table copies only its density (4 bytes a texel) beside its sampling
+        // tables (6); a compact or version 1-2 table is read whole and decoded (24).
+        const TableHeader header = read_table_header(input);
+        const bool read_whole = header.compact || header.version < 3;
+        check(header.width, header.height, uint64_t{header.width} * header.height, read_whole ? 24 : 12);
+        return;
+    }
     const io::ImageSize size = io::read_image_size(input);
-    check_memory(input.string() + " (" + std::to_string(size.width) + "x" + std::to_string(size.height) + ")",
-                 size.largest_texels * bytes_per_texel);
+    check(size.width, size.height, size.largest_texels, bytes_per_texel);
 }
 
 LoadedMap load_map(const std::string& path, const MapFlags& flags, std::ostream& notes) {
+    check_map_memory(path, kBuildPeak);
     if (looks_like_table(path)) {
         const auto start = std::chrono::steady_clock::now();
         Table table = read_table(path);
@@ -337,7 +347,6 @@ LoadedMap load_map(const std::string& path, const MapFlags& flags, std::ostream&
         loaded.load_ms = milliseconds_since(start);
         return loaded;
     }
-    check_map_memory(path, kBuildPeak);
     BuiltMap built = build_map(path, build_request(flags), &interrupted());
     for (const std::string& notice : built.notices) notes << "note: " << printable(notice) << "\n";
     return loaded_map(built);

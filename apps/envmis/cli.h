@@ -122,8 +122,8 @@ inline constexpr uint64_t kBuildPeak = 32;
 // regular file (loading it then says why).
 uint64_t header_texels(const std::filesystem::path& input);
 // Checks, from its header alone and before any pixel is read, that an image's map of
-// `bytes_per_texel` per texel fits in available_memory(); throws "FILE (WxH): needs N MB
-// of memory, more than the M MB available". Tables are not checked: they are mapped.
+// `bytes_per_texel` per texel, or a table's load, fits in available_memory(); throws
+// "FILE (WxH): needs N MB of memory, more than the M MB available".
 void check_map_memory(const std::filesystem::path& input, uint64_t bytes_per_texel);
 
 // A map ready to sample, and where it came from.

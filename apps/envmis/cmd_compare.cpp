@@ -669,32 +669,36 @@ void run_library_compare(const CompareArgs& args) {
     if (!(args.threads_flag && args.threads_flag->count() > 0))
         shared.threads = std::max(1u, hardware_cores() / std::min<uint32_t>(args.jobs, uint32_t(items.size())));
     const std::string options = options_text(args);
-    run_library(items,
-                {"compare", args.jobs,
-                 args.summary.empty() ? dir / "summary.json" : std::filesystem::path(args.summary), kComparePeak},
-                [&](const LibraryItem& item, uint64_t hash) {
-                    MapOutcome outcome;
-                    if (!args.force && results_up_to_date(item.output, hash, options)) {
-                        outcome.status = "up-to-date";
-                        outcome.printed = "envmis compare: " + item.output.string() + " is up to date\n";
-                        return outcome;
-                    }
-                    CompareArgs one = shared;
-                    one.input = item.input.string();
-                    one.source_hash = hash_text(hash);
-                    one.json = item.output.string();
-                    const std::string stem = item.input.stem().string();
-                    if (!args.csv.empty()) one.csv = (std::filesystem::path(args.csv) / (stem + ".csv")).string();
-                    if (!args.plots.empty()) one.plots = (std::filesystem::path(args.plots) / stem).string();
-                    if (!args.images.empty()) one.images = (std::filesystem::path(args.images) / stem).string();
-                    std::ostringstream out, notes;
-                    one.notes = &notes;
-                    compare_one(one, out);
-                    outcome.status = "written";
-                    outcome.printed = out.str();
-                    outcome.notes = notes.str();
-                    return outcome;
-                });
+    const auto matches = [&](const std::filesystem::path& output, uint64_t hash) {
+        return results_up_to_date(output, hash, options);
+    };
+    run_library(
+        items,
+        {"compare", args.jobs, args.summary.empty() ? dir / "summary.json" : std::filesystem::path(args.summary),
+         kComparePeak, matches},
+        [&](const LibraryItem& item, uint64_t hash) {
+            MapOutcome outcome;
+            if (!args.force && results_up_to_date(item.output, hash, options)) {
+                outcome.status = "up-to-date";
+                outcome.printed = "envmis compare: " + item.output.string() + " is up to date\n";
+                return outcome;
+            }
+            CompareArgs one = shared;
+            one.input = item.input.string();
+            one.source_hash = hash_text(hash);
+            one.json = item.output.string();
+            const std::string stem = item.input.stem().string();
+            if (!args.csv.empty()) one.csv = (std::filesystem::path(args.csv) / (stem + ".csv")).string();
+            if (!args.plots.empty()) one.plots = (std::filesystem::path(args.plots) / stem).string();
+            if (!args.images.empty()) one.images = (std::filesystem::path(args.images) / stem).string();
+            std::ostringstream out, notes;
+            one.notes = &notes;
+            compare_one(one, out);
+            outcome.status = "written";
+            outcome.printed = out.str();
+            outcome.notes = notes.str();
+            return outcome;
+        });
 }
 
 }  // namespace

@@ -173,7 +173,10 @@ void precompute_items(const PrecomputeArgs& args, const std::vector<LibraryItem>
                       const std::filesystem::path& summary) {
     for (const LibraryItem& item : items) prepare_output(item.output);
     const std::string options = canonical_options(precompute_request(args));
-    run_library(items, {"precompute", args.jobs, summary, args.compact ? kCompactPeak : kFullPeak},
+    const auto matches = [&](const std::filesystem::path& output, uint64_t hash) {
+        return up_to_date(output, hash, options);
+    };
+    run_library(items, {"precompute", args.jobs, summary, args.compact ? kCompactPeak : kFullPeak, matches},
                 [&](const LibraryItem& item, uint64_t hash) {
                     MapOutcome outcome;
                     if (!args.force && up_to_date(item.output, hash, options)) {

@@ -167,30 +167,40 @@ private:
     uint32_t running_ = 0;
 };
 
-// The output of a map whose job failed, an earlier run's, no longer matches its input
-// (the input changed or became unreadable, or the options changed): removed, so that
-// the folder never holds an output that looks valid beside a failure. True if removed.
-bool remove_stale_output(const fs::path& output) {
+// The output of a map whose job failed, where it is shown not to match its input: the
+// input could not be read (no hash), or run.up_to_date says it holds other results.
+// Removed, so that the folder never holds an output that looks valid beside a failure.
+// True if removed.
+bool remove_stale_output(const LibraryRun& run, const fs::path& output, std::optional<uint64_t> hash) {
     std::error_code ec;
-    return fs::is_regular_file(fs::symlink_status(output, ec)) && fs::remove(output, ec);
+    if (!fs::is_regular_file(fs::symlink_status(output, ec))) return false;
+    if (hash && run.up_to_date && run.up_to_date(output, *hash)) return false;
+    return fs::remove(output, ec);
 }
 
 // One map through `job` once the gate admits it, timed, its failure caught: the summary's entry.
-nlohmann::json run_one(const LibraryItem& item, const MapJob& job, MemoryGate& gate, uint64_t bytes_per_texel,
+nlohmann::json run_one(const LibraryItem& item, const MapJob& job, MemoryGate& gate, const LibraryRun& run,
                        MapOutcome& outcome, std::string& error) {
     nlohmann::json entry = {{"input", item.input.string()}, {"output", item.output.string()}};
     auto start = std::chrono::steady_clock::now();
+    std::optional<uint64_t> hash;
+    bool unreadable = false;  // the input itself failed to be read
     try {
-        const uint64_t need = header_texels(item.input) * bytes_per_texel;
+        const uint64_t need = header_texels(item.input) * run.bytes_per_texel;
         if (!gate.admit(item.input, need)) return entry;
         const MemoryGate::Admitted admitted{gate, need};
         start = std::chrono::steady_clock::now();
         std::error_code ec;
         const uintmax_t bytes = fs::file_size(item.input, ec);
         if (!ec) entry["bytes"] = bytes;
-        const uint64_t hash = io::hash_file(item.input, &interrupted());
-        entry["source_hash"] = hash_text(hash);
-        outcome = job(item, hash);
+        try {
+            hash = io::hash_file(item.input, &interrupted());
+        } catch (const io::ImageError&) {
+            unreadable = true;
+            throw;
+        }
+        entry["source_hash"] = hash_text(*hash);
+        outcome = job(item, *hash);
         entry["status"] = outcome.status;
         entry["details"] = std::move(outcome.details);
     } catch (const Interrupted&) {
@@ -199,7 +209,7 @@ nlohmann::json run_one(const LibraryItem& item, const MapJob& job, MemoryGate& g
         entry["status"] = interrupted() ? "interrupted" : "failed";
         if (!interrupted()) {
             error = naming(item.input, e.what());
-            if (remove_stale_output(item.output)) {
+            if ((hash || unreadable) && remove_stale_output(run, item.output, hash)) {
                 error += " (its earlier output " + item.output.string() + " was removed: it no longer matches)";
                 entry["removed_output"] = true;
             }
@@ -241,7 +251,7 @@ void run_library(const std::vector<LibraryItem>& items, const LibraryRun& run, c
         for (size_t i; !interrupted() && (i = next++) < items.size();) {
             MapOutcome outcome;
             std::string error;
-            nlohmann::json entry = run_one(items[i], job, gate, run.bytes_per_texel, outcome, error);
+            nlohmann::json entry = run_one(items[i], job, gate, run, outcome, error);
             if (!entry.contains("status")) continue;  // a signal arrived while it waited: not started
             const std::lock_guard guard(lock);
             std::cerr << outcome.notes;

@@ -61,6 +61,9 @@ struct LibraryRun {
     // A map's job's peak memory per texel of its map (the header's width x height): what
     // the memory check below expects each map to take.
     uint64_t bytes_per_texel = 0;
+    // True where `output` holds the results of the input whose bytes hash to `hash` with
+    // this run's options (what lets a map be skipped as up to date).
+    std::function<bool(const std::filesystem::path& output, uint64_t hash)> up_to_date;
 };
 
 // Runs `job` over `items` on min(jobs, items) threads, each map once, with one progress
@@ -70,8 +73,11 @@ struct LibraryRun {
 // does not fit alone fails with check_memory's message ("FILE: needs N MB of memory, more
 // than the M MB available"). An estimate, from the headers alone: other processes' use
 // changes under it, and bytes_per_texel is measured, not a bound. A map that fails is reported at once on stderr
-// ("envmis: FILE: problem") and in the summary, and the others go on; an earlier run's
-// output for it is removed (it no longer matches), and the message and summary say so. Writes the summary
+// ("envmis: FILE: problem") and in the summary, and the others go on. An earlier run's
+// output for a map that fails is removed, and the message and summary say so, where it
+// is shown not to match: the input could not be read, or it hashes to other bytes or the
+// options differ (run.up_to_date). An output that matches stays, whatever failed (memory,
+// a full disk, a later output of the same map). Writes the summary
 // atomically: per map its input and output paths, status ("written", "up-to-date",
 // "failed", or "interrupted" and "not started" after Ctrl-C), error, seconds, source hash,
 // input bytes and the job's details. Then throws Interrupted once a signal arrived (the

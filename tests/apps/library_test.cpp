@@ -176,6 +176,20 @@ TEST_F(Library, AMapThatNowFailsLosesItsEarlierTableAndTheRunSaysSo) {
         EXPECT_EQ(entry.value("removed_output", false), entry["input"] == "maps/studio.exr") << entry;
 }
 
+// A run that fails for a reason of its own (here a full disk while rewriting with --force)
+// keeps the earlier tables, which still match their inputs.
+TEST_F(Library, AFailureThatIsNotTheInputsKeepsTheTablesThatStillMatch) {
+    make_maps(false);
+    ASSERT_EQ(envmis({"precompute", "maps", "-o", "tables"}).exit_code, 0);
+    const Result r =
+        envmis::test::run_shell("cd " + envmis::test::quoted(dir_.string()) + " && ulimit -f 8 && " +
+                                    envmis::test::quoted(ENVMIS_CLI) + " precompute maps -o tables --force --jobs 1",
+                                dir_ / "..stdout", dir_ / "..stderr");
+    EXPECT_NE(r.exit_code, 0) << r;
+    EXPECT_EQ(r.err.find("was removed"), std::string::npos) << r;
+    for (const std::string& stem : kStems) EXPECT_TRUE(fs::exists(file("tables/" + stem + ".envmis"))) << stem << r;
+}
+
 TEST_F(Library, TwoInputsWithTheSameStemAreRefusedBeforeAnyWork) {
     make_maps(false);
     fs::create_directories(file("other"));

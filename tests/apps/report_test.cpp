@@ -161,6 +161,16 @@ TEST_F(Report, RejectsCompareResultsWithAMissingOrMistypedFieldNamingIt) {
                                  {"bsdf_samples", 1}}};
          }),
          "allocation[0].env_samples: expected an integer"},
+        // Counts beyond what compare writes would overflow the writer's arithmetic.
+        {broken([](json& j) {
+             j["allocation"] = {{{"bsdf", "lambert"},
+                                 {"technique", "mis-balance"},
+                                 {"efficiency", 1},
+                                 {"env_samples", 9223372036854775807LL},
+                                 {"bsdf_samples", -1}}};
+         }),
+         "allocation[0].env_samples: expected an integer from 0 to 4294967295"},
+        {broken([](json& j) { j["inputs"]["spp"] = -3; }), "inputs.spp: expected an integer from 0"},
     };
     for (const auto& [j, message] : cases) {
         std::ofstream(dir_ / "bad.json") << j.dump();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <map>
@@ -36,8 +37,13 @@ struct Schema {
             require(o[k].is_number(), where + "." + k, "a number");
         }
     }
+    // Counts and sizes: integers from 0 to 2^32 - 1 (compare's --spp goes that far).
     void integers(const json& o, const std::string& where, std::initializer_list<const char*> keys) const {
-        for (const char* k : keys) require(!o.contains(k) || o[k].is_number_integer(), where + "." + k, "an integer");
+        for (const char* k : keys)
+            require(!o.contains(k) || (o[k].is_number_integer() && o[k].get<int64_t>() >= 0 &&
+                                       o[k].get<int64_t>() <= int64_t{UINT32_MAX} &&
+                                       !(o[k].is_number_unsigned() && o[k].get<uint64_t>() > UINT32_MAX)),
+                    where + "." + k, "an integer from 0 to 4294967295");
     }
     // Required fields.
     void has(const json& o, const std::string& where, std::initializer_list<const char*> keys) const {
@@ -213,12 +219,13 @@ void write_allocation(std::ostream& out, const std::vector<json>& runs, bool no_
             const json* even = nullptr;
             for (const json* r : rows) {
                 if (!best || (*r)["efficiency"].get<double>() > (*best)["efficiency"].get<double>()) best = r;
-                const int gap = std::abs((*r)["env_samples"].get<int>() - (*r)["bsdf_samples"].get<int>());
-                if (!even || gap < std::abs((*even)["env_samples"].get<int>() - (*even)["bsdf_samples"].get<int>()))
+                const int64_t gap = std::abs((*r)["env_samples"].get<int64_t>() - (*r)["bsdf_samples"].get<int64_t>());
+                if (!even ||
+                    gap < std::abs((*even)["env_samples"].get<int64_t>() - (*even)["bsdf_samples"].get<int64_t>()))
                     even = r;
             }
             out << "| " << run["inputs"].value("map", "?") << " | " << key.first << " | " << key.second << " | "
-                << (*best)["env_samples"].get<int>() << ":" << (*best)["bsdf_samples"].get<int>() << " | "
+                << (*best)["env_samples"].get<int64_t>() << ":" << (*best)["bsdf_samples"].get<int64_t>() << " | "
                 << number((*best)["efficiency"]) << " | "
                 << number((*best)["efficiency"].get<double>() / (*even)["efficiency"].get<double>(), "%.2f") << "x |\n";
         }
@@ -257,12 +264,12 @@ void write_intro(std::ostream& out, const std::vector<json>& runs, const std::st
     const auto with_results =
         std::find_if(runs.begin(), runs.end(), [](const json& r) { return r.contains("results"); });
     const json& first = (with_results != runs.end() ? *with_results : runs.front())["inputs"];
-    out << "Every technique spends the same number of samples per estimate (" << first.value("env_samples", 1)
-        << " environment + " << first.value("bsdf_samples", 1)
+    out << "Every technique spends the same number of samples per estimate (" << first.value("env_samples", int64_t{1})
+        << " environment + " << first.value("bsdf_samples", int64_t{1})
         << " BSDF for MIS). Figures are variances of one estimate relative to balance "
-        << "MIS over the plain density (`mis-balance`), as the geometric mean over " << first.value("points_done", 0)
-        << " shading points of the per-point ratios; " << first.value("spp", 0)
-        << " estimates per point. Below 1 is better than balance MIS.\n\n";
+        << "MIS over the plain density (`mis-balance`), as the geometric mean over "
+        << first.value("points_done", int64_t{0}) << " shading points of the per-point ratios; "
+        << first.value("spp", int64_t{0}) << " estimates per point. Below 1 is better than balance MIS.\n\n";
 }
 
 // Summary: one row per case, one column per technique, the geometric mean row and the
@@ -373,8 +380,9 @@ void write_tables(std::ostream& out, const std::vector<json>& runs, bool no_timi
     for (const json& run : runs) {
         if (!run.contains("results")) continue;
         const json& in = run["inputs"];
-        out << "## " << in.value("map", "?") << " (" << in.value("width", 0) << "x" << in.value("height", 0)
-            << "), alpha " << number(in.value("alpha", 1.0), "%.3g") << "\n\n| bsdf | technique |";
+        out << "## " << in.value("map", "?") << " (" << in.value("width", int64_t{0}) << "x"
+            << in.value("height", int64_t{0}) << "), alpha " << number(in.value("alpha", 1.0), "%.3g")
+            << "\n\n| bsdf | technique |";
         for (const StatsColumn& c : columns) out << " " << c.heading << " |";
         out << "\n|---|---|";
         for (size_t i = 0; i < columns.size(); ++i) out << "---:|";
@@ -391,6 +399,7 @@ void write_tables(std::ostream& out, const std::vector<json>& runs, bool no_timi
 }  // namespace
 
 void write_markdown(std::ostream& out, const std::vector<json>& runs, const MarkdownOptions& options) {
+    if (runs.empty()) throw std::invalid_argument("write_markdown: no runs");
     const auto [techniques, cases] = collect_cases(runs);
     write_intro(out, runs, options.title, options.command);
     write_summary(out, techniques, cases);

@@ -57,8 +57,9 @@ void check_options(const EnvMapOptions& o) {
     if (o.mapping != Mapping::equirect && o.mapping != Mapping::equal_area)
         throw std::invalid_argument("unknown mapping " + std::to_string(static_cast<uint32_t>(o.mapping)));
     const LumaCoefficients k = o.luma;
-    if (!(k.r >= 0 && k.g >= 0 && k.b >= 0 && k.r + k.g + k.b > 0 && std::isfinite(k.r + k.g + k.b)))
-        throw std::invalid_argument("luma coefficients must be finite, >= 0 and not all 0");
+    // A working space's weights are its white's Y: each in [0, 1] for any linear space.
+    if (!(k.r >= 0 && k.g >= 0 && k.b >= 0 && k.r <= 1 && k.g <= 1 && k.b <= 1 && k.r + k.g + k.b > 0))
+        throw std::invalid_argument("luma coefficients must be in [0, 1] and not all 0");
 }
 
 // Per-row results, reduced in row order so that the result does not depend on the
@@ -207,6 +208,16 @@ uint32_t fill_density_row(const uint32_t* luminance, uint32_t w, float weight, f
     return zeroed;
 }
 
+// Whether a stored density value is the build's `expected` from a texel of luminance l
+// (threshold t, row weight w), up to what builds of other format versions round
+// differently (l to an ulp or so): 1e-4 of the value plus 1e-6 of (l + t) w, in double so
+// that a luminance near float's maximum cannot make it infinite. A texel clearly below
+// the threshold must hold exactly 0: compensation's zeros are exact in every build.
+bool stored_density_agrees(float stored, float expected, double l, double t, float w) noexcept {
+    if (expected == 0 && l < t * (1 - 1e-6)) return stored == 0;
+    return std::abs(double{stored} - expected) <= 1e-4 * expected + 1e-6 * (l + t) * w;
+}
+
 // Whether a and b differ by more than `relative` of the larger.
 bool differ(double a, double b, double relative) noexcept {
     return !(std::abs(a - b) <= relative * std::max(std::abs(a), std::abs(b)));
@@ -244,10 +255,10 @@ void check_stored(RgbImageView radiance, const uint32_t* density, const EnvMapOp
             const float weight = row_weight(options.mapping, y, h);
             fill_density_row(luminance.data(), w, weight, stats.threshold, uniform, expected.data());
             const uint32_t* stored = density + size_t{y} * w;
-            for (uint32_t x = 0; x < w; ++x) {
-                const float l = uniform ? 1.0f : std::bit_cast<float>(luminance[x]) + stats.threshold;
-                wrong[y] += !(std::abs(std::bit_cast<float>(stored[x]) - expected[x]) <= 1e-4f * l * weight);
-            }
+            for (uint32_t x = 0; x < w; ++x)
+                wrong[y] +=
+                    !stored_density_agrees(std::bit_cast<float>(stored[x]), expected[x],
+                                           uniform ? 1.0 : std::bit_cast<float>(luminance[x]), stats.threshold, weight);
         }
     });
     const auto total = [](const std::vector<uint64_t>& v) { return std::accumulate(v.begin(), v.end(), uint64_t{0}); };
@@ -275,6 +286,9 @@ void check_stored(RgbImageView radiance, const uint32_t* density, const EnvMapOp
     const bool thresholded = options.compensation.enabled && stats.fallback == DensityFallback::none;
     const float threshold = compensation_threshold(stats.mean_luminance, options.compensation.alpha);
     fact(!thresholded || !differ(stats.threshold, threshold, 1e-5), "threshold", stats.threshold, threshold);
+    // The uncompensated fallback is only for a map that compensation zeroes whole.
+    fact(stats.fallback != DensityFallback::uncompensated || max <= threshold * (1 + 1e-5),
+         "max luminance of a map compensation zeroes whole", max, threshold);
     if (const uint64_t n = total(wrong))
         throw std::invalid_argument(std::to_string(n) + " density values are not those of the radiance");
 }

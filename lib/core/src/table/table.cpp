@@ -359,12 +359,10 @@ void check_stats(const Header& header, const Cursor& in) {
     };
     const float alpha = header.options.compensation.alpha;
     field(std::isfinite(alpha) && alpha >= 0, "alpha", number(alpha), "finite and >= 0");
-    // A working space's luminance weights are its white's Y: each in [0, 1], summing to 1.
+    // EnvMap's own rule for the weights (in [0, 1], not all 0), named as the header's field.
     const LumaCoefficients k = header.options.luma;
     for (const auto& [c, name] : {std::pair{k.r, "red"}, std::pair{k.g, "green"}, std::pair{k.b, "blue"}})
         field(c >= 0 && c <= 1, "luma coefficient", std::string(name) + " " + number(c), "in [0, 1]");
-    field(std::abs(double{k.r} + k.g + k.b - 1) <= 1e-3, "luma coefficients", "summing to " + number(k.r + k.g + k.b),
-          "summing to 1");
     // EnvMap refuses a map whose power 4 pi Lbar overflows float.
     field(std::isfinite(s.mean_luminance) && s.mean_luminance >= 0 && 4 * kPi * s.mean_luminance <= FLT_MAX,
           "mean luminance", number(s.mean_luminance), "finite, >= 0 and 4 pi times it at most 3.4e38");

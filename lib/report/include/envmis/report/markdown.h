@@ -34,7 +34,7 @@ struct MarkdownOptions {
     bool no_timing = false;  // leave out what measured time decides (ns/estimate, efficiency, allocation)
 };
 
-// The report of `runs` (each one parse_results gave).
+// The report of `runs` (each one parse_results gave; at least one).
 void write_markdown(std::ostream& out, const std::vector<nlohmann::json>& runs, const MarkdownOptions& options);
 
 }  // namespace envmis
