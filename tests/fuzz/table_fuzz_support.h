@@ -19,7 +19,7 @@
 
 namespace envmis::fuzz {
 
-// Layout of table format version 1 (docs/table-format.md): a 32-byte preamble whose bytes
+// Layout of the table format (docs/table-format.md): a 32-byte preamble whose bytes
 // 16..23 hold the file size and 24..27 the metadata size, then the metadata, the header
 // checksum, the payload and the payload checksum. Version 4 adds, after the metadata's
 // 100 fixed bytes and three strings, the bins-section size B; when B > 0 the bins section

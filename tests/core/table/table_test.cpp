@@ -559,7 +559,7 @@ TEST(TableParse, InMemoryBytesGiveTheSameErrors) {
 }
 
 // ---------------------------------------------------------------------------------
-// Binned tables (version 4): the plain map, then the bins' layout with its checksum.
+// Binned tables (version 4 and later): the plain map, then the bins' layout with its checksum.
 
 EnvMap plain_sky() {
     EnvMapOptions o;

@@ -3,7 +3,7 @@
 // Cephes (Moshier 1989): Cody-Waite range reduction to [-pi/4, pi/4], then minimax
 // polynomials. Accuracy, against double precision: within 2e-7 absolute for sin and cos
 // on |x| <= 8 pi, within 4e-7 (1.5 float ulps of pi) for atan2 everywhere; checked in
-// tests/fast_math_test.cpp.
+// tests/core/math/fast_math_test.cpp.
 #pragma once
 
 #include <cmath>

@@ -52,7 +52,7 @@ struct Table {
     TableSource source;
     uint32_t version = 0;  // the file's format version
     bool mapped = false;   // the map borrows its radiance from a mapping of the file
-    // The bins of a binned map (version 4 tables written from a BinnedEnvMap): `map` is
+    // The bins of a binned map (tables of version 4 or later written from a BinnedEnvMap): `map` is
     // then the plain map they were built over. Checked against the map's size when read;
     // binned_map rebuilds them.
     std::optional<BinLayout> bins;
