@@ -306,8 +306,6 @@ std::string resident_memory() {
 }
 
 uint64_t header_texels(const std::filesystem::path& input) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(input, ec)) return 0;
     try {
         if (looks_like_table(input)) {
             const TableHeader header = read_table_header(input);

@@ -511,6 +511,7 @@ void write_exact(std::ostream& out, const CompareArgs& args, const Setup& s, Wri
             out << text;
             w.json["exact"][s.options.bsdfs[b].name()][t.name()] = {{"ratio", mean}, {"worst", worst}};
         }
+        if (progress) progress->update((b + 1) * (nt + 1));
         out << "\n";
     }
 }

@@ -41,8 +41,7 @@ struct Schema {
     void integers(const json& o, const std::string& where, std::initializer_list<const char*> keys) const {
         for (const char* k : keys)
             require(!o.contains(k) || (o[k].is_number_integer() && o[k].get<int64_t>() >= 0 &&
-                                       o[k].get<int64_t>() <= int64_t{UINT32_MAX} &&
-                                       !(o[k].is_number_unsigned() && o[k].get<uint64_t>() > UINT32_MAX)),
+                                       o[k].get<int64_t>() <= int64_t{UINT32_MAX}),
                     where + "." + k, "an integer from 0 to 4294967295");
     }
     // Required fields.
