@@ -83,6 +83,22 @@ void sample(benchmark::State& state) {
     }
 }
 
+// The distribution behind the guided sampler alone (no direction, radiance or pdf in
+// solid angle): its tuned sample (distribution.h) against the plain search of cdf.h,
+// which it equals sample for sample; the compensated sky, whose sun rows are hot.
+template <bool kTuned>
+void distribution_sample(benchmark::State& state) {
+    const EnvMap map(sky(static_cast<uint32_t>(state.range(0))), options());
+    const envmis::Distribution2DView d = map.view().distribution;
+    const auto& us = uniforms();
+    size_t i = 0;
+    for (auto _ : state) {
+        const envmis::Vec2 u = us[i++ & (us.size() - 1)];
+        const auto s = kTuned ? d.sample(u) : d.search(u);
+        benchmark::DoNotOptimize(s);
+    }
+}
+
 // The guided sampler through sample_many, kBatch points a call (as the estimator's lanes
 // or a wavefront renderer ask): the points are the same as sample's, stored as the
 // batch call reads them; the counter is the time per sample.
@@ -403,6 +419,8 @@ BENCHMARK(build<TextbookEnvMap>)->Name("build/textbook")->Apply(sizes);
 BENCHMARK(sample<EnvMap>)->Name("sample/guided")->Apply(sizes_ns);
 BENCHMARK(sample<TextbookEnvMap>)->Name("sample/textbook")->Apply(sizes_ns);
 BENCHMARK(sample_batch<true>)->Name("sample/guided-many")->Apply(sizes_ns);
+BENCHMARK(distribution_sample<false>)->Name("distribution/plain")->Apply(sizes_ns);
+BENCHMARK(distribution_sample<true>)->Name("distribution/tuned")->Apply(sizes_ns);
 // Binned against today's map, plain and compensated (guided above); build/bins is the
 // bins alone, on top of a plain map's build.
 BENCHMARK(build<EnvMap, false>)->Name("build/plain")->Apply(sizes);

@@ -18,9 +18,9 @@
 #include <sstream>
 #include <string_view>
 
+#include "envmis/build/atomic_file.h"
 #include "envmis/io/image_io.h"
 #include "envmis/study/shading/bsdf.h"
-#include "envmis/table/atomic_file.h"
 
 namespace envmis::cli {
 

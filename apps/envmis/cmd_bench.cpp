@@ -45,7 +45,8 @@ double ns_per_call(const std::vector<Input>& inputs, Call&& call) {
 
 // What a single sample call hands back, summed: all of it, as sample_many writes all of
 // it. A sum of part of it let the compiler drop the rest (a direction's y and z, two
-// radiance channels; 3-6 ns of a 20 ns compensated sample).
+// radiance channels) and flattered the single calls (measured: docs/performance-log.md,
+// 'every_output').
 float every_output(const EnvSample& s) {
     return s.pdf + s.direction.x + s.direction.y + s.direction.z + s.radiance.r + s.radiance.g + s.radiance.b;
 }
@@ -118,7 +119,7 @@ std::pair<std::unique_ptr<Sampler>, double> build_repeatedly(const Source& sourc
     for (int r = 0; r < repeats; ++r) {
         throw_if_interrupted();
         Source copy = source;
-        sampler.reset();  // freeing the previous sampler is no part of a build (40 ms at 8k)
+        sampler.reset();  // freeing the previous sampler is no part of a build
         const auto start = std::chrono::steady_clock::now();
         sampler = std::make_unique<Sampler>(build(copy));
         builds.push_back(milliseconds_since(start));

@@ -16,12 +16,12 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
+#include "envmis/build/atomic_file.h"
 #include "envmis/io/image_io.h"
 #include "envmis/report/inputs.h"
 #include "envmis/report/results.h"
 #include "envmis/study/comparison/comparison.h"
 #include "envmis/study/comparison/sweeps.h"
-#include "envmis/table/atomic_file.h"
 #include "library.h"
 #include "render.h"
 #include "sweeps.h"

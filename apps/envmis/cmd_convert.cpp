@@ -8,7 +8,7 @@
 #include <optional>
 
 #include "cli.h"
-#include "envmis/image/remap.h"
+#include "envmis/build/remap.h"
 #include "envmis/io/image_io.h"
 
 namespace envmis::cli {

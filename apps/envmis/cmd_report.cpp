@@ -9,8 +9,8 @@
 #include <sstream>
 
 #include "cli.h"
+#include "envmis/build/atomic_file.h"
 #include "envmis/report/markdown.h"
-#include "envmis/table/atomic_file.h"
 
 namespace envmis::cli {
 namespace {

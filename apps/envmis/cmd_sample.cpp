@@ -8,8 +8,8 @@
 #include <stdexcept>
 
 #include "cli.h"
+#include "envmis/build/atomic_file.h"
 #include "envmis/study/shading/bsdf.h"
-#include "envmis/table/atomic_file.h"
 
 namespace envmis::cli {
 namespace {

@@ -16,8 +16,8 @@
 #include <OpenImageIO/imageio.h>
 
 #include "cli.h"
+#include "envmis/build/atomic_file.h"
 #include "envmis/io/image_io.h"
-#include "envmis/table/atomic_file.h"
 #include "envmis/table/table.h"
 
 namespace envmis::cli {

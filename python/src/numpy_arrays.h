@@ -64,8 +64,8 @@ inline py::array_t<float, py::array::c_style> float_array(const py::handle& obje
 // [0, 1) (NaN is not): the core's samplers assume it (CdfView::invert reads one past
 // its table at u = 1, and converts u to an unsigned index). Names the first value that
 // is not, as "envmis.EnvMap.sample: u[12, 1] = 1 is outside [0, 1)". One pass over the
-// values in blocks without branches (vectorised), about 0.15 ns a value (AMD EPYC); the
-// block that holds a bad value is searched again.
+// values in blocks without branches (vectorised); the block that holds a bad value is
+// searched again (measured: docs/performance-log.md, 'check_unit_points').
 inline void check_unit_points(const py::array_t<float, py::array::c_style>& u, const char* where, const char* name) {
     const float* values = u.data();
     const auto count = static_cast<size_t>(u.size());
@@ -73,7 +73,7 @@ inline void check_unit_points(const py::array_t<float, py::array::c_style>& u, c
     for (size_t first = 0; first < count; first += kBlock) {
         const size_t last = std::min(count, first + kBlock);
         // Both comparisons evaluated (&, not &&) and the flags or'ed as integers: GCC
-        // vectorises this form (0.15 ns a value at -O3), not the short-circuit one (0.5).
+        // vectorises this form, not the short-circuit one.
         uint32_t bad = 0;
         for (size_t i = first; i < last; ++i) {
             const bool inside = (values[i] >= 0.0f) & (values[i] < 1.0f);

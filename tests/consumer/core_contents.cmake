@@ -1,5 +1,5 @@
 # Checks that the installed envmis::core is the runtime alone: its archive holds exactly the
-# objects of lib/core/src (no study, I/O or picture code) and defines no symbol of those
+# objects of lib/core/src (no build, study, I/O or picture code) and defines no symbol of those
 # libraries or of their third-party dependencies. Run by consumer.core-contents:
 #   cmake -DARCHIVE=<prefix>/lib/libenvmis_core.a -DSOURCES=<repo>/lib/core/src -DNM=nm -DAR=ar -P core_contents.cmake
 foreach(variable ARCHIVE SOURCES NM AR)
@@ -29,11 +29,12 @@ endif()
 execute_process(COMMAND ${NM} -C --defined-only ${ARCHIVE} OUTPUT_VARIABLE symbols COMMAND_ERROR_IS_FATAL ANY)
 foreach(foreign "envmis::Bsdf" "envmis::Frame" "envmis::Technique" "envmis::DirectLightingEstimator"
                 "envmis::compare" "envmis::choose_alpha" "envmis::io::" "envmis::pictures::" "Eigen::"
-                "OpenImageIO" "OCIO" "Imf_")
+                "envmis::write_table(" "envmis::rgbe_round(" "envmis::remap(" "envmis::AtomicFile"
+                "envmis::write_file_atomically(" "OpenImageIO" "OCIO" "Imf_")
   string(FIND "${symbols}" "${foreign}" at)
   if(NOT at EQUAL -1)
     message(FATAL_ERROR "libenvmis_core.a defines a symbol of another library: '${foreign}'")
   endif()
 endforeach()
 list(LENGTH members count)
-message(STATUS "libenvmis_core.a: ${count} objects, all from lib/core/src; no study, I/O or picture symbols")
+message(STATUS "libenvmis_core.a: ${count} objects, all from lib/core/src; no build, study, I/O or picture symbols")

@@ -1,9 +1,13 @@
-// An installed envmis, used as a renderer would: build a sampler from an image, save it
-// as a table, load it back and sample it. Exits non-zero, saying why, on any mismatch.
+// An installed envmis, used as a renderer and a table maker would. Exits non-zero, saying
+// why, on any mismatch.
 //
-// Usage: consumer_core|consumer_io WORK_FOLDER
-// consumer_io also writes the image as EXR, loads it through OpenImageIO and OpenColorIO
-// ($OCIO: the installed config) and samples that.
+// Usage: consumer_build|consumer_io WORK_FOLDER
+//        consumer_core WORK_FOLDER TABLE
+// consumer_build (envmis::core and envmis::build) builds a sampler from an image, saves it
+// as WORK_FOLDER/sky.envmis, loads it back and samples it. consumer_core (envmis::core
+// alone, a renderer) builds the same sampler and loads TABLE, the table consumer_build
+// wrote: both must sample alike. consumer_io also writes the image as EXR, loads it
+// through OpenImageIO and OpenColorIO ($OCIO: the installed config) and samples that.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -13,6 +17,9 @@
 #include <string>
 
 #include "envmis/core.h"
+#ifdef ENVMIS_CONSUMER_BUILD
+#include "envmis/build.h"
+#endif
 #ifdef ENVMIS_CONSUMER_IO
 #include "envmis/io/colour.h"
 #include "envmis/io/image_io.h"
@@ -78,9 +85,11 @@ void check_samples(const envmis::EnvMap& map, const envmis::EnvMap& loaded) {
           std::to_string(edge_cases) + " of " + std::to_string(n) + " samples disagree with pdf(direction)");
 }
 
-void check_map(const envmis::EnvMap& map, const std::filesystem::path& table_file) {
-    const envmis::TableSource source{"sky.exr", 42, "lin_rec709", "lin_rec709", ""};
-    envmis::write_table(table_file, map, source);
+const envmis::TableSource kSource{"sky.exr", 42, "lin_rec709", "lin_rec709", ""};
+
+// The table `table_file` holds `map`.
+void check_table(const envmis::EnvMap& map, const std::filesystem::path& table_file) {
+    const envmis::TableSource& source = kSource;
     check(envmis::looks_like_table(table_file), "the written table is not recognised");
     const envmis::Table table = envmis::read_table(table_file);
     check(table.map.width() == map.width() && table.map.height() == map.height(), "loaded size differs");
@@ -91,11 +100,23 @@ void check_map(const envmis::EnvMap& map, const std::filesystem::path& table_fil
     check_samples(map, table.map);
 }
 
+#ifdef ENVMIS_CONSUMER_BUILD
+void check_map(const envmis::EnvMap& map, const std::filesystem::path& table_file) {
+    envmis::write_table(table_file, map, kSource);
+    check_table(map, table_file);
+}
+#endif
+
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc != 2) {
-        std::fprintf(stderr, "usage: %s WORK_FOLDER\n", argv[0]);
+#ifdef ENVMIS_CONSUMER_BUILD
+    const int args = 2;
+#else
+    const int args = 3;
+#endif
+    if (argc != args) {
+        std::fprintf(stderr, "usage: %s WORK_FOLDER%s\n", argv[0], args == 3 ? " TABLE" : "");
         return 2;
     }
     try {
@@ -103,7 +124,12 @@ int main(int argc, char** argv) {
         std::filesystem::create_directories(work);
         const envmis::EnvMap map(sky(64, 32));
         check(map.compensated() && !map.complete(), "the synthetic sky should be compensated and incomplete");
+#ifdef ENVMIS_CONSUMER_BUILD
         check_map(map, work / "sky.envmis");
+#else
+        check_normalised(map);
+        check_table(map, argv[2]);
+#endif
 #ifdef ENVMIS_CONSUMER_IO
         const envmis::io::ColourConfig config;
         check(config.has_space("lin_rec709"), "the OCIO config " + config.description() + " lacks lin_rec709");

@@ -7,7 +7,8 @@
 #include <filesystem>
 #include <string>
 
-#include "envmis/image/remap.h"
+#include "envmis/build/remap.h"
+#include "envmis/build/table_writer.h"
 #include "envmis/interrupt.h"
 #include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"

@@ -50,7 +50,7 @@ function(envmis_fuzz_target name seed_maker library)
 endfunction()
 
 add_executable(envmis_make_fuzz_seed ${CMAKE_CURRENT_LIST_DIR}/make_fuzz_seed.cpp)
-target_link_libraries(envmis_make_fuzz_seed PRIVATE envmis::core)
+target_link_libraries(envmis_make_fuzz_seed PRIVATE envmis::core envmis::build)
 envmis_fuzz_target(table_fuzz envmis_make_fuzz_seed envmis::core)
 envmis_fuzz_target(mapped_table_fuzz envmis_make_fuzz_seed envmis::core)
 

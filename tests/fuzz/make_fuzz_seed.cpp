@@ -5,7 +5,7 @@
 #include <exception>
 #include <filesystem>
 
-#include "envmis/table/table.h"
+#include "envmis/build/table_writer.h"
 
 namespace {
 

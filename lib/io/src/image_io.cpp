@@ -12,9 +12,9 @@
 #include <fstream>
 #include <span>
 
+#include "envmis/build/atomic_file.h"
 #include "envmis/io/colour.h"
 #include "envmis/math/hash.h"
-#include "envmis/table/atomic_file.h"
 
 namespace envmis::io {
 namespace {
@@ -94,8 +94,8 @@ struct Window {
 bool stop_reading(void* stop, float) { return stop_requested(static_cast<StopFlag>(stop)); }
 
 // Rows read at a time when the read may be stopped: OpenImageIO calls its progress
-// callback only every few hundred megabytes (after 1.4 s, then at 69% and 100% of a
-// 4096x2048 EXR), so scanline files are read a block at a time and the flag checked
+// callback only every few hundred megabytes (measured: docs/performance-log.md,
+// 'kRowsPerRead'), so scanline files are read a block at a time and the flag checked
 // between blocks. Tiled files are read whole, stopped through the callback.
 constexpr int kRowsPerRead = 256;
 

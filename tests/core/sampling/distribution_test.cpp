@@ -189,6 +189,52 @@ TEST(Distribution2D, BuildDoesNotDependOnThreads) {
 // Tables of at least kCoarseGuideMinBytes (6 bytes a cell): 2057 x 1400 cells.
 constexpr uint32_t kCoarseW = 32 * kCoarseGuideStep + 9, kCoarseH = 1400;
 
+// The tuned sample (distribution.h: prefetches, the coarse guide's prediction, hot rows
+// searched from it) is the plain algorithm of cdf.h, sample for sample: the same point,
+// pdf and cell, bit for bit, for points across [0,1)^2 and at its edges, on the small
+// grids above, on a table large enough for a coarse guide whose sun makes hot rows, and
+// on one with empty cells and rows. Rows invert alike too: guided, from the coarse
+// guide, and without prefetches.
+TEST(Distribution2D, TheTunedSampleIsThePlainSearchBitForBit) {
+    std::vector<Grid> grids = test_grids();
+    Grid sun{kCoarseW, kCoarseH, test::random_function(size_t{kCoarseW} * kCoarseH, 67, 2)};
+    for (uint32_t y = 300; y < 304; ++y)
+        for (uint32_t x = 900; x < 1000; ++x) sun.func[size_t{y} * kCoarseW + x] = 1e6f;  // hot rows
+    grids.push_back(sun);
+    Grid holes{kCoarseW, kCoarseH, test::random_function(size_t{kCoarseW} * kCoarseH, 71, 8)};
+    for (size_t i = 0; i < holes.func.size(); i += 3) holes.func[i] = 0;
+    std::fill(holes.func.begin(), holes.func.begin() + 5 * kCoarseW, 0.0f);
+    grids.push_back(holes);
+    const float edges[] = {0.0f, 0x1p-31f, 0.5f, 1 - 0x1p-20f, kOneMinusEpsilon, 1.0f};
+    size_t hot = 0;
+    for (const Grid& g : grids) {
+        const Distribution2D d(g.func, g.w, g.h);
+        const Distribution2DView v = d.view();
+        const Cdf2DTable& plain = v;
+        Rng rng(73);
+        for (int i = 0; i < 100000; ++i) {
+            const Vec2 u = i < 36 ? Vec2{edges[i % 6], edges[i / 6]} : Vec2{rng.uniform(), rng.uniform()};
+            const Distribution2DView::Sample tuned = v.sample(u), reference = plain.search(u);
+            ASSERT_EQ(bit_cast<uint32_t>(tuned.p.x), bit_cast<uint32_t>(reference.p.x)) << g.w << "x" << g.h;
+            ASSERT_EQ(bit_cast<uint32_t>(tuned.p.y), bit_cast<uint32_t>(reference.p.y)) << g.w << "x" << g.h;
+            ASSERT_EQ(bit_cast<uint32_t>(tuned.pdf), bit_cast<uint32_t>(reference.pdf)) << g.w << "x" << g.h;
+            ASSERT_EQ(tuned.x, reference.x);
+            ASSERT_EQ(tuned.y, reference.y);
+            const CellHit r = v.sample_row(u.y);
+            hot += v.row_is_hot(r.width);
+            const CdfView row = v.row(r.index);
+            const CellHit want = row.search(u.x);
+            for (const CellHit c : {row.invert(u.x), row.invert<false>(u.x)}) {
+                ASSERT_EQ(c.index, want.index);
+                ASSERT_EQ(bit_cast<uint32_t>(c.offset), bit_cast<uint32_t>(want.offset));
+                ASSERT_EQ(c.width, want.width);
+            }
+            if (row.coarse) ASSERT_EQ(row.invert_cached(u.x).index, want.index);
+        }
+    }
+    EXPECT_GT(hot, 10000u);  // the sun's rows (and the small grids' one-cell sun) take the hot path
+}
+
 TEST(Distribution2D, LargeTablesHoldEveryStepthGuideEntryOfEachRowInTheCoarseGuide) {
     const Distribution2D d(test::random_function(size_t{kCoarseW} * kCoarseH, 31, 6), kCoarseW, kCoarseH);
     const Distribution2DView v = d.view();

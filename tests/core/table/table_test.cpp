@@ -11,6 +11,7 @@
 #include <limits>
 #include <vector>
 
+#include "envmis/build/table_writer.h"
 #include "envmis/math/hash.h"
 #include "envmis/table/table.h"
 #include "maps.h"

@@ -1,7 +1,7 @@
 // The processor the library runs on, and the path each family of batch kernels takes
 // on it: lookup_many and sample_many (envmap.h, binned.h) and the estimator's lanes
 // (envmis::study). Chosen once per process by rules measured per CPU family
-// (docs/performance.md), or forced with the environment variable ENVMIS_SIMD=scalar or
+// (choose_batch_paths), or forced with the environment variable ENVMIS_SIMD=scalar or
 // avx2 (tests, benchmarks). Every path gives bit-identical results; only speed differs.
 //
 // Cost: cpu_info() and batch_paths() run cpuid and read the environment once, on their
@@ -28,7 +28,7 @@ struct CpuInfo {
     bool avx512 = false;             // AVX-512 F, BW, DQ and VL likewise (no kernel uses it: see below)
 };
 const CpuInfo& cpu_info() noexcept;
-// "<brand> (<vendor> family 0x1a model 0x2, AVX2, AVX-512)": for benchmark output.
+// "<brand> (<vendor> family 0x<f> model 0x<m>, AVX2, AVX-512)": for benchmark output.
 std::string cpu_name();
 
 // The path of each kernel family; `forced` is ENVMIS_SIMD's value (empty when unset),
@@ -41,21 +41,14 @@ struct BatchPaths {
     std::string forced;
     bool unavailable = false;
 };
-// The rules, measured (envmis bench, 8k sky, ratios within one run; docs/performance.md):
-// - lookup_many's AVX2 kernel wherever AVX2 is usable: over single pdf calls, 0.96-1.33x
-//   against the scalar pipeline's 0.31-0.63x on AMD family 0x1a, 3.2-3.5x against 1.5-1.7x
-//   on family 0x19 model 0x11;
-// - sample_many's AVX2 kernel on Intel (8.5x the textbook on the Xeon) and AMD from
-//   family 0x19 on (over single calls, compensated sky: about 1.5x against the scalar
-//   pipeline's 0.95x on 0x1a, 1.6x against 0.78x on 0x19; plain: 4x against 2.6x, 2.0x
-//   against 1.4x); the scalar pipeline on older AMD families (not measured);
+// The rules (measured: docs/performance-log.md, 'choose_batch_paths'), equirect and
+// equal-area maps alike:
+// - lookup_many's AVX2 kernel wherever AVX2 is usable;
+// - sample_many's AVX2 kernel on Intel and on AMD from family 0x19 on, where its gathers
+//   pay; the scalar pipeline on older AMD families (not measured);
 // - the estimator's lanes (arithmetic, no gathers of their own) wherever AVX2 is usable.
-// The same rules serve equal-area maps: on the 5792^2 sky, family 0x19, the AVX2 kernels
-// sample in 0.43-0.67x of the scalar pipeline's time, and look up 2.6-2.9x faster than
-// single pdf calls against its 1.5-1.9x.
-// No AVX-512 path: much of the kernels' time goes to gathers, and on AMD family 0x1a one
-// 16-lane gather of eight 64-bit pairs took 1.7x the time of the two 8-lane AVX2 gathers
-// of the same pairs (docs/performance-log.md, 2026-12-02).
+// No AVX-512 path: much of the kernels' time goes to gathers, and a 16-lane gather of
+// eight 64-bit pairs was slower than the two 8-lane AVX2 gathers of the same pairs.
 BatchPaths choose_batch_paths(const CpuInfo& cpu, std::string_view forced);
 // choose_batch_paths(cpu_info(), ENVMIS_SIMD), once.
 const BatchPaths& batch_paths() noexcept;

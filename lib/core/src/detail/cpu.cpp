@@ -108,10 +108,10 @@ BatchPaths choose_batch_paths(const CpuInfo& cpu, std::string_view forced) {
         paths.unavailable = true;
         return paths;
     }
-    // Measured: Intel, and AMD families 0x19 and 0x1a. On 0x19 the gathers are microcoded
-    // (about 40 micro-ops each) and the AVX2 sampler still wins, its time going to memory;
-    // family 0x17 (Zen 1 and 2, 256-bit work split in halves) is not measured here: the
-    // scalar pipeline is the safe choice there.
+    // The AVX2 sampler where its gathers pay: Intel, and AMD from family 0x19 on (on 0x19
+    // they are microcoded, but the sampler's time goes to memory); older AMD families are
+    // not measured, and the scalar pipeline is the safe choice there (cpu.h; measured:
+    // docs/performance-log.md, 'choose_batch_paths').
     const bool gathers_pay = cpu.vendor == "GenuineIntel" || (cpu.vendor == "AuthenticAMD" && cpu.family >= 0x19);
     paths.lanes = paths.lookup = avx2 ? BatchPath::avx2 : BatchPath::scalar;
     paths.sample = avx2 && gathers_pay ? BatchPath::avx2 : BatchPath::scalar;

@@ -28,8 +28,8 @@ namespace envmis {
 namespace {
 
 // How many lanes ahead the first stage of the scalar paths runs: the misses in flight.
-// 32 measured best for lookups on the plain 8k sky (AMD EPYC family 0x1a; 16 and 64
-// slower), 16 for samples, whose second stage's misses are fewer and nearer the first's.
+// Fewer for samples, whose second stage's misses are fewer and nearer the first's
+// (measured: docs/performance-log.md, 'kLookupDistance').
 constexpr uint32_t kLookupDistance = 32, kSampleDistance = 16;
 
 void lookup_scalar(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t first, uint32_t n) noexcept {
@@ -99,9 +99,9 @@ ENVMIS_AVX2 I8 gather(const uint32_t* a, I8 i) noexcept {
     return _mm256_i32gather_epi32(reinterpret_cast<const int*>(a), i, 4);
 }
 
-// a[i] and a[i + 1] in eight lanes, from two gathers of 64-bit pairs: on AMD family 0x1a
-// a gather's cost grows with its elements, and four 64-bit elements take two thirds of
-// the time of eight 32-bit ones (measured), so two values a lane come cheaper as pairs.
+// a[i] and a[i + 1] in eight lanes, from two gathers of 64-bit pairs: a gather's cost
+// grows with its elements, so two values a lane come cheaper as pairs (measured:
+// docs/performance-log.md, 'gather_pairs').
 struct Pair8 {
     I8 first, second;
 };
@@ -208,9 +208,9 @@ struct Cells8 {
 // EnvMapView::uv_of and the cells of eval_uv and pdf_uv (envmap.h), for the eight
 // directions from lane l on; starts loading all that fetch8 reads there (prefetch_cell).
 // Both lines of a texel that straddles two, and the next CDF entry's where it starts a
-// line: a gather waits for its slowest lane, and with one line a texel prefetched, four
-// groups of eight in five had a lane whose line nobody had asked for (measured:
-// docs/performance-log.md).
+// line: a gather waits for its slowest lane, and with one line a texel prefetched, most
+// groups of eight had a lane whose line nobody had asked for (measured:
+// docs/performance-log.md, 'locate8').
 ENVMIS_AVX2 Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l) noexcept {
     const Vec8 d =
         to_canonical8(env.axes, {_mm256_loadu_ps(in.x + l), _mm256_loadu_ps(in.y + l), _mm256_loadu_ps(in.z + l)});

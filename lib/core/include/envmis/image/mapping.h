@@ -96,15 +96,14 @@ inline constexpr float kFourPi = 4 * kPiF;
 // The azimuth within the quadrant is phi = pi/4 (1 + t), t in [-1, 1]: its cosine and
 // sine are (cos a -+ sin a) / sqrt 2 with a = pi/4 t, from the minimax polynomials of
 // fast_sincos, which need no range reduction on |a| <= pi/4. Within 2.4e-7 of the exact
-// direction (tests/core/image/mapping_test.cpp); half the time of fast_sincos, whose
-// quadrant selects in a random octant cost as much as the rest of a sample (measured:
-// docs/performance-log.md).
+// direction (tests/core/image/mapping_test.cpp); cheaper than fast_sincos, whose
+// quadrant selects in a random octant are costly (measured: docs/performance-log.md,
+// 'equal_area_direction').
 //
 // A sample waits on this function: its column decides u last. So the polynomials are
 // split in two halves that run side by side (Estrin's scheme, in a^2 and a^4), pi/4
 // scales the numerator before the division, and 1/sqrt 2 goes inside the root, which
-// leaves fewer operations in a row after the division and the root (chained calls: 18
-// against 21 ns, AMD EPYC family 0x19).
+// leaves fewer operations in a row after the division and the root.
 ENVMIS_HD inline Vec3 equal_area_direction(Vec2 uv) noexcept {
     const float u = 2 * uv.x - 1, v = 2 * uv.y - 1, au = std::abs(u), av = std::abs(v);
     // Signed distance from the diamond |u| + |v| = 1 (the equator); r is the distance

@@ -12,8 +12,8 @@
 // ENVMIS_INLINE marks the sampling path's steps, which must be inlined into the
 // caller's loop: GCC's own estimate left EnvMapView::sample out of line in `envmis
 // bench` once it had grown by its prefetches, and the call (its sample returned through
-// memory) took the 1k compensated sample from 17.7-18.3 to 26.8-40.8 ns (alternating
-// runs, AMD EPYC family 0x1a).
+// memory) made the sample much slower (measured: docs/performance-log.md,
+// 'ENVMIS_INLINE').
 #if defined(__CUDACC__)
 #define ENVMIS_HD __host__ __device__
 #define ENVMIS_NOINLINE __noinline__

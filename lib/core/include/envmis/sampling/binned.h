@@ -222,8 +222,9 @@ struct BinnedOptions {
     // its predicted variance is lower than the plain density's by more than this factor,
     // so that each bin holds what is predicted best at equal time. The default is that of
     // a renderer whose rays cost little (the example renderer's); the variance study's
-    // estimates, which do nothing but sample and shade, cost more than twice as much with
-    // bins (docs/performance.md); 1 chooses at equal samples.
+    // estimates, which do nothing but sample and shade, cost much more with bins
+    // (measured: docs/performance-log.md, 'BinnedOptions::cost'); 1 chooses at equal
+    // samples.
     float cost = 1.2f;
 };
 

@@ -1,28 +1,21 @@
-// Piecewise-constant distributions over [0,1) and [0,1)^2, sampled by CDF inversion
-// accelerated with a guide table (Chen & Asau 1974).
+// Piecewise-constant distributions over [0,1) and [0,1)^2: the owning classes, which
+// build the tables of cdf.h (the algorithm, its measure, precision and cost), and the
+// views renderers sample through, which tune cdf.h's inversion for memory latency.
 //
-// Measure: image space. A distribution over n cells with function values f_i has
-// density pdf(x) = p_i n on cell i, where p_i is the cell's probability, so the pdf
-// integrates to 1 over [0,1)^d. `sample` inverts the CDF: it preserves the
-// stratification of its input and is exactly invertible (`invert(sample(u).p) == u` up
-// to float rounding).
+// The tuning, a layer over the plain search that never changes an answer: the CDF
+// lines a sample will read are prefetched before the guide entry that names them
+// arrives (CdfView::invert); a coarse guide, one uint16 entry per kCoarseGuideStep
+// cells of a row (0.03 bytes a cell, built from kCoarseGuideMinBytes of tables on),
+// predicts where in a row the answer lies; rows that draw many of the samples
+// (kHotRowFactor) are searched from the coarse guide without prefetches. Samples,
+// pdfs and inversions are bit-identical to cdf.h's plain ones (distribution_test), and
+// apps/benchmarks times the two side by side (distribution/plain, distribution/tuned).
 //
-// Precision: sums are accumulated in double, then each CDF is stored in 31-bit fixed
-// point (uint32: cell i covers [start_i, start_{i+1}) of 2^31 units). Fixed point has
-// the same resolution everywhere (a float CDF has 2^-24 near 1 and loses small cells
-// after large ones). Every cell with f_i > 0 gets at least one unit, so pdf > 0 exactly
-// where f > 0, and pdf() reports the stored probability itself: sample and pdf agree
-// exactly. p_i differs from f_i / sum f by at most one unit, 2^-31 = 4.7e-10.
-//
-// Cost (n cells): build O(n); 6 bytes per cell (uint32 CDF, uint16 guide entry), and in
-// 2D one uint16 coarse guide entry per kCoarseGuideStep cells of a row (0.03 bytes a
-// cell); sample O(1) expected (a guide-table lookup, then a binary search only inside the
-// few cells that share one guide bucket); pdf O(1); invert O(1). Sizes: 1 to 65536 cells
-// per dimension.
-//
-// The owning classes hold the tables and throw on invalid input. Their `view()` is a
-// set of flat arrays with noexcept, allocation-free methods that also compile for
-// CUDA: upload the arrays and use the same view on the device.
+// sample preserves the stratification of its input and is exactly invertible
+// (`invert(sample(u).p) == u` up to float rounding). Builds sum in double; p_i differs
+// from f_i / sum f by at most one unit, 2^-31 = 4.7e-10. The owning classes throw on
+// invalid input; their `view()` is a set of flat arrays with noexcept, allocation-free
+// methods that also compile for CUDA: upload the arrays and use the same view there.
 #pragma once
 
 #include <cmath>
@@ -34,19 +27,15 @@
 
 #include "envmis/large_vector.h"
 #include "envmis/math/math.h"
+#include "envmis/sampling/cdf.h"
 
 namespace envmis {
 
-inline constexpr uint32_t kCdfUnits = 1u << 31;    // total of a fixed-point CDF
-inline constexpr uint32_t kMaxCells1D = 1u << 16;  // per dimension (uint16 guide entries)
-
 // A row holding more than this many times the mean row's share of a 2D distribution
 // draws so many of the samples that its data stays in cache: the samplers skip their
-// prefetches in it, which take load slots there and save nothing. Measured on the
-// compensated 8k sky, whose samples crowd onto the sun's rows (each about 300 times the
-// mean; its other rows hold about the mean): single samples 15.4 ns without, 17.2-18.4 ns
-// with (AMD EPYC family 0x1a); on small maps, whose rows hold many times more of the
-// density each, a relative share keeps ordinary rows prefetched.
+// prefetches in it, which take load slots there and save nothing. On small maps, whose
+// rows hold many times more of the density each, a relative share keeps ordinary rows
+// prefetched (measured: docs/performance-log.md, 'kHotRowFactor').
 inline constexpr uint32_t kHotRowFactor = 64;
 
 // One coarse guide entry per this many guide buckets of a 2D distribution's row: the
@@ -56,8 +45,7 @@ inline constexpr uint32_t kHotRowFactor = 64;
 // CdfView::invert), and in a hot row to skip the guide (CdfView::invert_cached).
 // Built only where the tables (6 bytes a cell) reach kCoarseGuideMinBytes, about 2.8
 // million cells and up: smaller ones stay in the last-level cache, where it has
-// little to hide (a 1k map, one process, with against without it: compensated
-// 0.99-1.00x, plain 1.05-1.06x; AMD EPYC family 0x1a).
+// little to hide (measured: docs/performance-log.md, 'kCoarseGuideMinBytes').
 inline constexpr uint32_t kCoarseGuideShift = 6, kCoarseGuideStep = 1u << kCoarseGuideShift;
 inline constexpr size_t kCoarseGuideMinBytes = size_t{16} << 20;
 // Coarse guide entries of a row of w cells (the last step may be shorter).
@@ -65,66 +53,34 @@ ENVMIS_HD inline uint32_t coarse_guide_size(uint32_t w) noexcept {
     return (w + kCoarseGuideStep - 1) / kCoarseGuideStep;
 }
 
-// A point found by inverting a CDF: the cell, the position inside it, in [0,1), and the
-// cell's width in units (CdfView::width), which the search has read and the caller's pdf
-// needs. Reading it again took plain single samples of the 8k sky 6-13% longer (AMD EPYC
-// family 0x19): a cold row's sample must leave room in the reorder buffer for the next
-// sample's first misses, and a few instructions more decide whether they fit.
-struct CellHit {
-    uint32_t index = 0;
-    float offset = 0;
-    uint32_t width = 0;
-};
-
-// u clamped into [0, kOneMinusEpsilon], NaN to 0: the samplers take points of [0,1), and
-// this keeps any other input from reading outside their tables (a renderer's float
-// conversion of a random integer can round up to 1). Valid points pass unchanged.
-ENVMIS_HD inline float unit_point(float u) noexcept { return u > 0.0f ? min(u, kOneMinusEpsilon) : 0.0f; }
-
-// The unit of a CDF that u names, u 2^31 truncated (unit_point(u) first): what
-// CdfView::invert searches for.
-ENVMIS_HD inline uint32_t unit_of(float u) noexcept {
-    return static_cast<uint32_t>(unit_point(u) * static_cast<float>(kCdfUnits));
-}
-
 // The hint of CdfView::invert that does nothing.
 struct NoHint {
     ENVMIS_HD void operator()(uint32_t, uint32_t) const noexcept {}
 };
 
-// Non-owning view of one fixed-point CDF over n cells.
-struct CdfView {
-    const uint32_t* start = nullptr;  // n: first unit of each cell; zero-width cells are empty
-    const uint16_t* guide = nullptr;  // n: guide[k] = cell of the first unit of bucket k
-    uint32_t n = 0;
+// One fixed-point CDF (cdf.h's CdfTable) with the tuning of its inversion for memory
+// latency: the same answers as CdfTable::search (distribution_test), found with fewer
+// waits on memory where the tables are beyond the cache.
+struct CdfView : CdfTable {
     // Optional, ceil(n / kCoarseGuideStep): coarse[j] = guide[j kCoarseGuideStep]; only
     // read for prefetching (predicted_cell), never for the answer.
     const uint16_t* coarse = nullptr;
 
-    ENVMIS_HD uint32_t width(uint32_t i) const noexcept { return (i + 1 < n ? start[i + 1] : kCdfUnits) - start[i]; }
-
-    // The cell holding unit u * 2^31, and the position inside it.
-    // Single precision throughout: x is exact (a power-of-two scale of u), and so are
-    // its integer part t and the fraction x - t; only the offset's division rounds.
-    //
-    // Memory: a map beyond the cache misses on the guide entry, then on the CDF entry it
+    // CdfTable::search's answer. Memory: a map beyond the cache misses on the guide entry, then on the CDF entry it
     // names, then on the caller's data for the cell found. Where the function is flat
     // the answer is near cell k of the guide bucket, so the CDF around k is prefetched
     // and `near_answer(k, k)` lets the caller prefetch its own: the three loads overlap
-    // instead of waiting for each other. Real maps are not flat (the answer lies within
-    // a cell of k in 1-6% of the samples of 14 maps at 1k), so where a coarse guide is
-    // given, the cell it predicts and its two neighbours are prefetched too. A caller
-    // that knows the data is in cache passes kPrefetch = false: the prefetches would
-    // only take load slots (and see invert_cached).
+    // instead of waiting for each other. Real maps are not flat (the answer seldom lies
+    // within a cell of k), so where a coarse guide is given, the cell it predicts and
+    // its two neighbours are prefetched too. A caller that knows the data is in cache
+    // passes kPrefetch = false: the prefetches would only take load slots (and see
+    // invert_cached).
     //
     // The cells prefetched are tried first (find_near): where they hold the answer, the
-    // guide's entry, a miss of its own, is not read at all. Plain single samples of the
-    // 8k sky in envmis bench, binaries alternating: 8-17% less time (AMD EPYC family
-    // 0x19; fewer instructions, and no branch on the guide's answer). Where they do not
-    // (3-16% of cold rows' samples: the 8k sky in equal-area, a real map upscaled to 8k),
-    // the guide's entry is already on its way: prefetched too where the coarse guide sees
-    // no flat stretch. Plain single samples of rooitou_park upscaled to 33.5M texels, in
-    // one process: 4-9% less time; the flat 8k sky unchanged (AMD EPYC family 0x19).
+    // guide's entry, a miss of its own, is not read at all (fewer instructions, and no
+    // branch on the guide's answer). Where they do not, the guide's entry is already on
+    // its way: prefetched too where the coarse guide sees no flat stretch (measured:
+    // docs/performance-log.md, 'find_near').
     template <bool kPrefetch = true, class Hint = NoHint>
     ENVMIS_HD ENVMIS_INLINE CellHit invert(float u, Hint near_answer = {}) const noexcept {
         const float x = unit_point(u) * static_cast<float>(kCdfUnits);
@@ -139,9 +95,8 @@ struct CdfView {
     // entries around the guide bucket where they are at most a cell apart, as in a row
     // whose few bright cells span many buckets each. A 2D distribution's row read often
     // (Distribution2DView::row_is_hot) keeps its coarse guide, 1/64 of its guide, in the
-    // nearest cache, where its guide spills into the next: compensated single samples on
-    // the 8k sky took 0.87-0.99x the time of a search from the guide (AMD EPYC family
-    // 0x19). The same answer as invert.
+    // nearest cache, where its guide spills into the next (measured:
+    // docs/performance-log.md, 'invert_cached'). The same answer as invert.
     ENVMIS_HD ENVMIS_INLINE CellHit invert_cached(float u) const noexcept {
         const float x = unit_point(u) * static_cast<float>(kCdfUnits);
         const auto t = static_cast<uint32_t>(x);
@@ -150,12 +105,8 @@ struct CdfView {
         return find(coarse.hi - coarse.lo <= 1 ? coarse : guide_span(k), x, t);
     }
 
-    // The first and last cell that may hold the answer for a unit in guide bucket k: from
-    // the guide, and from the coarse guide (a wider span, the step's).
-    struct Span {
-        uint32_t lo, hi;
-    };
-    ENVMIS_HD Span guide_span(uint32_t k) const noexcept { return {guide[k], k + 1 < n ? guide[k + 1] : n - 1}; }
+    // The first and last cell that may hold a unit of guide bucket k, from the coarse
+    // guide (a wider span than guide_span's: the step's).
     ENVMIS_HD Span coarse_span(uint32_t k) const noexcept {
         const uint32_t j = k >> kCoarseGuideShift;
         return {coarse[j], (j + 1) * kCoarseGuideStep < n ? coarse[j + 1] : n - 1};
@@ -168,24 +119,6 @@ struct CdfView {
         cell = lo + (lo < hi && start[lo + 1] <= t) + (lo + 1 < hi && start[lo + 2] <= t);
         return true;
     }
-    // The cell in span s holding unit t (x: t with its fraction), and the position inside it.
-    ENVMIS_HD ENVMIS_INLINE CellHit find(Span s, float x, uint32_t t) const noexcept {
-        uint32_t lo = s.lo, hi = s.hi;
-        while (lo < hi) {  // last cell whose start is <= t
-            const uint32_t mid = (lo + hi + 1) / 2;
-            if (start[mid] <= t)
-                lo = mid;
-            else
-                hi = mid - 1;
-        }
-        const uint32_t cell_width = width(lo);
-        const float offset =
-            (static_cast<float>(t - start[lo]) + (x - static_cast<float>(t))) / static_cast<float>(cell_width);
-        // Both terms are >= 0 (t >= start[lo], t <= x) and the found cell is not empty,
-        // so only the rounding up to 1 needs a clamp.
-        return {lo, min(offset, kOneMinusEpsilon), cell_width};
-    }
-
     // The prefetches of invert for unit t: the CDF at its guide bucket k and, with a
     // coarse guide, k's guide entry and the CDF around the cell it predicts where that is
     // not next to k; `near_answer` at the same cells. Returns the cell whose
@@ -201,10 +134,9 @@ struct CdfView {
         const uint32_t p = predicted_cell(bucket_position(t));
         if (p + 1 >= k && p <= k + 1) return k;  // a flat stretch: the answer is k, whose lines are on their way
         ENVMIS_PREFETCH(guide + k);              // for the search that follows where p is wrong
-        // p is the answer in 29-74% of samples (14 real maps at 1k and the 8k-class sky,
-        // either mapping), a neighbour in most of the rest: on the equal-area sky these
-        // three cells hold every line the search and its caller read in 97% of samples,
-        // p alone in 77% (a texel's 12 bytes may straddle two lines).
+        // p or a neighbour is the answer in most samples, and these three cells then hold
+        // the lines the search and its caller read (a texel's 12 bytes may straddle two
+        // lines; measured: docs/performance-log.md, 'prefetch_unit').
         prefetch_cells(p > 0 ? p - 1 : 0, min(p + 1, n - 1), near_answer);
         return p;
     }
@@ -221,10 +153,9 @@ struct CdfView {
     // (bucket_position): the cells from the coarse entry before it to the next one (the
     // end of the row after the last), interpolated linearly to b, fraction and all, then
     // rounded. A coarse entry is the cell of its bucket's first unit, on average half a
-    // cell before where the CDF reaches that unit: hence the rounding, not truncation
-    // (on 14 real maps at 1k, either mapping: the answer itself 29-67% of the time
-    // against 20-51% when the prediction took the bucket's first unit and truncated).
-    // It lies in the span that holds the answer.
+    // cell before where the CDF reaches that unit: hence the rounding, not truncation,
+    // which predicts the answer itself more often (measured: docs/performance-log.md,
+    // 'predicted_cell'). It lies in the span that holds the answer.
     ENVMIS_HD ENVMIS_INLINE uint32_t predicted_cell(uint64_t b) const noexcept {
         constexpr uint32_t kStep = 31 + kCoarseGuideShift;  // bits of b below a coarse step
         const uint32_t j = static_cast<uint32_t>(b >> kStep), first = coarse[j];
@@ -235,80 +166,9 @@ struct CdfView {
         const uint64_t buckets = uint64_t{n - j * kCoarseGuideStep} << 31;  // the row's last, shorter step
         return min(first + static_cast<uint32_t>(((n - first) * into + buckets / 2) / buckets), n - 1);
     }
-
-    // The guide bucket of unit t, and of u: where invert starts, for callers that
-    // prefetch its first reads (sample_many).
-    ENVMIS_HD uint32_t bucket_of_unit(uint32_t t) const noexcept {
-        return static_cast<uint32_t>(bucket_position(t) >> 31);
-    }
-    ENVMIS_HD uint32_t bucket(float u) const noexcept { return bucket_of_unit(unit_of(u)); }
-    // Where unit t lies among the guide buckets, in fixed point with 31 bits below the
-    // point: bucket_of_unit(t) and t's place inside that bucket.
-    ENVMIS_HD uint64_t bucket_position(uint32_t t) const noexcept { return uint64_t{t} * n; }
-
-    // The u that `invert` maps to (index, offset).
-    ENVMIS_HD float at(uint32_t index, float offset) const noexcept {
-        const double units = start[index] + static_cast<double>(offset) * width(index);
-        return clamp(static_cast<float>(units / kCdfUnits), 0.0f, kOneMinusEpsilon);
-    }
 };
 
 namespace detail {
-
-// Cell of x in [0,1); exact, because a float times n <= 2^31 is exact in double. A NaN
-// (from a NaN direction) gets cell 0: converting it to an integer is undefined.
-ENVMIS_HD inline uint32_t cell_of(float x, uint32_t n) noexcept {
-    const float inside = x > 0 ? min(x, 1.0f) : 0.0f;
-    const auto i = static_cast<uint32_t>(static_cast<double>(inside) * n);
-    return i < n ? i : n - 1;
-}
-
-// Position of x inside cell i, in [0,1), from the same exact product as cell_of.
-ENVMIS_HD inline float offset_in_cell(float x, uint32_t i, uint32_t n) noexcept {
-    return clamp(static_cast<float>(static_cast<double>(x) * n - i), 0.0f, kOneMinusEpsilon);
-}
-
-// float(a / n), the double quotient rounded to float, without the double division on
-// the sample's critical path: the product with 1/n lies within 3 double ulps of the
-// quotient, so both round to the same float unless the quotient is within a few ulps of
-// a midpoint between floats (their last 29 mantissa bits near 2^28; about one point in
-// 2^24), where the division decides; so does it below 2^-126, where floats are
-// subnormal and their midpoints lie elsewhere in the bits.
-ENVMIS_HD inline float quotient_to_float(double a, uint32_t n) noexcept {
-    const double product = a * (1.0 / n);
-    const uint64_t below_float = bit_cast<uint64_t>(product) & ((uint64_t{1} << 29) - 1);
-    if (below_float - ((uint64_t{1} << 28) - 16) < 32 || product < 0x1p-126) [[unlikely]]
-        return static_cast<float>(a / n);
-    return static_cast<float>(product);
-}
-
-// The float nearest (index + offset) / n that still lies in cell `index`: rounding to
-// float can step over a cell edge, and one step back always suffices because a cell is
-// many float ulps wide. Forced inline: GCC left it out of line in envmis bench's sample
-// loop, a tenth of an equal-area sample's time (measured: docs/performance-log.md).
-ENVMIS_HD ENVMIS_INLINE float point_in_cell(uint32_t index, float offset, uint32_t n) noexcept {
-    if ((n & (n - 1)) == 0) {
-        // Power-of-two n (most maps): index / n and offset / n are exact floats, so
-        // their sum rounds once, to the same float as the division below, and can only
-        // round up onto the next cell's edge, which is exact too.
-        const float inv_n = 1.0f / static_cast<float>(n), i = static_cast<float>(index);
-        const float x = i * inv_n + offset * inv_n;
-        const float next_edge = (i + 1) * inv_n;
-        return x < next_edge ? x : bit_cast<float>(bit_cast<uint32_t>(next_edge) - 1);
-    }
-    float x = quotient_to_float(index + static_cast<double>(offset), n);
-    // x lies within half a float ulp below 1, 2^-25, of the quotient (and 2^-54 more where
-    // the double division rounds first): about n 2^-25 cells. An offset twice that far
-    // from both edges of its cell keeps x inside, below 1, with no check on the sample's
-    // critical path.
-    const float margin = static_cast<float>(n) * 0x1p-24f;
-    if (offset >= margin && offset <= 1.0f - margin) [[likely]]
-        return x;
-    const uint32_t c = cell_of(x, n);
-    if (c > index) x = ::nextafterf(x, 0.0f);
-    if (c < index) x = ::nextafterf(x, 1.0f);
-    return clamp(x, 0.0f, kOneMinusEpsilon);
-}
 
 // The uniform CDF over n cells: what build_cdf gives a function without a positive value.
 struct UniformCdf {
@@ -373,7 +233,7 @@ public:
     // a negative or non-finite value. An all-zero func gives the uniform distribution.
     explicit Distribution1D(std::span<const float> func);
 
-    Distribution1DView view() const noexcept { return {{start_.data(), guide_.data(), size()}}; }
+    Distribution1DView view() const noexcept { return {{{start_.data(), guide_.data(), size()}}}; }
     Distribution1DView::Sample sample(float u) const noexcept { return view().sample(u); }
     float pdf(float x) const noexcept { return view().pdf(x); }
     float invert(float x) const noexcept { return view().invert(x); }
@@ -389,29 +249,17 @@ private:
     bool uniform_ = false;
 };
 
-// Non-owning view of a 2D distribution: a marginal CDF over rows, then one
-// conditional CDF per row. Cell (x, y) covers [x/w, (x+1)/w) x [y/h, (y+1)/h).
-struct Distribution2DView {
-    const uint32_t* start = nullptr;  // w h, row-major: row y's CDF is start[y w, y w + w)
-    const uint16_t* guide = nullptr;  // w h, likewise
-    CdfView marginal;                 // over the h rows
-    uint32_t w = 0, h = 0;
-    float pdf_scale = 0;  // w h 2^-62: density per unit of the marginal times unit of a row
+// Non-owning view of a 2D distribution (cdf.h's Cdf2DTable: its pdf and invert) whose
+// sample is tuned for memory latency: the same samples as Cdf2DTable::search
+// (distribution_test). Cell (x, y) covers [x/w, (x+1)/w) x [y/h, (y+1)/h).
+struct Distribution2DView : Cdf2DTable {
     // coarse_row_size() h, row-major, the rows' coarse guides (CdfView::coarse); optional
     // (null below kCoarseGuideMinBytes): samples are the same, only the host's prefetches
     // and hot rows' searches differ. Device code never reads it, so it need not be uploaded.
     const uint16_t* coarse = nullptr;
 
-    struct Sample {
-        Vec2 p;                 // continuous point in [0,1)^2
-        float pdf = 0;          // density at p (measure: dx dy on [0,1)^2)
-        uint32_t x = 0, y = 0;  // cell of p
-    };
-
     ENVMIS_HD CdfView row(uint32_t y) const noexcept {
-        const size_t offset = static_cast<size_t>(y) * w;
-        return {start + offset, guide + offset, w,
-                coarse ? coarse + static_cast<size_t>(y) * coarse_row_size() : nullptr};
+        return {row_table(y), coarse ? coarse + static_cast<size_t>(y) * coarse_row_size() : nullptr};
     }
     ENVMIS_HD uint32_t coarse_row_size() const noexcept { return coarse_guide_size(w); }
     // u.y picks the row, u.x the column within it. `near_answer(first, last)` is told
@@ -423,7 +271,7 @@ struct Distribution2DView {
     }
     // The first stage of sample: the row that u.y picks. The marginal is read by every
     // sample and stays in cache: its inversion prefetches nothing.
-    ENVMIS_HD ENVMIS_INLINE CellHit sample_row(float uy) const noexcept { return marginal.invert<false>(uy); }
+    ENVMIS_HD ENVMIS_INLINE CellHit sample_row(float uy) const noexcept { return marginal.search(uy); }
     // The second stage of sample: the column in row r (sample_row(u.y)) and the point.
     // Batch callers find many rows first and prefetch the columns' data meanwhile.
     template <class Hint = NoHint>
@@ -456,20 +304,6 @@ struct Distribution2DView {
     ENVMIS_HD uint32_t hot_row_units() const noexcept {
         return static_cast<uint32_t>(min((uint64_t{kHotRowFactor} << 31) / h, uint64_t{kCdfUnits}));
     }
-    ENVMIS_HD float pdf(Vec2 p) const noexcept {
-        const uint32_t x = detail::cell_of(p.x, w), y = detail::cell_of(p.y, h);
-        return pdf_of(marginal.width(y), row(y).width(x));
-    }
-    ENVMIS_HD Vec2 invert(Vec2 p) const noexcept {
-        const uint32_t x = detail::cell_of(p.x, w), y = detail::cell_of(p.y, h);
-        return {row(y).at(x, detail::offset_in_cell(p.x, x, w)), marginal.at(y, detail::offset_in_cell(p.y, y, h))};
-    }
-    // Density of a cell from its row's and its own fixed-point widths. In float: the
-    // int-to-double conversions cost more than the whole rest of the product (measured),
-    // and the two extra roundings leave it within 3 float ulps of the exact value.
-    ENVMIS_HD float pdf_of(uint32_t row_width, uint32_t cell_width) const noexcept {
-        return static_cast<float>(row_width) * static_cast<float>(cell_width) * pdf_scale;
-    }
 };
 
 // A piecewise-constant distribution over [0,1)^2 from a w x h row-major function.
@@ -496,12 +330,12 @@ public:
     Distribution2D(uint32_t w, uint32_t h, LargeVector<uint32_t> cells, const CellRowFunction& rows);
 
     Distribution2DView view() const noexcept {
-        return {start_.data(),
-                guide_.data(),
-                {marginal_start_.data(), marginal_guide_.data(), h_},
-                w_,
-                h_,
-                static_cast<float>(uint64_t{w_} * h_) * 0x1p-62f,
+        return {{start_.data(),
+                 guide_.data(),
+                 {marginal_start_.data(), marginal_guide_.data(), h_},
+                 w_,
+                 h_,
+                 static_cast<float>(uint64_t{w_} * h_) * 0x1p-62f},
                 coarse_.empty() ? nullptr : coarse_.data()};
     }
     Distribution2DView::Sample sample(Vec2 u) const noexcept { return view().sample(u); }

@@ -94,8 +94,8 @@ struct EnvMapView {
         return {to_world(axes, canonical), solid_angle_pdf(image_pdf, sin_theta), radiance[texel], p};
     }
     // The equal-area half of at(), inline: a call, returning the sample through memory,
-    // costs a third of an equal-area sample, and inlining it leaves the equirectangular
-    // path as fast (measured).
+    // is costly, and inlining it leaves the equirectangular path as fast (measured:
+    // docs/performance-log.md, 'at_equal_area').
     ENVMIS_HD EnvSample at_equal_area(Vec2 p, float image_pdf, size_t texel) const noexcept {
         return {to_world(axes, equal_area_direction(p)), image_pdf * (1 / kFourPi), radiance[texel], p};
     }
@@ -116,7 +116,8 @@ struct EnvMapView {
         return equirect_uv(canonical);
     }
     // Out of line, keeping the equirectangular lookup's code small: inlined equal-area
-    // code has slowed it by a fifth (measured with a longer equal_area_direction).
+    // code has slowed it (measured: docs/performance-log.md,
+    // 'equal_area_uv_out_of_line').
     ENVMIS_NOINLINE ENVMIS_HD static Vec2 equal_area_uv_out_of_line(Vec3 canonical) noexcept {
         return equal_area_uv(canonical);
     }

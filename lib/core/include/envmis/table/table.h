@@ -9,9 +9,8 @@
 // that built them, so a loaded table samples bit-identically to the saved one, and no
 // index read from a file can ever address memory.
 //
-// Writing goes to a temporary file in the destination's folder (an AtomicFile,
-// atomic_file.h), renamed over the destination only when complete and flushed to disk:
-// an interrupted run or a full disk never leaves a partial table.
+// The writer is envmis::build's (envmis/build/table_writer.h); the layout both use is
+// table/format.h.
 #pragma once
 
 #include <cstddef>
@@ -65,34 +64,6 @@ public:
     using std::runtime_error::runtime_error;
 };
 
-// How the payload is stored.
-//   full:    float32 density and RGB radiance, 16 bytes a texel; loads bit-identical to
-//            the map written.
-//   compact: radiance only, in RGBE (8-bit mantissas with a shared exponent, as in
-//            Radiance .hdr files), 4 bytes a texel; the density is rebuilt from it on
-//            load. The table holds the RGBE-rounded map (rgbe_round): channels within
-//            1/255 of the pixel's largest channel, the largest within 0.4% (values
-//            above 1.7e38 saturate); it loads bit-identical to
-//            EnvMap(rgbe_round(radiance), options). Lossless for .hdr sources.
-enum class TableEncoding { full, compact };
-
-// Writes atomically (temporary file, then rename; atomic_file.h). Throws TableError on
-// I/O failure and where the destination exists and is not a regular file, and
-// Interrupted once `stop` is set (interrupt.h; checked every few rows written), leaving
-// no file.
-void write_table(const std::filesystem::path& path, const EnvMap& map, const TableSource& source,
-                 TableEncoding encoding = TableEncoding::full, StopFlag stop = nullptr);
-
-// A binned map: its plain map (as the overload above writes it) and its BinLayout, from
-// which the reader rebuilds the bins bit-identically. A compact table holds the
-// RGBE-rounded plain map and loads as BinnedEnvMap(EnvMap(rgbe_round(radiance),
-// options), layout).
-void write_table(const std::filesystem::path& path, const BinnedEnvMap& binned, const TableSource& source,
-                 TableEncoding encoding = TableEncoding::full, StopFlag stop = nullptr);
-
-// The radiance a compact table stores: each pixel rounded to RGBE and back.
-RgbImage rgbe_round(RgbImageView image);
-
 // How read_table gets a full table's radiance (12 bytes a texel).
 //   map:  borrowed from a read-only mapping of the file (POSIX mmap), which the map keeps
 //         alive: no copy, pages shared with the page cache and with other processes
@@ -116,7 +87,7 @@ struct TableHeader {
     EnvMapOptions options;
     EnvMapStats stats;
     TableSource source;
-    bool compact = false;  // RGBE payload (TableEncoding::compact)
+    bool compact = false;  // RGBE payload (table_writer.h: TableEncoding::compact)
     bool binned = false;   // has a bins section
 };
 

@@ -11,12 +11,12 @@
 #include <string_view>
 #include <vector>
 
+#include "envmis/build/table_writer.h"
 #include "envmis/image/image.h"
 #include "envmis/interrupt.h"
 #include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"
 #include "envmis/study/comparison/alpha.h"
-#include "envmis/table/table.h"
 
 namespace envmis {
 
@@ -82,8 +82,8 @@ struct BuiltMap {
 // equal-area map that is not square, a power that overflows float) as
 // std::invalid_argument naming the file; io's load errors as it throws them. Cost: the
 // load, the build (O(texels)), with alpha auto a choice on a 128-wide copy, with bins
-// their build (0.15 s for a 1k map). Once `stop` is set the load and builds throw
-// Interrupted.
+// their build (timings: docs/performance-log.md, 'build_map'). Once `stop` is set the
+// load and builds throw Interrupted.
 BuiltMap build_map(const std::filesystem::path& path, const BuildRequest& request, StopFlag stop = nullptr);
 
 // The same from pixels in memory: linear RGB in request.colorspace (empty: the working

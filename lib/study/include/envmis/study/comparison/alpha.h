@@ -18,9 +18,8 @@
 // Cost: (candidates + 1) x BSDFs x points exact variances on the downsampled map, each
 // O(w h) BSDF and pdf evaluations, parallel over rows, plus one downsampling pass over
 // the full map (O(W H)). Defaults (9 candidates, 3 BSDFs, 16 points, 128 x 64): 480
-// quadratures of 8192 texels, measured at 0.15 to 0.2 s on this project's two-core
-// machine (up to 0.6 s while it is shared), whatever the map's size, plus about 0.3 s
-// of downsampling for an 8192 x 4096 map.
+// quadratures of 8192 texels, whatever the map's size, plus the downsampling (timings:
+// docs/performance-log.md, 'choose_alpha').
 #pragma once
 
 #include <cstdint>

@@ -1,4 +1,4 @@
-#include "envmis/image/remap.h"
+#include "envmis/build/remap.h"
 
 #include <algorithm>
 #include <cmath>

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "cli_run.h"
-#include "envmis/table/atomic_file.h"
+#include "envmis/build/atomic_file.h"
 
 namespace envmis {
 namespace {

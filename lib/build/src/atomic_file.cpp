@@ -1,4 +1,4 @@
-#include "envmis/table/atomic_file.h"
+#include "envmis/build/atomic_file.h"
 
 #include <fcntl.h>
 #include <signal.h>

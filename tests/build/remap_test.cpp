@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "envmis/image/remap.h"
+#include "envmis/build/remap.h"
 #include "envmis/sampling/distribution.h"
 #include "envmis/study/reference/quadrature.h"
 #include "maps.h"
