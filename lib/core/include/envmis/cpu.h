@@ -28,7 +28,7 @@ struct CpuInfo {
     bool avx512 = false;             // AVX-512 F, BW, DQ and VL likewise (no kernel uses it: see below)
 };
 const CpuInfo& cpu_info() noexcept;
-// "<brand> (<vendor> family 0x<f> model 0x<m>, AVX2, AVX-512)": for benchmark output.
+// "<brand> (<vendor> family and model in hex, AVX2, AVX-512)": for benchmark output.
 std::string cpu_name();
 
 // The path of each kernel family; `forced` is ENVMIS_SIMD's value (empty when unset),
@@ -44,7 +44,7 @@ struct BatchPaths {
 // The rules (measured: docs/performance-log.md, 'choose_batch_paths'), equirect and
 // equal-area maps alike:
 // - lookup_many's AVX2 kernel wherever AVX2 is usable;
-// - sample_many's AVX2 kernel on Intel and on AMD from family 0x19 on, where its gathers
+// - sample_many's AVX2 kernel on Intel and on AMD whose family is 0x19 or later: its gathers
 //   pay; the scalar pipeline on older AMD families (not measured);
 // - the estimator's lanes (arithmetic, no gathers of their own) wherever AVX2 is usable.
 // No AVX-512 path: much of the kernels' time goes to gathers, and a 16-lane gather of

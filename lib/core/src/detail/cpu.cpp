@@ -108,7 +108,7 @@ BatchPaths choose_batch_paths(const CpuInfo& cpu, std::string_view forced) {
         paths.unavailable = true;
         return paths;
     }
-    // The AVX2 sampler where its gathers pay: Intel, and AMD from family 0x19 on (on 0x19
+    // The AVX2 sampler where its gathers pay: Intel, and AMD whose family is 0x19 or later (there
     // they are microcoded, but the sampler's time goes to memory); older AMD families are
     // not measured, and the scalar pipeline is the safe choice there (cpu.h; measured:
     // docs/performance-log.md, 'choose_batch_paths').
