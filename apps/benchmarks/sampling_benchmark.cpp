@@ -99,6 +99,26 @@ void distribution_sample(benchmark::State& state) {
     }
 }
 
+// The whole guided sample (direction, solid-angle pdf, radiance) through the tuned
+// distribution, as EnvMapView::sample draws it, against the same sample through the
+// plain search of cdf.h: what the tuning gives a renderer's single call.
+template <bool kTuned>
+void whole_sample(benchmark::State& state) {
+    const EnvMap map(sky(static_cast<uint32_t>(state.range(0))), options());
+    const EnvMapView view = map.view();
+    const auto& us = uniforms();
+    size_t i = 0;
+    for (auto _ : state) {
+        const envmis::Vec2 u = us[i++ & (us.size() - 1)];
+        if constexpr (kTuned) {
+            benchmark::DoNotOptimize(view.sample(u));
+        } else {
+            const auto s = view.distribution.search(u);
+            benchmark::DoNotOptimize(view.at(s.p, s.pdf, static_cast<size_t>(s.y) * view.distribution.w + s.x));
+        }
+    }
+}
+
 // The guided sampler through sample_many, kBatch points a call (as the estimator's lanes
 // or a wavefront renderer ask): the points are the same as sample's, stored as the
 // batch call reads them; the counter is the time per sample.
@@ -421,6 +441,8 @@ BENCHMARK(sample<TextbookEnvMap>)->Name("sample/textbook")->Apply(sizes_ns);
 BENCHMARK(sample_batch<true>)->Name("sample/guided-many")->Apply(sizes_ns);
 BENCHMARK(distribution_sample<false>)->Name("distribution/plain")->Apply(sizes_ns);
 BENCHMARK(distribution_sample<true>)->Name("distribution/tuned")->Apply(sizes_ns);
+BENCHMARK(whole_sample<false>)->Name("sample/guided-plain-search")->Apply(sizes_ns);
+BENCHMARK(whole_sample<true>)->Name("sample/guided-tuned")->Apply(sizes_ns);
 // Binned against today's map, plain and compensated (guided above); build/bins is the
 // bins alone, on top of a plain map's build.
 BENCHMARK(build<EnvMap, false>)->Name("build/plain")->Apply(sizes);

@@ -24,15 +24,16 @@
 
 namespace envmis::cli {
 
-void add_map_flags(CLI::App& app, MapFlags& flags) {
-    app.add_flag("--no-compensate", flags.no_compensate, "Sample proportionally to luminance (no MIS compensation)");
+void add_map_flags(CLI::App& app, BuildRequest& request) {
+    app.add_flag_callback(
+        "--no-compensate", [&request] { request.compensate = false; },
+        "Sample proportionally to luminance (no MIS compensation)");
     const CLI::Validator alpha_value([](std::string& text) { return alpha_problem(text); }, "");
     app.add_option_function<std::string>(
            "--alpha",
-           [&flags](const std::string& text) {
-               flags.alpha_auto = text == "auto";
-               flags.alpha_given = true;
-               if (!flags.alpha_auto) flags.alpha = std::strtof(text.c_str(), nullptr);
+           [&request](const std::string& text) {
+               request.alpha_auto = text == "auto";
+               if (!request.alpha_auto) request.alpha = std::strtof(text.c_str(), nullptr);
            },
            "Compensation strength: q = max(L - alpha * mean(L), 0); auto: the candidate with the lowest exact MIS "
            "variance (alpha.h; compare chooses per BSDF)")
@@ -40,27 +41,15 @@ void add_map_flags(CLI::App& app, MapFlags& flags) {
         ->default_str("1")
         ->check(alpha_value)
         ->excludes("--no-compensate");
-    app.add_option("--mapping", flags.mapping,
+    app.add_option("--mapping", request.mapping,
                    "Image mapping: equirect (latitude-longitude) or equal-area (octahedral, square)")
         ->capture_default_str()
         ->check(CLI::IsMember({"equirect", "equal-area"}));
-    app.add_option("--colorspace", flags.colorspace, "Input colour space (default: from the file's metadata)");
-    app.add_option("--working-space", flags.working_space, "Linear working colour space, e.g. lin_rec709 or ACEScg")
+    app.add_option("--colorspace", request.colorspace, "Input colour space (default: from the file's metadata)");
+    app.add_option("--working-space", request.working_space, "Linear working colour space, e.g. lin_rec709 or ACEScg")
         ->capture_default_str();
-    app.add_option("--axes", flags.axes, "World frame of directions: z-up, y-up or a signed permutation like x,z,-y")
+    app.add_option("--axes", request.axes, "World frame of directions: z-up, y-up or a signed permutation like x,z,-y")
         ->capture_default_str();
-}
-
-BuildRequest build_request(const MapFlags& flags) {
-    BuildRequest request;
-    request.compensate = !flags.no_compensate;
-    if (flags.alpha_given && !flags.alpha_auto) request.alpha = flags.alpha;
-    request.alpha_auto = flags.alpha_auto;
-    request.axes = flags.axes;
-    request.mapping = flags.mapping;
-    request.colorspace = flags.colorspace;
-    request.working_space = flags.working_space;
-    return request;
 }
 
 namespace {
@@ -333,7 +322,7 @@ void check_map_memory(const std::filesystem::path& input, uint64_t bytes_per_tex
     check(size.width, size.height, size.largest_texels, bytes_per_texel);
 }
 
-LoadedMap load_map(const std::string& path, const MapFlags& flags, std::ostream& notes) {
+LoadedMap load_map(const std::string& path, const BuildRequest& request, std::ostream& notes) {
     check_map_memory(path, kBuildPeak);
     if (looks_like_table(path)) {
         const auto start = std::chrono::steady_clock::now();
@@ -345,7 +334,7 @@ LoadedMap load_map(const std::string& path, const MapFlags& flags, std::ostream&
         loaded.load_ms = milliseconds_since(start);
         return loaded;
     }
-    BuiltMap built = build_map(path, build_request(flags), &interrupted());
+    BuiltMap built = build_map(path, request, &interrupted());
     for (const std::string& notice : built.notices) notes << "note: " << printable(notice) << "\n";
     return loaded_map(built);
 }

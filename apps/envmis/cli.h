@@ -30,20 +30,10 @@
 
 namespace envmis::cli {
 
-// How to build an EnvMap from an image (ignored for tables, which record their own).
-struct MapFlags {
-    bool no_compensate = false;
-    float alpha = 1.0f;
-    bool alpha_auto = false;   // --alpha auto: choose_alpha() (alpha.h) picks it, map-wide
-    bool alpha_given = false;  // --alpha was on the command line (binned tables default to auto)
-    std::string colorspace;    // input colour space; empty: from the file
-    std::string working_space = "lin_rec709";
-    std::string axes = "z-up";
-    std::string mapping = "equirect";  // or "equal-area" (a square image)
-};
-void add_map_flags(CLI::App& app, MapFlags& flags);
-// The request the flags make (no bins, not compact).
-BuildRequest build_request(const MapFlags& flags);
+// The map flags (--no-compensate, --alpha, --mapping, --colorspace, --working-space,
+// --axes), which fill `request` (build.h): how to build a map from an image (ignored for
+// tables, which record their own).
+void add_map_flags(CLI::App& app, BuildRequest& request);
 
 // The bounds of a count, size or seed flag, in the flag's own type T (an integer):
 // "-n: Value -5 not in range 1 to 1099511627776". The text is read as a decimal T in full:
@@ -144,7 +134,7 @@ struct LoadedMap {
 // (build_map in build.h); the notices go to `notes`, each a line "note: FILE: ...". An
 // image whose map cannot be built (its power overflows float, say) is an error naming
 // the file; an interruption (above) stops the load and the build.
-LoadedMap load_map(const std::string& path, const MapFlags& flags, std::ostream& notes = std::cerr);
+LoadedMap load_map(const std::string& path, const BuildRequest& request, std::ostream& notes = std::cerr);
 // A map built from an image, as load_map returns it; a binned map's bins stay in `built`
 // (loaded.bins is their layout, loaded.map empty).
 LoadedMap loaded_map(BuiltMap& built);

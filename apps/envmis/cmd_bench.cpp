@@ -198,10 +198,10 @@ BenchMap bench_map(const BenchArgs& args) {
         check_image_size("--size " + args.size, size, kBytesPerTexel);
         return {reference::synthetic_sky(size.width, size.height, options.mapping), "synthetic-sky", options};
     }
-    MapFlags flags;
-    flags.no_compensate = true;
-    flags.mapping = args.mapping;
-    const LoadedMap loaded = load_map(args.input, flags);
+    BuildRequest request;
+    request.compensate = false;
+    request.mapping = args.mapping;
+    const LoadedMap loaded = load_map(args.input, request);
     options.mapping = loaded.map.options().mapping, options.axes = loaded.map.options().axes;
     return {to_image(loaded.map.radiance()), args.input, options};
 }

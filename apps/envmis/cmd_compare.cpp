@@ -11,7 +11,6 @@
 #include <memory>
 #include <optional>
 #include <sstream>
-#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -20,7 +19,7 @@
 #include "envmis/io/image_io.h"
 #include "envmis/report/inputs.h"
 #include "envmis/report/results.h"
-#include "envmis/study/comparison/comparison.h"
+#include "envmis/study/comparison/setup.h"
 #include "envmis/study/comparison/sweeps.h"
 #include "library.h"
 #include "render.h"
@@ -43,7 +42,7 @@ struct CompareArgs {
     RenderOptions render;
     uint32_t spp = 1024, points = 16, threads = 0, env_samples = 1, bsdf_samples = 1, allocation_sweep = 0;
     double view_angle = 0;  // degrees between each --points normal and its view
-    uint32_t bins = 0;      // --bins; 0: kDefaultBins where a -bins technique runs
+    uint32_t bins = 0;      // --bins; 0: kDefaultStudyBins where a -bins technique runs
     float bin_cost = BinnedOptions{}.cost;
     uint64_t seed = 1;
     bool exact = false;
@@ -51,45 +50,21 @@ struct CompareArgs {
     // table, its own bytes: a table rebuilt with other options must run again). Empty: the
     // loaded map's source hash (for a table, the image it was built from).
     std::string source_hash;
-    MapFlags map;
-    const CLI::Option* alpha_flag = nullptr;  // --alpha: given, it fixes the bins' alpha too
+    BuildRequest map;  // the map flags
 };
 
-constexpr uint32_t kDefaultBins = 121;  // BinnedOptions{}.bins_per_side squared
-
 // The limits of the count flags, checked by in_range (cli.h), which refuses a negative value
-// instead of wrapping it.
+// instead of wrapping it; the study's own (setup.h) are Python's too.
 constexpr uint32_t kMaxSpp = std::numeric_limits<uint32_t>::max();
-constexpr uint32_t kMaxSamples = 65536;  // per estimate, of each kind
-constexpr uint32_t kMaxPoints = 1000000;
-constexpr uint32_t kMaxThreads = 1024;
-// Workers beyond this many per hardware thread only add start-up cost and contention.
-constexpr uint32_t kThreadsPerCore = 4;
 constexpr uint32_t kMaxImageSpp = 65536, kMaxReferenceSpp = 1 << 20;
 
-// Everything a run is set up with: the parsed flags, the plain map, the points, the
-// compensation strengths chosen and their maps.
-struct Setup {
+// Everything a run is set up with: the study's set-up, the map's name and hash, the
+// sweeps' techniques and alphas.
+struct Setup : CompareSetup {
     std::string map_name;
-    EnvMap plain;
-    std::vector<ShadingPoint> points;
-    ComparisonOptions options;
+    std::string source_hash;  // inputs.source_hash of the JSON (CompareArgs::source_hash)
     std::vector<Technique> alpha_techniques, allocation_techniques;  // of the sweeps asked for
     std::vector<float> swept;                                        // --alpha-sweep
-    std::optional<AlphaChoice> choice;
-    float map_alpha = 0;
-    std::vector<float> bsdf_alphas;
-    CompensatedMaps compensated;
-    std::shared_ptr<const BinnedEnvMap> binned;  // with a -bins technique
-    bool bins_auto = false;                      // its alpha chosen per bin
-    std::string source_hash;                     // inputs.source_hash of the JSON (CompareArgs::source_hash)
-
-    StudyInputs inputs() const { return {plain, compensated, points, options, binned.get()}; }
-    float alpha_of(const Bsdf& bsdf) const {
-        for (size_t b = 0; b < options.bsdfs.size(); ++b)
-            if (options.bsdfs[b].name() == bsdf.name()) return bsdf_alphas[b];
-        return map_alpha;
-    }
 };
 
 // What the run measured: the comparison, or the sweeps.
@@ -99,14 +74,6 @@ struct Outcome {
     std::optional<AllocationSweep> allocation;
     size_t alphas_swept = 0;  // --alpha-sweep's values with auto's choices and 0
 };
-
-std::vector<std::string> split(const std::string& text) {
-    std::vector<std::string> items;
-    std::stringstream in(text);
-    for (std::string item; std::getline(in, item, ',');)
-        if (!item.empty()) items.push_back(item);
-    return items;
-}
 
 void add_study_flags(CLI::App& sub, CompareArgs& args) {
     sub.add_option("input", args.inputs,
@@ -133,15 +100,15 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
         ->check(in_range(uint32_t{1}, kMaxSpp));
     sub.add_option("--env-samples", args.env_samples, "Environment samples per MIS estimate (0 to 65536)")
         ->capture_default_str()
-        ->check(in_range(uint32_t{0}, kMaxSamples));
+        ->check(in_range(uint32_t{0}, kMaxStudySamples));
     sub.add_option("--bsdf-samples", args.bsdf_samples, "BSDF samples per MIS estimate (0 to 65536)")
         ->capture_default_str()
-        ->check(in_range(uint32_t{0}, kMaxSamples));
+        ->check(in_range(uint32_t{0}, kMaxStudySamples));
     sub.add_option("--seed", args.seed, "Random seed")->capture_default_str()->check(any_seed());
     sub.add_option("--threads", args.threads,
                    "Worker threads, 1 to 1024, at most 4 per hardware thread (more are reduced to that, with a "
                    "note; default: all cores); results do not depend on it")
-        ->check(in_range(uint32_t{1}, kMaxThreads));
+        ->check(in_range(uint32_t{1}, kMaxStudyThreads));
     CLI::Option* normal = sub.add_option("--normal", args.normal, "One shading point with this normal x,y,z")
                               ->check(direction_validator());
     sub.add_option("--view", args.view, "View direction x,y,z for --normal (default: the normal)")
@@ -149,7 +116,7 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
         ->needs(normal);
     sub.add_option("--points", args.points, "Shading points: K normals spread evenly over the sphere (1 to 10^6)")
         ->capture_default_str()
-        ->check(in_range(uint32_t{1}, kMaxPoints))
+        ->check(in_range(uint32_t{1}, kMaxStudyPoints))
         ->excludes(normal);
     sub.add_option("--view-angle", args.view_angle,
                    "Degrees (0 to 89.9) between each --points normal and its view, towards azimuths that turn by "
@@ -202,13 +169,13 @@ void add_sweep_flags(CLI::App& sub, CompareArgs& args) {
 std::pair<EnvMap, float> load_plain(const CompareArgs& args, std::string& map_name, std::string& source_hash) {
     // The plain density; the compensated ones are built from its radiance, as --alpha
     // says (or as a table was built).
-    MapFlags flags = args.map;
-    flags.no_compensate = true;
+    BuildRequest flags = args.map;
+    flags.compensate = false;
     flags.alpha_auto = false;
     LoadedMap loaded = load_map(args.input, flags, *args.notes);
     map_name = loaded.source.name;
     source_hash = args.source_hash.empty() ? hash_text(loaded.source.content_hash) : args.source_hash;
-    const float fixed_alpha = !loaded.from_table         ? args.map.alpha
+    const float fixed_alpha = !loaded.from_table         ? args.map.alpha.value_or(1.0f)
                               : loaded.map.compensated() ? loaded.map.options().compensation.alpha
                                                          : 0.0f;
     EnvMapOptions plain_options = loaded.map.options();
@@ -217,105 +184,64 @@ std::pair<EnvMap, float> load_plain(const CompareArgs& args, std::string& map_na
     return {std::move(loaded.map), fixed_alpha};
 }
 
-// --threads (0: every hardware thread), at most kThreadsPerCore per hardware thread.
-uint32_t worker_threads(uint32_t asked) {
-    const uint32_t cores = std::max(1u, std::thread::hardware_concurrency());
-    if (asked == 0) return cores;
-    if (asked <= kThreadsPerCore * cores) return asked;
-    std::cerr << "note: --threads " << asked << ": more than " << kThreadsPerCore << " per hardware thread (" << cores
-              << "); using " << kThreadsPerCore * cores << "\n";
-    return kThreadsPerCore * cores;
+// --threads (0: every hardware thread), with a note where it is reduced.
+uint32_t threads_of(const CompareArgs& args) {
+    std::string note;
+    const uint32_t threads = worker_threads(args.threads, &note);
+    if (!note.empty()) std::cerr << "note: --" << note << "\n";
+    return threads;
 }
 
-ComparisonOptions comparison_options(const CompareArgs& args, std::vector<Technique>& requested) {
-    ComparisonOptions options;
+// The study the flags ask for, all but its fixed alpha, which the map may set
+// (load_plain); `requested` the techniques named (empty: the default).
+CompareRequest compare_request(const CompareArgs& args, std::vector<Technique>& requested) {
+    CompareRequest request;
+    ComparisonOptions& options = request.options;
     options.spp = args.spp;
     options.seed = args.seed;
     options.bsdfs.clear();
-    for (const std::string& b : split(args.bsdfs)) options.bsdfs.push_back(Bsdf::parse(b));
+    for (const std::string& b : split_list(args.bsdfs)) options.bsdfs.push_back(Bsdf::parse(b));
     if (options.bsdfs.empty()) throw std::runtime_error("--bsdf '" + args.bsdfs + "': expected at least one BSDF");
-    for (const std::string& t : split(args.techniques)) requested.push_back(Technique::parse(t));
+    for (const std::string& t : split_list(args.techniques)) requested.push_back(Technique::parse(t));
     if (!requested.empty()) options.techniques = requested;
     options.allocation = {args.env_samples, args.bsdf_samples};
-    options.threads = worker_threads(args.threads);
-    return options;
-}
-
-// g of --bins K = g * g; 0 (no bins) without a -bins technique.
-uint32_t bins_per_side(const CompareArgs& args, std::span<const Technique> techniques) {
-    const uint32_t k = args.bins ? args.bins : (uses_bins(techniques) ? kDefaultBins : 0);
-    const auto g = static_cast<uint32_t>(std::lround(std::sqrt(static_cast<double>(k))));
-    if (g * g != k || (k && g > 64))
-        throw std::runtime_error("--bins " + std::to_string(k) +
-                                 ": expected a square number g*g of normal bins, g 1 to 64 (e.g. 64, 100, 144)");
-    return uses_bins(techniques) ? g : 0;
-}
-
-// --alpha X fixes the bins' alpha; without it, or with auto, each bin chooses its own.
-bool bins_auto_alpha(const CompareArgs& args) {
-    return !(args.alpha_flag && args.alpha_flag->count() > 0 && !args.map.alpha_auto);
-}
-
-// The bins of the -bins techniques, over a copy of the plain map.
-std::shared_ptr<const BinnedEnvMap> build_bins(const CompareArgs& args, const EnvMap& plain, uint32_t g) {
-    if (g == 0) return nullptr;
-    BinnedOptions options;
-    options.bins_per_side = g;
-    options.auto_alpha = bins_auto_alpha(args);
-    options.alpha = args.map.alpha;
-    options.cost = args.bin_cost;
-    return std::make_shared<const BinnedEnvMap>(EnvMap(plain), options, &interrupted());
+    options.threads = threads_of(args);
+    try {
+        bins_per_side(args.bins, options.techniques);
+    } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(std::string("--") + e.what());
+    }
+    if (!args.normal.empty()) {
+        const Vec3 n = *parse_direction(args.normal);  // the flags' validators checked both
+        request.points = {{n, args.view.empty() ? n : *parse_direction(args.view)}};
+    } else {
+        request.points = sphere_points(args.points, args.view_angle);
+    }
+    // --alpha X fixes the bins' alpha; without it, or with auto, each bin chooses its own.
+    request.bin_alpha = args.map.alpha;
+    request.bins = args.bins;
+    request.bin_cost = args.bin_cost;
+    return request;
 }
 
 Setup prepare(const CompareArgs& args) {
     std::vector<Technique> requested;
-    ComparisonOptions options = comparison_options(args, requested);
-    const uint32_t g = bins_per_side(args, options.techniques);
-    std::vector<float> swept = args.alpha_sweep.empty() ? std::vector<float>{} : parse_alpha_sweep(args.alpha_sweep);
-    // Each sweep's techniques, checked before any study runs.
-    std::vector<Technique> alpha_techniques, allocation_techniques;
-    if (!swept.empty()) alpha_techniques = alpha_sweep_techniques(requested);
-    if (args.allocation_sweep) allocation_techniques = allocation_sweep_techniques(requested);
+    CompareRequest request = compare_request(args, requested);
+    Setup s;
+    // Each sweep's techniques, checked before any file is touched.
+    s.swept = args.alpha_sweep.empty() ? std::vector<float>{} : parse_alpha_sweep(args.alpha_sweep);
+    if (!s.swept.empty()) s.alpha_techniques = alpha_sweep_techniques(requested);
+    if (args.allocation_sweep) s.allocation_techniques = allocation_sweep_techniques(requested);
     check_outputs({args.input}, {{"--json", args.json}, {"--csv", args.csv}});
     for (const std::string* output : {&args.csv, &args.json})
         if (!output->empty()) prepare_output(*output);
     if (!args.images.empty()) std::filesystem::create_directories(args.images);
     if (!args.plots.empty()) std::filesystem::create_directories(args.plots);
-    std::string map_name, source_hash;
-    auto [plain, fixed_alpha] = load_plain(args, map_name, source_hash);
-    std::vector<ShadingPoint> points;
-    if (!args.normal.empty()) {
-        const Vec3 n = *parse_direction(args.normal);  // the flags' validators checked both
-        points = {{n, args.view.empty() ? n : *parse_direction(args.view)}};
-    } else {
-        points = sphere_points(args.points, args.view_angle);
-    }
-    std::optional<AlphaChoice> choice;
-    if (args.map.alpha_auto) {
-        AlphaOptions search;
-        search.bsdfs = options.bsdfs;
-        search.points = points;
-        search.allocation = options.allocation;
-        choice = choose_alpha(plain.radiance(), plain.options(), search);
-    }
-    const float map_alpha = choice ? choice->alpha : fixed_alpha;
-    std::vector<float> bsdf_alphas = choice ? choice->bsdf_alphas : std::vector<float>(options.bsdfs.size(), map_alpha);
-    CompensatedMaps compensated = compensated_maps(plain, bsdf_alphas, &interrupted());
-    std::shared_ptr<const BinnedEnvMap> binned = build_bins(args, plain, g);
-    return {std::move(map_name),
-            std::move(plain),
-            std::move(points),
-            std::move(options),
-            std::move(alpha_techniques),
-            std::move(allocation_techniques),
-            std::move(swept),
-            std::move(choice),
-            map_alpha,
-            std::move(bsdf_alphas),
-            std::move(compensated),
-            std::move(binned),
-            bins_auto_alpha(args),
-            std::move(source_hash)};
+    auto [plain, fixed_alpha] = load_plain(args, s.map_name, s.source_hash);
+    if (!args.map.alpha_auto) request.alpha = fixed_alpha;
+    static_cast<CompareSetup&>(s) =
+        prepare_compare(std::make_shared<const EnvMap>(std::move(plain)), std::move(request), &interrupted());
+    return s;
 }
 
 // A RunControl that shows `label`'s progress on stderr and stops at Ctrl-C.
@@ -406,8 +332,8 @@ std::string header_line(const Setup& s, size_t points_done) {
     }
     const ComparisonOptions& o = s.options;
     std::ostringstream header;
-    header << "envmis compare: " << printable(s.map_name) << " (" << s.plain.width() << "x" << s.plain.height() << "), "
-           << points_done << (points_done < s.points.size() ? " of " + std::to_string(s.points.size()) : "")
+    header << "envmis compare: " << printable(s.map_name) << " (" << s.plain->width() << "x" << s.plain->height()
+           << "), " << points_done << (points_done < s.points.size() ? " of " + std::to_string(s.points.size()) : "")
            << (s.points.size() == 1 ? " shading point" : " shading points") << ", " << o.spp << " estimates each, "
            << o.allocation.env << " env + " << o.allocation.bsdf << " BSDF samples per estimate ("
            << o.allocation.total() << " for single techniques), alpha " << alpha.str() << ", seed " << o.seed
@@ -430,13 +356,12 @@ std::string options_text(const CompareArgs& a) {
          << " normal=" << a.normal << " view=" << a.view << " points=" << a.points;
     if (a.view_angle != 0) text << " view-angle=" << a.view_angle;
     char alpha[32];
-    std::snprintf(alpha, sizeof alpha, "%.9g", a.map.alpha);
-    const bool alpha_given = a.alpha_flag && a.alpha_flag->count() > 0;
+    std::snprintf(alpha, sizeof alpha, "%.9g", a.map.alpha.value_or(1.0f));
     text << " alpha="
          << (a.map.alpha_auto ? "auto"
-             : alpha_given    ? alpha
+             : a.map.alpha    ? alpha
                               : "(default)")
-         << " compensate=" << !a.map.no_compensate << " colorspace=" << a.map.colorspace
+         << " compensate=" << a.map.compensate << " colorspace=" << a.map.colorspace
          << " working-space=" << a.map.working_space << " axes=" << a.map.axes << " mapping=" << a.map.mapping
          << " alpha-sweep=" << a.alpha_sweep << " exact=" << a.exact << " allocation-sweep=" << a.allocation_sweep
          << " csv=" << !a.csv.empty() << " plots=" << !a.plots.empty() << " images=" << !a.images.empty();
@@ -447,7 +372,7 @@ std::string options_text(const CompareArgs& a) {
 }
 
 nlohmann::json inputs_json(const CompareArgs& args, const Setup& s, size_t points_done) {
-    nlohmann::json inputs = envmis::inputs_json({s.map_name, s.plain.width(), s.plain.height(), s.map_alpha,
+    nlohmann::json inputs = envmis::inputs_json({s.map_name, s.plain->width(), s.plain->height(), s.map_alpha,
                                                  s.choice ? &*s.choice : nullptr, &s.options, s.bsdf_alphas,
                                                  s.binned.get(), s.bins_auto, std::span(s.points).first(points_done)});
     inputs["source_hash"] = s.source_hash;
@@ -486,32 +411,25 @@ void write_comparison(std::ostream& out, const CompareArgs& args, const Setup& s
 // --exact: per BSDF, each fixed-weight technique's exact variance over mis-balance's,
 // the geometric mean over points and the worst point.
 void write_exact(std::ostream& out, const CompareArgs& args, const Setup& s, Written& w) {
-    const StudyInputs inputs = s.inputs();
-    const Technique balance = Technique::parse("mis-balance");
+    std::optional<Progress> progress;
+    RunControl control{&interrupted(), {}};
+    if (args.show_progress)
+        control.progress = [&progress](size_t done, size_t total) {
+            if (!progress) progress.emplace("exact variances", total);
+            progress->update(done);
+        };
+    const std::vector<ExactRatio> ratios = exact_ratios(s, control);
     out << "exact var/mis: exact variance / that of mis-balance (quadrature, one subdivision), geometric mean "
            "over points (worst point)\n";
-    const size_t nb = s.options.bsdfs.size(), nt = s.options.techniques.size();
-    std::optional<Progress> progress;
-    if (args.show_progress) progress.emplace("exact variances", nb * (nt + 1));
-    for (size_t b = 0; b < nb; ++b) {
-        const std::vector<double> baseline = exact_point_variances(inputs, balance, b, 1, &interrupted());
-        if (progress) progress->update(b * (nt + 1) + 1);
+    for (size_t b = 0; b < s.options.bsdfs.size(); ++b) {
         out << "  " << s.options.bsdfs[b].name() << ":";
-        for (size_t i = 0; i < nt; ++i) {
-            const Technique& t = s.options.techniques[i];
-            if (progress) progress->update(b * (nt + 1) + 1 + i);
-            if (t.adaptive() || t.mixture) continue;
-            const std::vector<double> v = exact_point_variances(inputs, t, b, 1, &interrupted());
-            double worst = 0;
-            for (size_t p = 0; p < v.size(); ++p)
-                if (v[p] > 0 && baseline[p] > 0) worst = std::max(worst, v[p] / baseline[p]);
-            const double mean = geometric_mean_ratios(v, baseline, 1).front();
+        for (const ExactRatio& r : ratios) {
+            if (r.bsdf != b) continue;
             char text[96];
-            std::snprintf(text, sizeof text, " %s %.3f (%.3f)", t.name().c_str(), mean, worst);
+            std::snprintf(text, sizeof text, " %s %.3f (%.3f)", r.technique.name().c_str(), r.ratio, r.worst);
             out << text;
-            w.json["exact"][s.options.bsdfs[b].name()][t.name()] = {{"ratio", mean}, {"worst", worst}};
+            w.json["exact"][s.options.bsdfs[b].name()][r.technique.name()] = {{"ratio", r.ratio}, {"worst", r.worst}};
         }
-        if (progress) progress->update((b + 1) * (nt + 1));
         out << "\n";
     }
 }
@@ -551,8 +469,8 @@ void write_allocation_sweep(std::ostream& out, const CompareArgs& args, const Se
 // map-wide choice).
 void write_pictures(std::ostream& out, const CompareArgs& args, const Setup& s) {
     std::optional<CompensatedMaps> map_wide;
-    if (s.choice) map_wide = compensated_maps(s.plain, std::vector<float>{s.map_alpha});
-    const StudyInputs inputs{s.plain, map_wide ? *map_wide : s.compensated, s.points, s.options, s.binned.get()};
+    if (s.choice) map_wide = compensated_maps(*s.plain, std::vector<float>{s.map_alpha});
+    const StudyInputs inputs{*s.plain, map_wide ? *map_wide : s.compensated, s.points, s.options, s.binned.get()};
     const auto montage = render_comparison(inputs, args.render, args.images, s.map_name, {&interrupted(), {}});
     out << "pictures: " << args.images << " (montage: " << montage.string() << ")\n";
 }
@@ -713,7 +631,6 @@ Subcommand add_compare(CLI::App& app) {
     add_sweep_flags(*sub, *args);
     add_library_flags(*sub, *args);
     add_map_flags(*sub, args->map);
-    args->alpha_flag = sub->get_option("--alpha");
     args->threads_flag = sub->get_option("--threads");
     return {sub, [args] {
                 std::error_code ec;

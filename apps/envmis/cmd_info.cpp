@@ -13,7 +13,7 @@ namespace {
 // The arguments of `envmis info`.
 struct InfoArgs {
     std::string input;
-    MapFlags map;
+    BuildRequest map;  // the map flags
 };
 
 // Rebuilds a binned table's bins (as a renderer loading it would), to check that they

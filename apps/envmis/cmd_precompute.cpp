@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <type_traits>
 #include <vector>
 
 #include "cli.h"
@@ -38,7 +39,7 @@ void print_compact_error(std::ostream& out, const EnvMap& map) {
 struct PrecomputeArgs {
     std::vector<std::string> inputs;
     std::string output, summary;
-    MapFlags map;
+    BuildRequest map;  // the map flags
     bool compact = false;
     uint32_t bins = 0;  // K = g^2 normal bins (sampling/binned.h); 0: a single density
     uint32_t cell_columns = 0;
@@ -81,7 +82,7 @@ void add_precompute_flags(CLI::App& sub, PrecomputeArgs& args) {
 
 // The request the flags make (build.h), with --bins, --cell-columns and --compact.
 BuildRequest precompute_request(const PrecomputeArgs& args) {
-    BuildRequest request = build_request(args.map);
+    BuildRequest request = args.map;
     request.bins = args.bins;
     request.cell_columns = args.cell_columns;
     request.bin_cost = args.bin_cost;
@@ -89,23 +90,28 @@ BuildRequest precompute_request(const PrecomputeArgs& args) {
     return request;
 }
 
-// What a written table's summary entry records of it.
+// What a written table's summary entry records of it: its size and options, every
+// statistic of the build (visit_stats_fields) and the times.
 nlohmann::json table_details(const LoadedMap& loaded, const EnvMap& map, double write_ms) {
-    const EnvMapStats& s = map.stats();
-    return {{"width", map.width()},
-            {"height", map.height()},
-            {"compensated", map.options().compensation.enabled},
-            {"alpha", map.options().compensation.alpha},
-            {"mean_luminance", s.mean_luminance},
-            {"max_luminance", s.max_luminance},
-            {"zeroed_texels", s.zeroed_texels},
-            {"fallback", std::string(to_string(s.fallback))},
-            {"complete", map.complete()},
-            {"bins", loaded.bins ? loaded.bins->bins_per_side * loaded.bins->bins_per_side : 0},
-            {"diffuse_bins", loaded.bins ? loaded.bins->diffuse_bins_per_side * loaded.bins->diffuse_bins_per_side : 0},
-            {"load_ms", loaded.load_ms},
-            {"build_ms", loaded.build_ms},
-            {"write_ms", write_ms}};
+    nlohmann::json details = {
+        {"width", map.width()},
+        {"height", map.height()},
+        {"compensated", map.options().compensation.enabled},
+        {"alpha", map.options().compensation.alpha},
+        {"complete", map.complete()},
+        {"bins", loaded.bins ? loaded.bins->bins_per_side * loaded.bins->bins_per_side : 0},
+        {"diffuse_bins", loaded.bins ? loaded.bins->diffuse_bins_per_side * loaded.bins->diffuse_bins_per_side : 0},
+        {"load_ms", loaded.load_ms},
+        {"build_ms", loaded.build_ms},
+        {"write_ms", write_ms}};
+    visit_stats_fields(map.stats(), [&details](const char* name, const auto& value) {
+        using Value = std::decay_t<decltype(value)>;
+        if constexpr (std::is_same_v<Value, BadPixels>)
+            details[name] = {{"nan", value.nan}, {"infinite", value.infinite}, {"negative", value.negative}};
+        else
+            details[name] = value;
+    });
+    return details;
 }
 
 // `map` is loaded.map, or the plain map of `binned` (which then holds it).

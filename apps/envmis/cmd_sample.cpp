@@ -55,7 +55,7 @@ struct SampleArgs {
     std::string input, output;
     uint64_t count = 1000;
     uint64_t seed = 1;
-    MapFlags map;
+    BuildRequest map;                            // the map flags
     std::string normal, view, lobe = "lambert";  // a binned table's shading point; normal empty: none
 };
 

@@ -36,7 +36,7 @@ std::vector<float> pdf_image(const EnvMap& map) { return pdf_image(map, map.widt
 struct VisualizeArgs {
     std::string input, output;
     uint32_t panel_width = 512;
-    MapFlags map;
+    BuildRequest map;                      // the map flags
     std::string normal, lobe = "lambert";  // normal empty: no binned panel
     uint32_t bins = 121;
 };

@@ -23,6 +23,7 @@
 #include <random>
 #include <sstream>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 
 #include "envmis/io/image_io.h"
@@ -131,33 +132,38 @@ py::dict source_dict(const TableSource& s) {
 // The source a table of the map records, its build options describing exactly what is
 // saved: for a map built here, the canonical options of its request with the table's
 // own encoding, as `envmis precompute` records them; for a map read from a table, that
-// table's options with compact= rewritten. A compact (RGBE-rounded) table saved full is
-// no build of the source, nor are options without compact= (an older table's): they
-// record none, so that precompute's library mode rebuilds them.
+// table's request with its encoding replaced. A compact (RGBE-rounded) table saved full
+// is no build of the source, nor are options in no canonical form (an older table's):
+// they record none, so that precompute's library mode rebuilds them.
 template <class T>
 TableSource saved_source(const std::shared_ptr<T>& map, bool compact) {
     Provenance provenance = provenance_of(map);
     std::string& options = provenance.source.build_options;
-    if (provenance.request) {
-        provenance.request->compact = compact;
-        options = canonical_options(*provenance.request);
+    std::optional<BuildRequest> request = provenance.request;
+    if (!request && provenance.from_table) request = parse_canonical_options(options);
+    if (request && !(provenance.from_table && provenance.compact && !compact)) {
+        request->compact = compact;
+        options = canonical_options(*request);
     } else if (provenance.from_table) {
-        constexpr std::string_view kCompact = " compact=";
-        const size_t at = options.rfind(kCompact);
-        if (at == std::string::npos || at + kCompact.size() >= options.size() || (provenance.compact && !compact))
-            options.clear();
-        else
-            options[at + kCompact.size()] = compact ? '1' : '0';
+        options.clear();
     }
     return provenance.source;
 }
 
 py::dict stats_dict(const EnvMapStats& s) {
-    py::dict bad, d;
-    bad["nan"] = s.bad_pixels.nan, bad["infinite"] = s.bad_pixels.infinite, bad["negative"] = s.bad_pixels.negative;
-    d["bad_pixels"] = bad, d["mean_luminance"] = s.mean_luminance, d["threshold"] = s.threshold;
-    d["max_luminance"] = s.max_luminance, d["min_positive_luminance"] = s.min_positive_luminance;
-    d["zeroed_texels"] = s.zeroed_texels, d["fallback"] = std::string(to_string(s.fallback));
+    py::dict d;
+    visit_stats_fields(s, [&d](const char* name, const auto& value) {
+        using Value = std::decay_t<decltype(value)>;
+        if constexpr (std::is_same_v<Value, BadPixels>) {
+            py::dict bad;
+            bad["nan"] = value.nan, bad["infinite"] = value.infinite, bad["negative"] = value.negative;
+            d[name] = bad;
+        } else if constexpr (std::is_same_v<Value, std::string_view>) {
+            d[name] = std::string(value);
+        } else {
+            d[name] = value;
+        }
+    });
     return d;
 }
 

@@ -190,7 +190,7 @@ with -comp (sampling the compensated density), 'mis-balance-all' and 'mis-optima
 }
 
 py::array_t<float> sphere_normals(const py::handle& k) {
-    const auto count = static_cast<uint32_t>(count_in_range(k, "envmis.sphere_points", "k", 1, kMaxPoints));
+    const auto count = static_cast<uint32_t>(count_in_range(k, "envmis.sphere_points", "k", 1, kMaxStudyPoints));
     const std::vector<ShadingPoint> points = sphere_points(count);
     auto out = new_float_array({static_cast<py::ssize_t>(count), 3});
     float* o = out.mutable_data();

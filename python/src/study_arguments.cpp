@@ -4,9 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
-#include <thread>
 
 #include "numpy_arrays.h"
 
@@ -15,20 +13,13 @@ namespace {
 
 std::string type_name(const py::handle& object) { return py::str(py::type::of(object).attr("__name__")); }
 
-std::vector<std::string> split(const std::string& text) {
-    std::vector<std::string> items;
-    std::stringstream in(text);
-    for (std::string item; std::getline(in, item, ',');)
-        if (!item.empty()) items.push_back(item);
-    return items;
-}
-
 // Items of a comma-separated str or of an iterable, each converted by `one`.
 template <class T, class One>
 std::vector<T> list_of(const py::handle& items, const char* where, const char* name, One one) {
     std::vector<T> result;
     if (py::isinstance<py::str>(items)) {
-        for (const std::string& item : split(items.cast<std::string>())) result.push_back(one(py::str(item), where));
+        for (const std::string& item : split_list(items.cast<std::string>()))
+            result.push_back(one(py::str(item), where));
         return result;
     }
     if (!py::isinstance<py::iterable>(items))
@@ -102,11 +93,11 @@ std::vector<ShadingPoint> shading_points(const py::handle& count, const py::hand
                                          const char* where) {
     if (normals.is_none()) {
         if (!views.is_none()) throw std::invalid_argument(std::string(where) + ": views needs normals");
-        return sphere_points(static_cast<uint32_t>(count_in_range(count, where, "points", 1, kMaxPoints)));
+        return sphere_points(static_cast<uint32_t>(count_in_range(count, where, "points", 1, kMaxStudyPoints)));
     }
     const std::vector<Vec3> n = unit_rows(float_array(normals, where, "normals", {-1, 3}), where, "normals");
-    if (n.empty() || n.size() > kMaxPoints)
-        throw std::invalid_argument(std::string(where) + ": normals must have 1 to " + std::to_string(kMaxPoints) +
+    if (n.empty() || n.size() > kMaxStudyPoints)
+        throw std::invalid_argument(std::string(where) + ": normals must have 1 to " + std::to_string(kMaxStudyPoints) +
                                     " rows; got " + std::to_string(n.size()));
     std::vector<Vec3> v = n;
     if (!views.is_none()) {
@@ -121,20 +112,17 @@ std::vector<ShadingPoint> shading_points(const py::handle& count, const py::hand
 }
 
 Allocation allocation_of(const py::handle& env_samples, const py::handle& bsdf_samples, const char* where) {
-    return {static_cast<uint32_t>(count_in_range(env_samples, where, "env_samples", 0, kMaxSamples)),
-            static_cast<uint32_t>(count_in_range(bsdf_samples, where, "bsdf_samples", 0, kMaxSamples))};
+    return {static_cast<uint32_t>(count_in_range(env_samples, where, "env_samples", 0, kMaxStudySamples)),
+            static_cast<uint32_t>(count_in_range(bsdf_samples, where, "bsdf_samples", 0, kMaxStudySamples))};
 }
 
 uint32_t worker_threads(const py::handle& threads, const char* where) {
-    const auto asked = static_cast<uint32_t>(count_in_range(threads, where, "threads", 0, kMaxThreads));
-    const uint32_t cores = std::max(1u, std::thread::hardware_concurrency());
-    if (asked == 0) return cores;
-    if (asked <= kThreadsPerCore * cores) return asked;
-    const std::string note = std::string(where) + ": threads " + std::to_string(asked) + ": more than " +
-                             std::to_string(kThreadsPerCore) + " per hardware thread (" + std::to_string(cores) +
-                             "); using " + std::to_string(kThreadsPerCore * cores);
-    if (PyErr_WarnEx(PyExc_RuntimeWarning, note.c_str(), 1) != 0) throw py::error_already_set();
-    return kThreadsPerCore * cores;
+    std::string note;
+    const uint32_t workers = envmis::worker_threads(
+        static_cast<uint32_t>(count_in_range(threads, where, "threads", 0, kMaxStudyThreads)), &note);
+    if (!note.empty() && PyErr_WarnEx(PyExc_RuntimeWarning, (std::string(where) + ": " + note).c_str(), 1) != 0)
+        throw py::error_already_set();
+    return workers;
 }
 
 }  // namespace envmis::python

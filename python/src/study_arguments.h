@@ -10,20 +10,13 @@
 #include <string>
 #include <vector>
 
-#include "envmis/study/comparison/comparison.h"
+#include "envmis/study/comparison/setup.h"
 #include "envmis/study/shading/bsdf.h"
 #include "envmis/study/techniques/estimator.h"
 
 namespace envmis::python {
 
 namespace py = pybind11;
-
-// The limits of compare's flags, so that Python refuses what the command refuses.
-inline constexpr uint32_t kMaxSamples = 65536;  // per estimate, of each kind
-inline constexpr uint32_t kMaxPoints = 1000000;
-inline constexpr uint32_t kMaxThreads = 1024;
-inline constexpr uint32_t kThreadsPerCore = 4;  // more workers than this per hardware thread only contend
-inline constexpr uint32_t kDefaultBins = 121;   // BinnedOptions{}.bins_per_side squared
 
 // A str of comma-separated names (as `--bsdf lambert,phong:50`), or an iterable of
 // names and envmis.Bsdf objects. Bsdf::parse's message for a bad name.
@@ -46,11 +39,10 @@ uint64_t count_in_range(const py::handle& value, const char* where, const char* 
 std::vector<ShadingPoint> shading_points(const py::handle& count, const py::handle& normals, const py::handle& views,
                                          const char* where);
 
-// env_samples and bsdf_samples, each 0 to kMaxSamples.
+// env_samples and bsdf_samples, each 0 to kMaxStudySamples.
 Allocation allocation_of(const py::handle& env_samples, const py::handle& bsdf_samples, const char* where);
 
-// --threads' rule: 0 is every hardware thread; more than kThreadsPerCore per hardware
-// thread is reduced to that, with a Python warning saying so.
+// worker_threads (setup.h), its note a Python RuntimeWarning.
 uint32_t worker_threads(const py::handle& threads, const char* where);
 
 }  // namespace envmis::python

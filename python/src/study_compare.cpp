@@ -12,7 +12,6 @@
 
 #include "envmis/report/inputs.h"
 #include "envmis/report/results.h"
-#include "envmis/study/comparison/alpha.h"
 #include "study_arguments.h"
 #include "study_json.h"
 #include "study_watch.h"
@@ -21,50 +20,6 @@ namespace envmis::python {
 namespace {
 
 constexpr const char* kWhere = "envmis.compare";
-
-// Everything a run is set up with, as cmd_compare.cpp's Setup.
-struct Setup {
-    const EnvMap* given = nullptr;    // the caller's map
-    std::optional<EnvMap> own_plain;  // it rebuilt without compensation, when it had some
-    std::vector<ShadingPoint> points;
-    ComparisonOptions options;
-    std::optional<AlphaChoice> choice;
-    float map_alpha = 0;
-    std::vector<float> bsdf_alphas;
-    CompensatedMaps compensated;
-    std::shared_ptr<const BinnedEnvMap> binned;
-    bool bins_auto = false;
-
-    const EnvMap& plain() const { return own_plain ? *own_plain : *given; }
-    StudyInputs inputs() const { return {plain(), compensated, points, options, binned.get()}; }
-    float alpha_of(const Bsdf& bsdf) const {
-        for (size_t b = 0; b < options.bsdfs.size(); ++b)
-            if (options.bsdfs[b].name() == bsdf.name()) return bsdf_alphas[b];
-        return map_alpha;
-    }
-};
-
-ComparisonOptions comparison_options(const CompareArguments& args) {
-    ComparisonOptions options;
-    options.bsdfs = bsdf_list(args.bsdfs, kWhere);
-    options.techniques = technique_list(args.techniques, kWhere, ComparisonOptions::default_techniques());
-    options.spp = static_cast<uint32_t>(count_in_range(args.spp, kWhere, "spp", 1, UINT32_MAX));
-    options.seed = count_in_range(args.seed, kWhere, "seed", 0, UINT64_MAX);
-    options.allocation = allocation_of(args.env_samples, args.bsdf_samples, kWhere);
-    options.threads = worker_threads(args.threads, kWhere);
-    return options;
-}
-
-// g of bins K = g * g; 0 without a -bins technique (the command's --bins rule).
-uint32_t bins_per_side(const CompareArguments& args, std::span<const Technique> techniques) {
-    const auto asked = static_cast<uint32_t>(count_in_range(args.bins, kWhere, "bins", 0, 4096));
-    const uint32_t k = asked ? asked : (uses_bins(techniques) ? kDefaultBins : 0);
-    const auto g = static_cast<uint32_t>(std::lround(std::sqrt(static_cast<double>(k))));
-    if (g * g != k || (k && g > 64))
-        throw std::invalid_argument(std::string(kWhere) + ": bins " + std::to_string(k) +
-                                    ": expected a square number g*g of normal bins, g 1 to 64 (e.g. 64, 100, 144)");
-    return uses_bins(techniques) ? g : 0;
-}
 
 // alpha: None (the command's default: the map's own strength if it is compensated, else
 // 0 for a map read from a table, which was built so, and --alpha's 1 for one built from
@@ -81,85 +36,63 @@ std::optional<float> fixed_alpha(const py::object& alpha, const EnvMap& map, boo
                                 py::repr(alpha).cast<std::string>());
 }
 
-Setup prepare(const EnvMap& map, const CompareArguments& args) {
-    Setup s;
-    s.given = &map;
-    s.options = comparison_options(args);
-    const uint32_t g = bins_per_side(args, s.options.techniques);
-    s.points = shading_points(args.points, args.normals, args.views, kWhere);
-    const std::optional<float> fixed = fixed_alpha(args.alpha, map, args.from_table);
-    s.bins_auto = !fixed || args.alpha.is_none();
-    py::gil_scoped_release release;
-    if (map.options().compensation.enabled) {
-        EnvMapOptions plain_options = map.options();
-        plain_options.compensation.enabled = false;
-        s.own_plain.emplace(to_image(map.radiance()), plain_options);
+CompareRequest compare_request(const CompareArguments& args, const EnvMap& map) {
+    CompareRequest request;
+    ComparisonOptions& options = request.options;
+    options.bsdfs = bsdf_list(args.bsdfs, kWhere);
+    options.techniques = technique_list(args.techniques, kWhere, ComparisonOptions::default_techniques());
+    options.spp = static_cast<uint32_t>(count_in_range(args.spp, kWhere, "spp", 1, UINT32_MAX));
+    options.seed = count_in_range(args.seed, kWhere, "seed", 0, UINT64_MAX);
+    options.allocation = allocation_of(args.env_samples, args.bsdf_samples, kWhere);
+    options.threads = worker_threads(args.threads, kWhere);
+    request.bins = static_cast<uint32_t>(count_in_range(args.bins, kWhere, "bins", 0, 4096));
+    try {
+        bins_per_side(request.bins, options.techniques);
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(std::string(kWhere) + ": " + e.what());
     }
-    if (!fixed) {
-        AlphaOptions search;
-        search.bsdfs = s.options.bsdfs;
-        search.points = s.points;
-        search.allocation = s.options.allocation;
-        s.choice = choose_alpha(s.plain().radiance(), s.plain().options(), search);
-    }
-    s.map_alpha = s.choice ? s.choice->alpha : *fixed;
-    s.bsdf_alphas = s.choice ? s.choice->bsdf_alphas : std::vector<float>(s.options.bsdfs.size(), s.map_alpha);
-    s.compensated = compensated_maps(s.plain(), s.bsdf_alphas);
-    if (g) {
-        BinnedOptions options;
-        options.bins_per_side = g;
-        options.auto_alpha = s.bins_auto;
-        options.alpha = fixed.value_or(1.0f);
-        s.binned = std::make_shared<const BinnedEnvMap>(EnvMap(s.plain()), options);
-    }
-    return s;
+    request.points = shading_points(args.points, args.normals, args.views, kWhere);
+    request.alpha = fixed_alpha(args.alpha, map, args.from_table);
+    // A number fixes the bins' alpha too; with None or 'auto' each bin chooses its own.
+    if (request.alpha && !args.alpha.is_none()) request.bin_alpha = request.alpha;
+    return request;
 }
 
 // compare --json's "inputs" (without the command's source_hash and options).
-py::dict inputs_dict(const Setup& s, const std::string& name, size_t points_done) {
+py::dict inputs_dict(const CompareSetup& s, const std::string& name, size_t points_done) {
     const nlohmann::json inputs =
-        inputs_json({name, s.plain().width(), s.plain().height(), s.map_alpha, s.choice ? &*s.choice : nullptr,
+        inputs_json({name, s.plain->width(), s.plain->height(), s.map_alpha, s.choice ? &*s.choice : nullptr,
                      &s.options, s.bsdf_alphas, s.binned.get(), s.bins_auto, std::span(s.points).first(points_done)});
     return to_python(inputs).cast<py::dict>();
 }
 
-// compare --exact's figures: per BSDF, each fixed-weight technique's exact variance
-// (quadrature, one subdivision) over mis-balance's, the geometric mean over points and
-// the worst point. Stops between techniques once `stop` is set (the result then unused).
-nlohmann::json exact_json(const Setup& s, const std::atomic<bool>& stop) {
-    const StudyInputs inputs = s.inputs();
-    const Technique balance = Technique::parse("mis-balance");
+// compare --exact's figures as its JSON holds them: {bsdf: {technique: {ratio, worst}}}.
+nlohmann::json exact_json(const CompareSetup& s, const std::atomic<bool>& stop) {
     nlohmann::json exact = nlohmann::json::object();
-    for (size_t b = 0; b < s.options.bsdfs.size(); ++b) {
-        const std::vector<double> baseline = exact_point_variances(inputs, balance, b, 1);
-        for (const Technique& t : s.options.techniques) {
-            if (t.adaptive() || t.mixture) continue;
-            if (stop) return exact;
-            const std::vector<double> v = exact_point_variances(inputs, t, b, 1);
-            double worst = 0;
-            for (size_t p = 0; p < v.size(); ++p)
-                if (v[p] > 0 && baseline[p] > 0) worst = std::max(worst, v[p] / baseline[p]);
-            const double mean = geometric_mean_ratios(v, baseline, 1).front();
-            exact[s.options.bsdfs[b].name()][t.name()] = {{"ratio", mean}, {"worst", worst}};
-        }
-    }
+    for (const ExactRatio& r : exact_ratios(s, {&stop, {}}))
+        exact[s.options.bsdfs[r.bsdf].name()][r.technique.name()] = {{"ratio", r.ratio}, {"worst", r.worst}};
     return exact;
 }
 
 }  // namespace
 
 ComparisonResult run_compare(const EnvMap& map, const CompareArguments& args) {
-    const Setup s = prepare(map, args);
+    CompareRequest request = compare_request(args, map);
     Watch watch;
     watch.progress = args.progress;
     struct Run {
+        CompareSetup setup;
         Comparison comparison;
         std::optional<nlohmann::json> exact;
         nlohmann::json records;
     };
+    // The caller's map is borrowed: it outlives the call, and the set-up is dropped with it.
+    const std::shared_ptr<const EnvMap> borrowed(std::shared_ptr<const EnvMap>(), &map);
     Run run = run_watched(
         [&] {
-            Run r{compare(s.inputs(), watch.control()), std::nullopt, {}};
+            Run r{prepare_compare(borrowed, std::move(request), &watch.stop), {}, std::nullopt, {}};
+            const CompareSetup& s = r.setup;
+            r.comparison = compare(s.inputs(), watch.control());
             if (args.exact && !watch.stop) r.exact = exact_json(s, watch.stop);
             r.records = stats_results_json(r.comparison, [&s](const Bsdf& b) { return s.alpha_of(b); });
             return r;
@@ -167,7 +100,7 @@ ComparisonResult run_compare(const EnvMap& map, const CompareArguments& args) {
         watch);
     ComparisonResult result{std::move(run.comparison), py::list(), py::dict(), py::none()};
     result.records = to_python(run.records).cast<py::list>();
-    result.inputs = inputs_dict(s, args.name, result.comparison.points_done);
+    result.inputs = inputs_dict(run.setup, args.name, result.comparison.points_done);
     if (run.exact) result.exact = to_python(*run.exact);
     return result;
 }

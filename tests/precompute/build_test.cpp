@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace envmis {
 namespace {
@@ -52,6 +54,39 @@ TEST(CanonicalOptions, RecordTheEffectiveAlphaNotHowItWasAskedFor) {
     EXPECT_NE(canonical_options(defaulted).find("alpha=auto"), std::string::npos);
     defaulted.compensate = false;
     EXPECT_NE(canonical_options(defaulted).find("alpha=-"), std::string::npos);
+}
+
+TEST(CanonicalOptions, ParseBackToARequestThatSpellsTheSame) {
+    std::vector<BuildRequest> requests(6);
+    requests[1].alpha = 0.1f, requests[1].compact = true;
+    requests[2].alpha_auto = true, requests[2].axes = "x,z,-y";
+    requests[3].compensate = false, requests[3].colorspace = "Utility - Linear - sRGB";
+    requests[4].bins = 121, requests[4].bin_cost = 2.5f, requests[4].cell_columns = 64;
+    requests[5].bins = 9, requests[5].alpha = 0.5f, requests[5].mapping = "equal-area";
+    for (const BuildRequest& request : requests) {
+        const std::string text = canonical_options(request);
+        const std::optional<BuildRequest> parsed = parse_canonical_options(text);
+        ASSERT_TRUE(parsed) << text;
+        EXPECT_EQ(canonical_options(*parsed), text);
+        EXPECT_EQ(parsed->compact, request.compact) << text;
+        EXPECT_EQ(parsed->colorspace, request.colorspace) << text;
+        EXPECT_EQ(parsed->bins, request.bins) << text;
+    }
+}
+
+TEST(CanonicalOptions, RefuseToParseWhatIsNotACanonicalSpelling) {
+    const std::string text = canonical_options(BuildRequest{});
+    for (const std::string& other :
+         {std::string(), std::string("compensate=1"), text + " extra=1", "x" + text,
+          std::string("compensate=1 alpha=1 mapping=equirect colorspace=(file) working-space=lin_rec709 axes=z-up "
+                      "compact=0"),  // an older table's, without bins
+          std::string("compensate=1 alpha=01 mapping=equirect colorspace=(file) working-space=lin_rec709 axes=z-up "
+                      "compact=0 bins=0 cell-columns=0"),
+          std::string("compensate=1 alpha=1 mapping=equirect colorspace=(file) working-space=lin_rec709 axes=z-up "
+                      "compact=2 bins=0 cell-columns=0"),
+          std::string("compensate=1 alpha=1 mapping=equirect colorspace=(file) working-space=lin_rec709 axes=z-up "
+                      "compact=0 bins=0 cell-columns=0 bin-cost=2")})
+        EXPECT_FALSE(parse_canonical_options(other)) << other;
 }
 
 TEST(BuildRequestChecks, SayWhatTheCommandLineSays) {

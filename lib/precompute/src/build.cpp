@@ -1,5 +1,6 @@
 #include "envmis/precompute/build.h"
 
+#include <array>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -85,6 +86,76 @@ std::string canonical_options(const BuildRequest& r) {
         text << " bin-cost=" << cost;
     }
     return text.str();
+}
+
+namespace {
+
+// canonical_options' keys in its order; the last is written only with bins.
+constexpr std::string_view kOptionKeys[] = {"compensate", "alpha",   "mapping", "colorspace",   "working-space",
+                                            "axes",       "compact", "bins",    "cell-columns", "bin-cost"};
+constexpr size_t kOptionCount = std::size(kOptionKeys);
+
+// The length of key i's "key=" at `at` (after a space unless it is the first key), or 0
+// where it is not there.
+size_t key_at(std::string_view text, size_t at, size_t i) {
+    const std::string_view rest = text.substr(std::min(at, text.size()));
+    const size_t space = i ? 1 : 0;
+    const std::string_view key = kOptionKeys[i];
+    if ((space && !rest.starts_with(' ')) || rest.substr(space, key.size()) != key ||
+        rest.substr(space + key.size(), 1) != "=")
+        return 0;
+    return space + key.size() + 1;
+}
+
+// Each key's value as `text` spells it ("key=value" separated by spaces; values may hold
+// spaces, as colour space names do), or nothing where a key is missing or out of order.
+std::optional<std::array<std::string_view, kOptionCount>> option_values(std::string_view text) {
+    std::array<std::string_view, kOptionCount> values;
+    size_t at = 0;
+    for (size_t i = 0; i < kOptionCount; ++i) {
+        if (i + 1 == kOptionCount && at == text.size()) break;
+        const size_t key = key_at(text, at, i);
+        if (key == 0) return std::nullopt;
+        at += key;
+        size_t end = at;
+        while (end < text.size() && !(i + 1 < kOptionCount && key_at(text, end, i + 1))) ++end;
+        values[i] = text.substr(at, end - at);
+        at = end;
+    }
+    return values;
+}
+
+template <class T>
+bool read_number(std::string_view text, T& value) {
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    return error == std::errc() && end == text.data() + text.size();
+}
+
+}  // namespace
+
+std::optional<BuildRequest> parse_canonical_options(std::string_view text) {
+    const auto values = option_values(text);
+    if (!values) return std::nullopt;
+    const auto& [compensate, alpha, mapping, colorspace, working_space, axes, compact, bins, cell_columns, bin_cost] =
+        *values;
+    BuildRequest r;
+    r.compensate = compensate == "1";
+    r.compact = compact == "1";
+    if (alpha == "auto") {
+        r.alpha_auto = true;
+    } else if (alpha != "-") {
+        float value = 0;
+        if (!read_number(alpha, value)) return std::nullopt;
+        r.alpha = value;
+    }
+    r.mapping = mapping;
+    r.colorspace = colorspace == "(file)" ? "" : std::string(colorspace);
+    r.working_space = working_space;
+    r.axes = axes;
+    if (!read_number(bins, r.bins) || !read_number(cell_columns, r.cell_columns)) return std::nullopt;
+    if (!bin_cost.empty() && !read_number(bin_cost, r.bin_cost)) return std::nullopt;
+    if (canonical_options(r) != text) return std::nullopt;
+    return r;
 }
 
 std::string alpha_problem(std::string_view text) {

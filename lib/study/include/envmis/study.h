@@ -5,12 +5,13 @@
 //   study/weights/     MIS weights: balance, power, optimal (solve) and variance-aware
 //   study/statistics/  running means and variances in doubles
 //   study/reference/   exact references: quadrature over the map, the textbook sampler
-//   study/comparison/  comparisons over shading points, alpha choice and sweeps
+//   study/comparison/  comparisons over shading points, their set-up, alpha choice and sweeps
 #pragma once
 
 #include "envmis/core.h"
 #include "envmis/study/comparison/alpha.h"
 #include "envmis/study/comparison/comparison.h"
+#include "envmis/study/comparison/setup.h"
 #include "envmis/study/comparison/sweeps.h"
 #include "envmis/study/reference/quadrature.h"
 #include "envmis/study/reference/textbook.h"

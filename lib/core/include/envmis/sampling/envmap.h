@@ -60,6 +60,21 @@ struct EnvMapStats {
     DensityFallback fallback = DensityFallback::none;
 };
 
+// EnvMapStats field by field, in declaration order, under the names every writer of them
+// uses (precompute's JSON summary, Python's EnvMap.stats): visit(name, value) with value
+// a const BadPixels&, a double, a float, a uint64_t or (the fallback) a std::string_view.
+// A new field added here reaches every writer.
+template <class Visit>
+void visit_stats_fields(const EnvMapStats& s, Visit&& visit) {
+    visit("bad_pixels", s.bad_pixels);
+    visit("mean_luminance", s.mean_luminance);
+    visit("threshold", s.threshold);
+    visit("max_luminance", s.max_luminance);
+    visit("min_positive_luminance", s.min_positive_luminance);
+    visit("zeroed_texels", s.zeroed_texels);
+    visit("fallback", to_string(s.fallback));
+}
+
 // One sample: a world direction, its solid-angle pdf, the radiance arriving from it and
 // its image point.
 struct EnvSample {

@@ -44,6 +44,12 @@ inline constexpr uint32_t kMaxCellColumns = 4096;
 // not how it was asked for. Under 300 bytes plus the colour space and axes names.
 std::string canonical_options(const BuildRequest& request);
 
+// The request that canonical_options spelled as `text`, or nothing where `text` is not
+// exactly such a spelling (another version's, or edited): canonical_options(*parsed) ==
+// text whenever this returns one. An alpha recorded as "auto" comes back as alpha_auto;
+// one recorded as "-" (no compensation) as none given.
+std::optional<BuildRequest> parse_canonical_options(std::string_view text);
+
 // What is wrong with a value of a flag, in the command line's words, or "" where it is
 // right. `text` is the value as written: --alpha "a number >= 0 or auto", --bins "a
 // square number g*g, g 1 to 64".
