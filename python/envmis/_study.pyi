@@ -125,6 +125,8 @@ def compare(
     env_samples: int = 1,
     bsdf_samples: int = 1,
     bins: int = 0,
+    view_angle: float = 0.0,
+    bin_cost: float = 1.2,
     exact: bool = False,
     name: Optional[str] = None,
     progress: Optional[Callable[[int, int], Any]] = None,

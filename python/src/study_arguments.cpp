@@ -90,11 +90,18 @@ uint64_t count_in_range(const py::handle& value, const char* where, const char* 
 }
 
 std::vector<ShadingPoint> shading_points(const py::handle& count, const py::handle& normals, const py::handle& views,
-                                         const char* where) {
+                                         const char* where, double view_degrees) {
     if (normals.is_none()) {
         if (!views.is_none()) throw std::invalid_argument(std::string(where) + ": views needs normals");
-        return sphere_points(static_cast<uint32_t>(count_in_range(count, where, "points", 1, kMaxStudyPoints)));
+        const auto k = static_cast<uint32_t>(count_in_range(count, where, "points", 1, kMaxStudyPoints));
+        try {
+            return sphere_points(k, view_degrees);
+        } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument(std::string(where) + ": view_angle: " + e.what());
+        }
     }
+    if (view_degrees != 0)
+        throw std::invalid_argument(std::string(where) + ": view_angle needs points, not normals (views give theirs)");
     const std::vector<Vec3> n = unit_rows(float_array(normals, where, "normals", {-1, 3}), where, "normals");
     if (n.empty() || n.size() > kMaxStudyPoints)
         throw std::invalid_argument(std::string(where) + ": normals must have 1 to " + std::to_string(kMaxStudyPoints) +

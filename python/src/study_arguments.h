@@ -35,9 +35,10 @@ uint64_t count_in_range(const py::handle& value, const char* where, const char* 
 // None, else one per row of normals (N, 3) float32, viewed from `views` (N, 3) float32
 // or head-on. Every row must be a unit vector to within 1e-3 (they are used as given,
 // not renormalised, so that sphere_points' own normals give the same estimates here as
-// in the command).
+// in the command). view_degrees tilts the views of the `count` points (sphere_points);
+// with normals it must be 0, as their views say where each is seen from.
 std::vector<ShadingPoint> shading_points(const py::handle& count, const py::handle& normals, const py::handle& views,
-                                         const char* where);
+                                         const char* where, double view_degrees = 0);
 
 // env_samples and bsdf_samples, each 0 to kMaxStudySamples.
 Allocation allocation_of(const py::handle& env_samples, const py::handle& bsdf_samples, const char* where);

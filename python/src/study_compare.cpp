@@ -51,10 +51,14 @@ CompareRequest compare_request(const CompareArguments& args, const EnvMap& map) 
     } catch (const std::invalid_argument& e) {
         throw std::invalid_argument(std::string(kWhere) + ": " + e.what());
     }
-    request.points = shading_points(args.points, args.normals, args.views, kWhere);
+    request.points = shading_points(args.points, args.normals, args.views, kWhere, args.view_angle);
     request.alpha = fixed_alpha(args.alpha, map, args.from_table);
     // A number fixes the bins' alpha too; with None or 'auto' each bin chooses its own.
     if (request.alpha && !args.alpha.is_none()) request.bin_alpha = request.alpha;
+    if (!(args.bin_cost >= 1 && args.bin_cost <= 100))
+        throw std::invalid_argument(std::string(kWhere) + ": bin_cost must be 1 to 100; got " +
+                                    std::to_string(args.bin_cost));
+    request.bin_cost = args.bin_cost;
     return request;
 }
 
@@ -168,6 +172,10 @@ alpha: the compensation strength, >= 0; 'auto' chooses it per BSDF (envmis.choos
   techniques choose theirs per bin unless alpha is a number.
 env_samples, bsdf_samples: samples per MIS estimate, 0 to 65536.
 bins: normal bins K = g*g (1 <= g <= 64) of the -bins techniques; 0: 121 where one runs.
+view_angle: degrees (0 to 89.9) between each of the `points` normals and its view, as
+  --view-angle (with normals, 0: their views say it).
+bin_cost: the bins' cost (1 to 100), as --bin-cost: a bin keeps compensation only where
+  it is predicted that much lower in variance.
 exact: also the exact, noise-free variance ratios of compare --exact (.exact).
 name: the map's name in .inputs (None: the file name envmis.load recorded). progress: None or a callable (done, total) called on
   this thread as points complete.
@@ -232,20 +240,22 @@ exact: with exact=True, {bsdf: {technique: {"ratio", "worst"}}}: exact variance 
         "compare",
         [](const py::object& map, py::object bsdfs, py::object techniques, py::object spp, py::object points,
            py::object normals, py::object views, py::object seed, py::object threads, py::object alpha,
-           py::object env_samples, py::object bsdf_samples, py::object bins, bool exact, py::object name,
-           py::object progress) {
+           py::object env_samples, py::object bsdf_samples, py::object bins, double view_angle, float bin_cost,
+           bool exact, py::object name, py::object progress) {
             if (!py::isinstance<EnvMap>(map))
                 throw py::type_error(std::string(kWhere) + ": map must be an envmis.EnvMap; got " +
                                      py::str(py::type::of(map).attr("__name__")).cast<std::string>());
-            return run_compare(map.cast<const EnvMap&>(),
-                               {bsdfs, techniques, spp, points, normals, views, seed, threads, alpha, env_samples,
-                                bsdf_samples, bins, exact, from_table(map), name_of(map, name), progress});
+            return run_compare(
+                map.cast<const EnvMap&>(),
+                {bsdfs, techniques, spp, points, normals, views, seed, threads, alpha, env_samples, bsdf_samples, bins,
+                 view_angle, bin_cost, exact, from_table(map), name_of(map, name), progress});
         },
         py::arg("map"), py::kw_only(), py::arg("bsdfs") = py::make_tuple("lambert", "phong:50", "ggx:0.1"),
         py::arg("techniques") = py::none(), py::arg("spp") = 1024, py::arg("points") = 16,
         py::arg("normals") = py::none(), py::arg("views") = py::none(), py::arg("seed") = 1, py::arg("threads") = 0,
         py::arg("alpha") = py::none(), py::arg("env_samples") = 1, py::arg("bsdf_samples") = 1, py::arg("bins") = 0,
-        py::arg("exact") = false, py::arg("name") = py::none(), py::arg("progress") = py::none(), kCompareDoc);
+        py::arg("view_angle") = 0.0, py::arg("bin_cost") = BinnedOptions{}.cost, py::arg("exact") = false,
+        py::arg("name") = py::none(), py::arg("progress") = py::none(), kCompareDoc);
 }
 
 }  // namespace envmis::python

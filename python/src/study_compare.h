@@ -16,6 +16,8 @@ namespace py = pybind11;
 // compare()'s keyword arguments as Python gave them (checked by run_compare).
 struct CompareArguments {
     py::object bsdfs, techniques, spp, points, normals, views, seed, threads, alpha, env_samples, bsdf_samples, bins;
+    double view_angle = 0;  // degrees, sphere_points
+    float bin_cost = 0;     // BinnedOptions::cost
     bool exact = false;
     bool from_table = false;  // the map was read from a table file (EnvMap.from_table)
     std::string name;

@@ -86,6 +86,19 @@ def test_compare_records_equal_the_commands_json_for_the_same_arguments_and_seed
         assert got.inputs[key] == expected["inputs"][key], key
 
 
+def test_view_angle_and_bin_cost_give_the_commands_records(env, table, tmp_path):
+    expected = cli_json(table, tmp_path, "--seed", 3, "--spp", 32, "--points", 4, "--bsdf", "lambert,phong:50",
+                        "--techniques", "mis-balance,mis-balance-bins", "--bins", 9, "--view-angle", 60,
+                        "--bin-cost", 2.5)
+    got = envmis.compare(env, bsdfs="lambert,phong:50", techniques=["mis-balance", "mis-balance-bins"], spp=32,
+                         points=4, seed=3, bins=9, view_angle=60.0, bin_cost=2.5)
+    assert [without_timings(r) for r in got.records] == [without_timings(r) for r in expected["results"]]
+    assert got.inputs["points"] == expected["inputs"]["points"]
+    head_on = envmis.compare(env, bsdfs="lambert,phong:50", techniques=["mis-balance", "mis-balance-bins"], spp=32,
+                             points=4, seed=3, bins=9)
+    assert head_on.inputs["points"] != got.inputs["points"]
+
+
 def test_an_uncompensated_table_is_compared_with_the_commands_default_alpha_of_zero(tmp_path):
     path = tmp_path / "plain.envmis"
     envmis.EnvMap(synthetic_radiance(), compensate=False).save(path)
@@ -224,6 +237,12 @@ def test_an_unknown_bsdf_or_technique_raises_the_commands_message(env, table):
     ({"bins": 10, "techniques": ["mis-balance-bins"]},
      "envmis.compare: bins 10: expected a square number g*g of normal bins, g 1 to 64 (e.g. 64, 100, 144)"),
     ({"env_samples": 0, "bsdf_samples": 0, "techniques": ["mis-balance"]}, "an estimate needs at least one sample"),
+    ({"view_angle": 90.0}, "envmis.compare: view_angle: a view angle must be 0 to 89.9 degrees, got 90.000000"),
+    ({"view_angle": float("nan")}, "envmis.compare: view_angle: a view angle must be 0 to 89.9 degrees, got nan"),
+    ({"view_angle": 10.0, "normals": np.array([[0, 0, 1]], np.float32)},
+     "envmis.compare: view_angle needs points, not normals (views give theirs)"),
+    ({"bin_cost": 0.5}, "envmis.compare: bin_cost must be 1 to 100; got 0.500000"),
+    ({"bin_cost": float("inf")}, "envmis.compare: bin_cost must be 1 to 100; got inf"),
 ])
 def test_a_count_out_of_range_is_refused_with_a_clear_message(env, arguments, message):
     with pytest.raises(ValueError) as error:
