@@ -2,7 +2,8 @@
 # builds this source tree with BUILD_SHARED_LIBS=ON and nothing but envmis::core and
 # envmis::build, installs those two components alone, then builds and runs the build and
 # core consumers against them with the third-party packages hidden, and checks that the
-# renderer's binary loads libenvmis_core's shared object and no other of envmis's.
+# renderer's binary loads libenvmis_core's shared object and no other of envmis's, which
+# exports its API and hides its private helpers.
 # Usage: cmake -DSOURCE=<repo> -DWORK=<folder> -DCONSUMER=<tests/consumer> -DCXX=<compiler>
 #        -DGENERATOR=<generator> -DCONFIG=<Release> -DREADELF=<readelf> -P shared.cmake
 foreach(variable SOURCE WORK CONSUMER CXX GENERATOR READELF)
@@ -47,3 +48,17 @@ if(NOT needed MATCHES "^libenvmis_core\\.so\\.[0-9]+\\.[0-9]+$")
   message(FATAL_ERROR "consumer_core needs [${needed}], expected libenvmis_core's shared object alone")
 endif()
 message(STATUS "consumer_core runs on ${needed}")
+
+# The runtime's shared object exports its API (envmis/core_export.h) and none of its
+# private helpers (lib/core/src): the cell grid and geometry of the bins' build, the
+# mapped file.
+file(GLOB core_object ${WORK}/prefix/lib*/libenvmis_core.so)
+execute_process(COMMAND ${READELF} --dyn-syms -W ${core_object} OUTPUT_VARIABLE symbols COMMAND_ERROR_IS_FATAL ANY)
+if(NOT symbols MATCHES "_ZN6envmis6EnvMapC[12]E")
+  message(FATAL_ERROR "${core_object} does not export EnvMap's constructors")
+endif()
+string(REGEX MATCHALL "6detail(8Geometry|8CellGrid|10MappedFile|11choose_bins|10bin_masses)" private "${symbols}")
+if(private)
+  message(FATAL_ERROR "${core_object} exports private helpers: ${private}")
+endif()
+message(STATUS "${core_object} exports EnvMap and no private helper")

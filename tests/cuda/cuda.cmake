@@ -13,7 +13,8 @@ if(ENVMIS_NVCC)
   add_custom_command(
     OUTPUT ${object}
     COMMAND ${ENVMIS_NVCC} -std=c++20 -Werror all-warnings -ccbin ${CMAKE_CXX_COMPILER}
-            -I${PROJECT_SOURCE_DIR}/lib/core/include -I${PROJECT_SOURCE_DIR}/lib/study/include -c ${CMAKE_CURRENT_LIST_DIR}/device_compile.cu -o ${object}
+            -I${PROJECT_SOURCE_DIR}/lib/core/include -I${PROJECT_BINARY_DIR}/lib/core/include
+            -I${PROJECT_SOURCE_DIR}/lib/study/include -c ${CMAKE_CURRENT_LIST_DIR}/device_compile.cu -o ${object}
     DEPENDS ${CMAKE_CURRENT_LIST_DIR}/device_compile.cu ${envmis_device_headers}
     COMMENT "Compiling the sampling path as CUDA device code (nvcc)")
   add_custom_target(envmis_cuda_compile_check ALL DEPENDS ${object})

@@ -12,12 +12,14 @@
 #include <string>
 #include <string_view>
 
+#include "envmis/core_export.h"
+
 namespace envmis {
 
 // How a batch kernel runs: one lane at a time, software-pipelined with prefetches
 // (scalar), or eight lanes at a time in AVX2 with hardware gathers (avx2).
 enum class BatchPath : uint8_t { scalar, avx2 };
-std::string_view to_string(BatchPath p) noexcept;
+ENVMIS_CORE_API std::string_view to_string(BatchPath p) noexcept;
 
 // What cpuid says, and what of it the operating system lets a program use.
 struct CpuInfo {
@@ -27,9 +29,9 @@ struct CpuInfo {
     bool avx2 = false;               // AVX2 present and its registers saved by the OS
     bool avx512 = false;             // AVX-512 F, BW, DQ and VL likewise (no kernel uses it: see below)
 };
-const CpuInfo& cpu_info() noexcept;
+ENVMIS_CORE_API const CpuInfo& cpu_info() noexcept;
 // "<brand> (<vendor> family and model in hex, AVX2, AVX-512)": for benchmark output.
-std::string cpu_name();
+ENVMIS_CORE_API std::string cpu_name();
 
 // The path of each kernel family; `forced` is ENVMIS_SIMD's value (empty when unset),
 // `unavailable` true when it names a path this CPU or build lacks, which then runs
@@ -49,10 +51,10 @@ struct BatchPaths {
 // - the estimator's lanes (arithmetic, no gathers of their own) wherever AVX2 is usable.
 // No AVX-512 path: much of the kernels' time goes to gathers, and a 16-lane gather of
 // eight 64-bit pairs was slower than the two 8-lane AVX2 gathers of the same pairs.
-BatchPaths choose_batch_paths(const CpuInfo& cpu, std::string_view forced);
+ENVMIS_CORE_API BatchPaths choose_batch_paths(const CpuInfo& cpu, std::string_view forced);
 // choose_batch_paths(cpu_info(), ENVMIS_SIMD), once.
-const BatchPaths& batch_paths() noexcept;
+ENVMIS_CORE_API const BatchPaths& batch_paths() noexcept;
 // "lookup_many=scalar sample_many=scalar lanes=avx2" (and the forcing, if any).
-std::string batch_paths_summary();
+ENVMIS_CORE_API std::string batch_paths_summary();
 
 }  // namespace envmis

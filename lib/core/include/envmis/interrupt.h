@@ -13,6 +13,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "envmis/core_export.h"
+
 namespace envmis {
 
 // A flag to watch, or null. The flag must outlive the call that watches it.
@@ -20,7 +22,7 @@ using StopFlag = const std::atomic<bool>*;
 
 // What a build throws when its StopFlag was set. what() is "interrupted" unless the
 // thrower says what the interruption left (e.g. which results are partial).
-class Interrupted : public std::runtime_error {
+class ENVMIS_CORE_API Interrupted : public std::runtime_error {
 public:
     Interrupted() : std::runtime_error("interrupted") {}
     explicit Interrupted(const std::string& what) : std::runtime_error(what) {}

@@ -26,6 +26,8 @@
 #include <span>
 #include <vector>
 
+#include "envmis/build_export.h"
+
 namespace envmis {
 
 // Throws std::runtime_error naming `destination` where it cannot be written as a regular
@@ -33,7 +35,7 @@ namespace envmis {
 // not a regular file: refusing to replace it"): a symbolic link (not followed, whatever
 // it points to), a directory, a character or block device, a FIFO or a socket. Does
 // nothing where it is a regular file or does not exist.
-void check_destination(const std::filesystem::path& destination);
+ENVMIS_BUILD_API void check_destination(const std::filesystem::path& destination);
 
 // Removes the stale temporaries of `destination` (names of either pattern above, for this
 // destination only): those whose process id names no running process, and those without
@@ -42,9 +44,10 @@ void check_destination(const std::filesystem::path& destination);
 // its stale file until that process ends. Process ids are this machine's: on a folder
 // shared between machines, another machine's live writer can look dead. Returns the
 // paths removed; a file that cannot be removed is skipped. Never throws.
-std::vector<std::filesystem::path> remove_stale_temporaries(const std::filesystem::path& destination) noexcept;
+ENVMIS_BUILD_API std::vector<std::filesystem::path> remove_stale_temporaries(
+    const std::filesystem::path& destination) noexcept;
 
-class AtomicFile {
+class ENVMIS_BUILD_API AtomicFile {
 public:
     // Checks the destination (check_destination), removes its stale temporaries
     // (remove_stale_temporaries) and creates the temporary. Throws std::runtime_error
@@ -75,6 +78,7 @@ private:
 // failed write ends `write` with an exception (the stream's badbit is an exception), so
 // that a full disk does not cost the rest of the work. Throws std::runtime_error naming
 // the file if it cannot be created or written.
-void write_file_atomically(const std::filesystem::path& destination, const std::function<void(std::ostream&)>& write);
+ENVMIS_BUILD_API void write_file_atomically(const std::filesystem::path& destination,
+                                            const std::function<void(std::ostream&)>& write);
 
 }  // namespace envmis

@@ -20,6 +20,7 @@
 #include <array>
 #include <cstdint>
 
+#include "envmis/build_export.h"
 #include "envmis/image/image.h"
 #include "envmis/image/mapping.h"
 #include "envmis/interrupt.h"
@@ -27,11 +28,11 @@
 namespace envmis {
 
 // Exact solid angle of the texels of row y of a w x h image under mapping m.
-double texel_solid_angle(Mapping m, uint32_t y, uint32_t w, uint32_t h) noexcept;
+ENVMIS_BUILD_API double texel_solid_angle(Mapping m, uint32_t y, uint32_t w, uint32_t h) noexcept;
 
 // Total power of an image, sum of radiance times texel solid angle, per channel
 // (NaN, infinite and negative values count as 0).
-std::array<double, 3> total_power(const RgbImage& image, Mapping m);
+ENVMIS_BUILD_API std::array<double, 3> total_power(const RgbImage& image, Mapping m);
 
 struct RemapResult {
     RgbImage image;
@@ -44,7 +45,7 @@ struct RemapResult {
 // sub-samples where the input texels are largest (s from 2 to 16). Throws std::invalid_argument for an empty or
 // inconsistent image, a zero or too large output size, or a non-square equal-area size;
 // Interrupted once `stop` is set (interrupt.h; checked every input row).
-RemapResult remap(const RgbImage& in, Mapping from, Mapping to, uint32_t width, uint32_t height,
-                  uint32_t supersampling = 0, StopFlag stop = nullptr);
+ENVMIS_BUILD_API RemapResult remap(const RgbImage& in, Mapping from, Mapping to, uint32_t width, uint32_t height,
+                                   uint32_t supersampling = 0, StopFlag stop = nullptr);
 
 }  // namespace envmis

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 
+#include "envmis/build_export.h"
 #include "envmis/interrupt.h"
 #include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"
@@ -28,17 +29,18 @@ enum class TableEncoding { full, compact };
 // I/O failure and where the destination exists and is not a regular file, and
 // Interrupted once `stop` is set (interrupt.h; checked every few rows written), leaving
 // no file.
-void write_table(const std::filesystem::path& path, const EnvMap& map, const TableSource& source,
-                 TableEncoding encoding = TableEncoding::full, StopFlag stop = nullptr);
+ENVMIS_BUILD_API void write_table(const std::filesystem::path& path, const EnvMap& map, const TableSource& source,
+                                  TableEncoding encoding = TableEncoding::full, StopFlag stop = nullptr);
 
 // A binned map: its plain map (as the overload above writes it) and its BinLayout, from
 // which the reader rebuilds the bins bit-identically. A compact table holds the
 // RGBE-rounded plain map and loads as BinnedEnvMap(EnvMap(rgbe_round(radiance),
 // options), layout).
-void write_table(const std::filesystem::path& path, const BinnedEnvMap& binned, const TableSource& source,
-                 TableEncoding encoding = TableEncoding::full, StopFlag stop = nullptr);
+ENVMIS_BUILD_API void write_table(const std::filesystem::path& path, const BinnedEnvMap& binned,
+                                  const TableSource& source, TableEncoding encoding = TableEncoding::full,
+                                  StopFlag stop = nullptr);
 
 // The radiance a compact table stores: each pixel rounded to RGBE and back.
-RgbImage rgbe_round(RgbImageView image);
+ENVMIS_BUILD_API RgbImage rgbe_round(RgbImageView image);
 
 }  // namespace envmis

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <span>
 
+#include "envmis/core_export.h"
 #include "envmis/image/mapping.h"
 #include "envmis/math/math.h"
 
@@ -24,11 +25,12 @@ struct CompensationOptions {
 };
 
 // Solid-angle-weighted mean of a w x h row-major luminance image (double sums).
-double solid_angle_mean(std::span<const float> luminance, uint32_t w, uint32_t h, Mapping mapping = Mapping::equirect);
+ENVMIS_CORE_API double solid_angle_mean(std::span<const float> luminance, uint32_t w, uint32_t h,
+                                        Mapping mapping = Mapping::equirect);
 
 // The same mean from the row sums (sum over x of L(x, y)) of a w-wide image.
-double solid_angle_mean_of_rows(std::span<const double> row_sums, uint32_t w,
-                                Mapping mapping = Mapping::equirect) noexcept;
+ENVMIS_CORE_API double solid_angle_mean_of_rows(std::span<const double> row_sums, uint32_t w,
+                                                Mapping mapping = Mapping::equirect) noexcept;
 
 // The threshold alpha * Lbar, rounded to float once so that every texel is compared
 // with the same value: a texel is zeroed exactly when L <= threshold.

@@ -25,6 +25,7 @@
 #include <string>
 #include <string_view>
 
+#include "envmis/core_export.h"
 #include "envmis/math/fast_math.h"
 #include "envmis/math/math.h"
 
@@ -32,7 +33,7 @@ namespace envmis {
 
 // A signed permutation of the axes: world component i = sign(code[i]) * canonical
 // component |code[i]| - 1. {1, 2, 3} is the identity (z up); {1, 3, -2} is y up.
-struct Axes {
+struct ENVMIS_CORE_API Axes {
     int8_t code[3] = {1, 2, 3};
 
     // Parses "x,y,z", "x,z,-y", ... or the presets "z-up" and "y-up".
@@ -86,9 +87,9 @@ ENVMIS_HD inline Vec2 equirect_uv(Vec3 d) noexcept {
 }
 
 enum class Mapping : uint32_t { equirect = 1, equal_area = 2 };
-std::string_view to_string(Mapping m) noexcept;  // "equirect", "equal-area"
+ENVMIS_CORE_API std::string_view to_string(Mapping m) noexcept;  // "equirect", "equal-area"
 // Reads the names to_string gives. Throws std::invalid_argument naming the text.
-Mapping parse_mapping(std::string_view text);
+ENVMIS_CORE_API Mapping parse_mapping(std::string_view text);
 
 inline constexpr float kFourPi = 4 * kPiF;
 

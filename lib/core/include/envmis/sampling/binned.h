@@ -87,6 +87,7 @@
 #include <span>
 #include <vector>
 
+#include "envmis/core_export.h"
 #include "envmis/sampling/envmap.h"
 
 namespace envmis {
@@ -179,7 +180,7 @@ inline Vec3 folded_octahedral_normal(float s, float t) noexcept {
 // Lobe classes: 0 is diffuse (Lambert); a positive exponent is a Phong lobe that sharp.
 // The class of a BSDF with Phong exponent e among `exponents` (ascending, the first 0):
 // the nearest on the scale log(1 + e). Lambert has e = 0; GGX, see ggx_lobe_exponent.
-uint32_t lobe_class(std::span<const float> exponents, float phong_exponent) noexcept;
+ENVMIS_CORE_API uint32_t lobe_class(std::span<const float> exponents, float phong_exponent) noexcept;
 
 // The Phong exponent whose lobe of reflected directions is as wide as GGX's with
 // roughness a: (2 / a^2 - 2) / 4. The usual 2 / a^2 - 2 matches the distribution of
@@ -386,12 +387,12 @@ struct BinnedEnvMapView {
 // Both for n (axis, choice, direction or point) at once, one array per world coordinate:
 // the batch forms of BinnedEnvMapView::lookup and sample, bit-identical to n single
 // calls. Host only; noexcept and allocation-free.
-void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axes, const float* choices,
-                 DirectionArrays in, LookupArrays out, uint32_t n) noexcept;
-void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axes, const float* choices, PointArrays in,
-                 SampleArrays out, uint32_t n) noexcept;
+ENVMIS_CORE_API void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axes, const float* choices,
+                                 DirectionArrays in, LookupArrays out, uint32_t n) noexcept;
+ENVMIS_CORE_API void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axes, const float* choices,
+                                 PointArrays in, SampleArrays out, uint32_t n) noexcept;
 
-class BinnedEnvMap {
+class ENVMIS_CORE_API BinnedEnvMap {
 public:
     BinnedEnvMap() = default;
     // Builds the bins over `plain`, which must be uncompensated (its density is the

@@ -25,6 +25,7 @@
 #include <span>
 #include <vector>
 
+#include "envmis/core_export.h"
 #include "envmis/large_vector.h"
 #include "envmis/math/math.h"
 #include "envmis/sampling/cdf.h"
@@ -171,7 +172,7 @@ struct CdfView : CdfTable {
 namespace detail {
 
 // The uniform CDF over n cells: what build_cdf gives a function without a positive value.
-struct UniformCdf {
+struct ENVMIS_CORE_API UniformCdf {
     std::vector<uint32_t> start;
     std::vector<uint16_t> guide;
 
@@ -194,8 +195,8 @@ struct CdfScratch {
 // the number of negative, NaN or infinite values to `invalid` (the caller rejects them).
 // A zero function gets a uniform CDF.
 template <class T>
-double build_cdf(const T* func, uint32_t n, uint32_t* start, uint16_t* guide, uint32_t& invalid,
-                 CdfScratch& scratch) noexcept;
+ENVMIS_CORE_API double build_cdf(const T* func, uint32_t n, uint32_t* start, uint16_t* guide, uint32_t& invalid,
+                                 CdfScratch& scratch) noexcept;
 
 }  // namespace detail
 
@@ -226,7 +227,7 @@ struct Distribution1DView {
 };
 
 // A piecewise-constant distribution over [0,1) with func.size() cells.
-class Distribution1D {
+class ENVMIS_CORE_API Distribution1D {
 public:
     Distribution1D() = default;
     // Throws std::invalid_argument if func is empty, has more than 65536 cells, or holds
@@ -307,7 +308,7 @@ struct Distribution2DView : Cdf2DTable {
 };
 
 // A piecewise-constant distribution over [0,1)^2 from a w x h row-major function.
-class Distribution2D {
+class ENVMIS_CORE_API Distribution2D {
 public:
     // Fills `row` (w values) with the function on row y; called once per row, from
     // several threads at a time for different rows.

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "envmis/compensation/compensation.h"
+#include "envmis/core_export.h"
 #include "envmis/image/image.h"
 #include "envmis/image/mapping.h"
 #include "envmis/interrupt.h"
@@ -40,7 +41,7 @@ enum class DensityFallback : uint32_t {
     uncompensated = 1,  // compensation zeroed every texel (a constant map): plain luminance used
     uniform = 2,        // the map is black: uniform over the sphere
 };
-std::string_view to_string(DensityFallback f) noexcept;
+ENVMIS_CORE_API std::string_view to_string(DensityFallback f) noexcept;
 
 struct EnvMapOptions {
     CompensationOptions compensation;     // enabled by default, alpha = 1
@@ -194,7 +195,7 @@ struct DirectionArrays {
 struct LookupArrays {
     float *r, *g, *b, *pdf;
 };
-void lookup_many(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept;
+ENVMIS_CORE_API void lookup_many(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept;
 
 // EnvMapView::sample for n random points at once, likewise: the points' two coordinates
 // in [0,1) in, one array each; direction, solid-angle pdf and radiance out, and the
@@ -208,15 +209,15 @@ struct SampleArrays {
     float *x, *y, *z, *pdf, *r, *g, *b;
     float *u = nullptr, *v = nullptr;  // optional: the image point's two coordinates
 };
-void sample_many(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t n) noexcept;
+ENVMIS_CORE_API void sample_many(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t n) noexcept;
 
 // Row y (of h) of the image-space density that a map with these options and stats
 // samples, q(x, y) w_y, from that row's radiance (row.size() values): what
 // EnvMap::density() holds, for code that rebuilds a map's density without the map.
-void density_row(std::span<const Rgb> radiance_row, uint32_t y, uint32_t h, const EnvMapOptions& options,
-                 const EnvMapStats& stats, std::span<float> out);
+ENVMIS_CORE_API void density_row(std::span<const Rgb> radiance_row, uint32_t y, uint32_t h,
+                                 const EnvMapOptions& options, const EnvMapStats& stats, std::span<float> out);
 
-class EnvMap {
+class ENVMIS_CORE_API EnvMap {
 public:
     EnvMap() = default;
     // Builds the sampler from a radiance image, repairing bad pixels (counted in

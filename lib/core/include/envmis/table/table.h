@@ -22,6 +22,7 @@
 #include <string>
 #include <string_view>
 
+#include "envmis/core_export.h"
 #include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"
 
@@ -59,7 +60,7 @@ struct Table {
 };
 
 // A table file that cannot be read; what() names the file and the problem.
-class TableError : public std::runtime_error {
+class ENVMIS_CORE_API TableError : public std::runtime_error {
 public:
     using std::runtime_error::runtime_error;
 };
@@ -78,7 +79,7 @@ enum class TableLoading { map, copy };
 
 // Reads and verifies a table. Throws TableError if the file is missing, truncated,
 // corrupted (checksums), of another format, or of an unsupported version.
-Table read_table(const std::filesystem::path& path, TableLoading loading = TableLoading::map);
+ENVMIS_CORE_API Table read_table(const std::filesystem::path& path, TableLoading loading = TableLoading::map);
 
 // What a table's header says, without its payload.
 struct TableHeader {
@@ -95,17 +96,17 @@ struct TableHeader {
 // checksum, and the file's size against the sizes they give (at most 64 KiB read,
 // whatever the table's size). Throws TableError as read_table does for those parts; a
 // payload or bins section that is corrupted is found only by read_table.
-TableHeader read_table_header(const std::filesystem::path& path);
+ENVMIS_CORE_API TableHeader read_table_header(const std::filesystem::path& path);
 
 // The same checks on bytes already in memory; `name` appears in error messages.
-Table parse_table(std::span<const std::byte> bytes, std::string_view name);
+ENVMIS_CORE_API Table parse_table(std::span<const std::byte> bytes, std::string_view name);
 
 // Moves the table's map into the BinnedEnvMap its bins describe. Throws TableError,
 // naming the table, if it has no bins or they do not fit its map.
-BinnedEnvMap binned_map(Table&& table);
+ENVMIS_CORE_API BinnedEnvMap binned_map(Table&& table);
 
 // True if the file is a regular file that starts with the table magic (cheap; does not
 // validate the rest).
-bool looks_like_table(const std::filesystem::path& path) noexcept;
+ENVMIS_CORE_API bool looks_like_table(const std::filesystem::path& path) noexcept;
 
 }  // namespace envmis
