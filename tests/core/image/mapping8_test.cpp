@@ -1,5 +1,7 @@
-// The AVX2 mappings of the batch calls (lib/core/src/detail/mapping8.h) against the scalar
-// functions of mapping.h, lane by lane and bit for bit. The batch tests of envmap_test
+// The mappings and angles of mapping.h and fast_math.h on eight AVX2 lanes (the lane
+// types of lib/common/detail/simd.h, as the batch calls use them) against the same
+// functions on one float, lane by lane and bit for bit: the lane types' operators must
+// give float's IEEE results, at signed zeros, NaN and clamps included. The batch tests of envmap_test
 // compare whole lookups, whose radiance and pdf are constant over a texel: an inverse
 // mapping off by an ulp, or wrong only at z = -0 or |z| > 1, passes them. Here the image
 // points and directions themselves are compared, on the inputs where the branches and
@@ -11,8 +13,9 @@
 #include <limits>
 #include <vector>
 
-#include "detail/mapping8.h"
+#include "detail/simd.h"
 #include "envmis/cpu.h"
+#include "envmis/image/mapping.h"
 #include "stats.h"
 
 #ifdef ENVMIS_AVX2_BATCHES
@@ -75,7 +78,7 @@ std::vector<Vec2> hard_points() {
     return p;
 }
 
-ENVMIS_AVX2 simd::F8 load8(const std::vector<float>& v, size_t l) { return _mm256_loadu_ps(v.data() + l); }
+ENVMIS_AVX2 simd::F8 load8(const std::vector<float>& v, size_t l) { return simd::load(v.data() + l); }
 
 // The three coordinates of directions as arrays, padded to a whole number of lanes.
 struct Coords {
@@ -84,7 +87,7 @@ struct Coords {
         for (const Vec3 v : d) x.push_back(v.x), y.push_back(v.y), z.push_back(v.z);
         x.resize(x.size() + 8), y.resize(y.size() + 8), z.resize(z.size() + 8);
     }
-    ENVMIS_AVX2 simd::Vec8 at(size_t l) const { return {load8(x, l), load8(y, l), load8(z, l)}; }
+    ENVMIS_AVX2 simd::Vec3x8 at(size_t l) const { return {load8(x, l), load8(y, l), load8(z, l)}; }
 };
 
 // f(eight lanes) for every direction, as Vec3s.
@@ -93,7 +96,7 @@ ENVMIS_AVX2 std::vector<Vec3> per_lane(const std::vector<Vec3>& d, F&& f) {
     const Coords c(d);
     std::vector<Vec3> out(d.size() + 8);
     for (size_t l = 0; l < d.size(); l += 8) {
-        const simd::Vec8 r = f(c.at(l));
+        const simd::Vec3x8 r = f(c.at(l));
         alignas(32) float x[8], y[8], z[8];
         _mm256_store_ps(x, r.x), _mm256_store_ps(y, r.y), _mm256_store_ps(z, r.z);
         for (int k = 0; k < 8; ++k) out[l + k] = {x[k], y[k], z[k]};
@@ -120,9 +123,9 @@ protected:
 TEST_F(Mapping8, ImagePointsOfDirectionsAreTheScalarOnesInBothMappings) {
     const std::vector<Vec3> d = hard_directions();
     for (const Mapping m : {Mapping::equirect, Mapping::equal_area}) {
-        const auto got = per_lane(d, [m](const simd::Vec8& v) ENVMIS_AVX2 {
-            const simd::Uv8 p = m == Mapping::equal_area ? simd::equal_area_uv8(v) : simd::equirect_uv8(v);
-            return simd::Vec8{p.u, p.v, _mm256_setzero_ps()};
+        const auto got = per_lane(d, [m](const simd::Vec3x8& v) ENVMIS_AVX2 {
+            const simd::Vec2x8 p = m == Mapping::equal_area ? equal_area_uv<simd::F8>(v) : equirect_uv<simd::F8>(v);
+            return simd::Vec3x8{p.x, p.y, 0.0f};
         });
         for (size_t i = 0; i < d.size(); ++i) {
             const Vec2 expected = image_uv(m, d[i]);
@@ -134,8 +137,9 @@ TEST_F(Mapping8, ImagePointsOfDirectionsAreTheScalarOnesInBothMappings) {
 TEST_F(Mapping8, EqualAreaDirectionsOfImagePointsAreTheScalarOnes) {
     std::vector<Vec3> points;  // (u, v, unused)
     for (const Vec2 p : hard_points()) points.push_back({p.x, p.y, 0.0f});
-    const auto got =
-        per_lane(points, [](const simd::Vec8& v) ENVMIS_AVX2 { return simd::equal_area_direction8(v.x, v.y); });
+    const auto got = per_lane(points, [](const simd::Vec3x8& v) ENVMIS_AVX2 {
+        return equal_area_direction<simd::F8>({v.x, v.y});
+    });
     for (size_t i = 0; i < points.size(); ++i)
         ASSERT_TRUE(same_bits(got[i], equal_area_direction({points[i].x, points[i].y}), points[i]));
 }
@@ -152,9 +156,9 @@ TEST_F(Mapping8, EveryAxesPermutationMovesComponentsAsTheScalarCode) {
                                      static_cast<int8_t>(signs & 4 ? -c : c)}};
                     ++permutations;
                     const auto world =
-                        per_lane(d, [&](const simd::Vec8& v) ENVMIS_AVX2 { return simd::to_world8(axes, v); });
+                        per_lane(d, [&](const simd::Vec3x8& v) ENVMIS_AVX2 { return to_world<simd::F8>(axes, v); });
                     const auto canonical =
-                        per_lane(d, [&](const simd::Vec8& v) ENVMIS_AVX2 { return simd::to_canonical8(axes, v); });
+                        per_lane(d, [&](const simd::Vec3x8& v) ENVMIS_AVX2 { return to_canonical<simd::F8>(axes, v); });
                     for (size_t i = 0; i < d.size(); i += 7) {
                         ASSERT_TRUE(same_bits(world[i], to_world(axes, d[i]), d[i])) << axes.to_string();
                         ASSERT_TRUE(same_bits(canonical[i], to_canonical(axes, d[i]), d[i])) << axes.to_string();
@@ -167,11 +171,32 @@ TEST_F(Mapping8, EveryAxesPermutationMovesComponentsAsTheScalarCode) {
 TEST_F(Mapping8, ArctangentsAreTheScalarOnesOnSpecialAndRandomPairs) {
     std::vector<Vec3> pairs;  // (y, x, unused)
     for (const Vec3 v : hard_directions()) pairs.push_back({v.x, v.y, 0.0f}), pairs.push_back({v.z, v.x, 0.0f});
-    const auto got = per_lane(pairs, [](const simd::Vec8& v) ENVMIS_AVX2 {
-        return simd::Vec8{simd::atan2_8(v.x, v.y), _mm256_setzero_ps(), _mm256_setzero_ps()};
+    const auto got = per_lane(pairs, [](const simd::Vec3x8& v) ENVMIS_AVX2 {
+        return simd::Vec3x8{fast_atan2(v.x, v.y), 0.0f, 0.0f};
     });
     for (size_t i = 0; i < pairs.size(); ++i)
         ASSERT_TRUE(same_bits(got[i], {fast_atan2(pairs[i].x, pairs[i].y), 0.0f, 0.0f}, pairs[i]));
+}
+
+TEST_F(Mapping8, SinesCosinesAndPowersAreTheScalarOnes) {
+    const std::vector<SinCos> turns = make_turn_table();
+    std::vector<Vec3> inputs;  // (angle or turn, base, exponent)
+    for (const Vec3 v : hard_directions()) inputs.push_back({8 * v.x, std::abs(v.y), 50 * std::abs(v.z)});
+    const auto sincos = per_lane(inputs, [](const simd::Vec3x8& v) ENVMIS_AVX2 {
+        const simd::SinCos8 s = fast_sincos(v.x);
+        return simd::Vec3x8{s.sin, s.cos, fast_pow(v.y, v.z)};
+    });
+    const auto turned = per_lane(inputs, [&](const simd::Vec3x8& v) ENVMIS_AVX2 {
+        const simd::SinCos8 t = sincos_turns(turns.data(), v.x), h = sincos_half_turns(turns.data(), v.y);
+        return simd::Vec3x8{t.sin, t.cos, h.sin + h.cos};
+    });
+    for (size_t i = 0; i < inputs.size(); ++i) {
+        const Vec3 v = inputs[i];
+        const SinCos s = fast_sincos(v.x), t = sincos_turns(turns.data(), v.x),
+                     h = sincos_half_turns(turns.data(), v.y);
+        ASSERT_TRUE(same_bits(sincos[i], {s.sin, s.cos, fast_pow(v.y, v.z)}, v));
+        ASSERT_TRUE(same_bits(turned[i], {t.sin, t.cos, h.sin + h.cos}, v));
+    }
 }
 
 }  // namespace

@@ -30,10 +30,10 @@ TEST(FastMath, Atan2Within4e7EverywhereIncludingAxes) {
         }
     }
     EXPECT_LT(worst, 4e-7);  // 1.5 float ulps at pi
-    EXPECT_EQ(fast_atan2(0, 0), 0.0f);
-    EXPECT_FLOAT_EQ(fast_atan2(1, 0), kPiF / 2);
-    EXPECT_FLOAT_EQ(fast_atan2(0, -1), kPiF);
-    EXPECT_FLOAT_EQ(fast_atan2(-1, 0), -kPiF / 2);
+    EXPECT_EQ(fast_atan2(0.0f, 0.0f), 0.0f);
+    EXPECT_FLOAT_EQ(fast_atan2(1.0f, 0.0f), kPiF / 2);
+    EXPECT_FLOAT_EQ(fast_atan2(0.0f, -1.0f), kPiF);
+    EXPECT_FLOAT_EQ(fast_atan2(-1.0f, 0.0f), -kPiF / 2);
 }
 
 TEST(FastMath, TurnTableSinCosWithin1e7OverTheTurnAndBeyond) {
@@ -82,11 +82,11 @@ TEST(FastMath, PowWithinItsBoundOnTheUnitIntervalAndExactAtItsFixedPoints) {
             worst = std::max(worst, std::abs(fast_pow(x, y) - exact) / exact / (1.5e-7 + 1.5e-7 * std::abs(t)));
         }
     EXPECT_LT(worst, 1.0);
-    EXPECT_EQ(fast_pow(0.3f, 0), 1.0f);
-    EXPECT_EQ(fast_pow(1, 1e5f), 1.0f);
-    EXPECT_EQ(fast_pow(0, 0.5f), 0.0f);
-    EXPECT_EQ(fast_pow(0.5f, 200), 0.0f);  // 2^-200: below 2^-126
-    EXPECT_EQ(fast_pow(0.5f, 3), 0.125f);
+    EXPECT_EQ(fast_pow(0.3f, 0.0f), 1.0f);
+    EXPECT_EQ(fast_pow(1.0f, 1e5f), 1.0f);
+    EXPECT_EQ(fast_pow(0.0f, 0.5f), 0.0f);
+    EXPECT_EQ(fast_pow(0.5f, 200.0f), 0.0f);  // 2^-200: below 2^-126
+    EXPECT_EQ(fast_pow(0.5f, 3.0f), 0.125f);
 }
 
 }  // namespace

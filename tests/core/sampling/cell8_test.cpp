@@ -32,8 +32,8 @@ ENVMIS_AVX2 std::vector<float> points8(const Lanes& lanes, uint32_t n) {
     std::vector<float> offset = lanes.offset, out(index.size() + 8);
     index.resize(index.size() + 8), offset.resize(offset.size() + 8);
     for (size_t l = 0; l < lanes.index.size(); l += 8) {
-        const simd::I8 i = _mm256_loadu_si256(reinterpret_cast<const simd::I8*>(index.data() + l));
-        _mm256_storeu_ps(out.data() + l, simd::point_in_cell8(i, _mm256_loadu_ps(offset.data() + l), n));
+        simd::store(out.data() + l,
+                    simd::point_in_cell8(simd::load(index.data() + l), simd::load(offset.data() + l), n));
     }
     out.resize(lanes.index.size());
     return out;

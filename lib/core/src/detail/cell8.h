@@ -13,7 +13,7 @@ namespace envmis::simd {
 
 // detail::cell_of: the product in double, truncated, at most n - 1.
 ENVMIS_AVX2 inline I8 cell8(F8 x, uint32_t n) noexcept {
-    const F8 c = clamp8(x, 0.0f, 1.0f);
+    const F8 c = clamp(x, 0.0f, 1.0f);
     const __m256d dn = _mm256_set1_pd(static_cast<double>(n));
     const __m128i lo = _mm256_cvttpd_epi32(_mm256_mul_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(c)), dn));
     const __m128i hi = _mm256_cvttpd_epi32(_mm256_mul_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(c, 1)), dn));
@@ -39,13 +39,11 @@ ENVMIS_AVX2 inline __m128 quotient4(__m128i index, __m128 offset, uint32_t n) no
 
 // detail::point_in_cell, both of its cases.
 ENVMIS_AVX2 inline F8 point_in_cell8(I8 index, F8 offset, uint32_t n) noexcept {
-    const F8 i = _mm256_cvtepi32_ps(index);
+    const F8 i = to_float(index);
     if ((n & (n - 1)) == 0) {
-        const F8 inv_n = splat(1.0f / static_cast<float>(n));
-        const F8 x = _mm256_add_ps(_mm256_mul_ps(i, inv_n), _mm256_mul_ps(offset, inv_n));
-        const F8 next_edge = _mm256_mul_ps(_mm256_add_ps(i, splat(1.0f)), inv_n);
-        const F8 below = _mm256_castsi256_ps(_mm256_sub_epi32(_mm256_castps_si256(next_edge), _mm256_set1_epi32(1)));
-        return select(less(x, next_edge), x, below);
+        const float inv_n = 1.0f / static_cast<float>(n);
+        const F8 x = i * inv_n + offset * inv_n, next_edge = (i + 1.0f) * inv_n;
+        return select(x < next_edge, x, from_bits(to_bits(next_edge) - 1u));
     }
     const F8 x = _mm256_set_m128(quotient4(_mm256_extracti128_si256(index, 1), _mm256_extractf128_ps(offset, 1), n),
                                  quotient4(_mm256_castsi256_si128(index), _mm256_castps256_ps128(offset), n));
@@ -53,7 +51,7 @@ ENVMIS_AVX2 inline F8 point_in_cell8(I8 index, F8 offset, uint32_t n) noexcept {
     // x < 1 in the second, so the step is an increment of its bits).
     const I8 c = cell8(x, n);
     const I8 step = _mm256_sub_epi32(_mm256_cmpgt_epi32(index, c), _mm256_cmpgt_epi32(c, index));
-    return clamp8(_mm256_castsi256_ps(_mm256_sub_epi32(_mm256_castps_si256(x), step)), 0.0f, kOneMinusEpsilon);
+    return clamp(from_bits(to_bits(x) - step), 0.0f, kOneMinusEpsilon);
 }
 
 }  // namespace envmis::simd

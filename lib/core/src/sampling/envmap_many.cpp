@@ -4,22 +4,19 @@
 // The scalar paths call the single calls' own functions, split into the stages of
 // detail/pipeline.h: bit-identical to the single calls by construction.
 //
-// The AVX2 paths (eight lanes at a time, hardware gathers) repeat the scalar arithmetic
-// operation for operation (detail::cell_of, CdfView::width and invert,
-// detail::point_in_cell, Distribution2DView::pdf_of, sincos_turns, sincos_half_turns,
-// solid_angle_pdf, and the mappings of detail/mapping8.h): the same IEEE operations in
-// the same order, no fused multiply-add, so every lane's result is bit-identical to the
-// scalar call (tests/core/sampling/envmap_test.cpp checks it on maps of several sizes, in
-// both mappings and several axes, at the poles, the seam and the last column, on every
-// path the CPU has). If one of those functions changes, this file must change with it;
-// the tests fail until it does. GCC 12's auto-vectoriser does not vectorise the scalar
-// loops in a target("avx2") function (docs/performance-log.md), hence the intrinsics.
+// The AVX2 paths (eight lanes at a time, hardware gathers) map, turn angles and convert
+// densities with the single calls' own functions, instantiated on eight lanes
+// (detail/simd.h). What they write apart is the CDF search by gathers (span8, unit8,
+// search8: CdfView::width and invert, Distribution2DView::pdf_of) and the placement
+// (detail/cell8.h): the same IEEE operations in the same order as the scalar code, so
+// every lane's result is bit-identical to the scalar call (tests/core/sampling/
+// envmap_test.cpp checks it on maps of several sizes, in both mappings and several axes,
+// at the poles, the seam and the last column, on every path the CPU has).
 #include "envmis/sampling/envmap.h"
 
 #include <algorithm>
 
 #include "detail/cell8.h"
-#include "detail/mapping8.h"
 #include "detail/pipeline.h"
 #include "detail/simd.h"
 #include "envmis/cpu.h"
@@ -95,29 +92,6 @@ bool avx2_applies(const EnvMapView& env) noexcept {
     return uint64_t{env.distribution.w} * env.distribution.h * 3 < (uint64_t{1} << 31);
 }
 
-ENVMIS_AVX2 I8 gather(const uint32_t* a, I8 i) noexcept {
-    return _mm256_i32gather_epi32(reinterpret_cast<const int*>(a), i, 4);
-}
-
-// a[i] and a[i + 1] in eight lanes, from two gathers of 64-bit pairs: a gather's cost
-// grows with its elements, so two values a lane come cheaper as pairs (measured:
-// docs/performance-log.md, 'gather_pairs').
-struct Pair8 {
-    I8 first, second;
-};
-// The eight lanes of a0 a1 a4 a5 | a2 a3 a6 a7 (64-bit pairs of 32-bit values) in order.
-ENVMIS_AVX2 I8 lanes_in_order(__m256 v) noexcept {
-    return _mm256_castpd_si256(_mm256_permute4x64_pd(_mm256_castps_pd(v), _MM_SHUFFLE(3, 1, 2, 0)));
-}
-ENVMIS_AVX2 Pair8 gather_pairs(const void* a, I8 i) noexcept {
-    const auto* q = static_cast<const long long*>(a);
-    // lo holds a0 b0 a1 b1 | a2 b2 a3 b3 and hi a4 b4 ... a7 b7 (b: the second values).
-    const __m256 lo = _mm256_castsi256_ps(_mm256_i32gather_epi64(q, _mm256_castsi256_si128(i), 4));
-    const __m256 hi = _mm256_castsi256_ps(_mm256_i32gather_epi64(q, _mm256_extracti128_si256(i, 1), 4));
-    return {lanes_in_order(_mm256_shuffle_ps(lo, hi, _MM_SHUFFLE(2, 0, 2, 0))),
-            lanes_in_order(_mm256_shuffle_ps(lo, hi, _MM_SHUFFLE(3, 1, 3, 1)))};
-}
-
 // Cell i of the CDF at `start`, n cells: its first unit and CdfView::width, the next
 // start (kCdfUnits after the last cell) minus this one; for n >= 2 one pair gather at
 // j = min(i, n - 2), which stays inside the table (the last cell's start is then the
@@ -126,76 +100,38 @@ struct Span8 {
     I8 start, width;
 };
 ENVMIS_AVX2 Span8 span8(const uint32_t* start, I8 base, I8 i, uint32_t n) noexcept {
-    const I8 units = _mm256_set1_epi32(static_cast<int>(kCdfUnits));
     if (n == 1) {  // i = 0
         const I8 first = gather(start, base);
-        return {first, _mm256_sub_epi32(units, first)};
+        return {first, I8(kCdfUnits) - first};
     }
-    const I8 j = _mm256_min_epu32(i, _mm256_set1_epi32(static_cast<int>(n - 2)));
-    const Pair8 p = gather_pairs(start, _mm256_add_epi32(base, j));
-    const I8 inside = _mm256_cmpeq_epi32(i, j);  // not the last cell
-    const I8 first = _mm256_blendv_epi8(p.second, p.first, inside);
-    const I8 end = _mm256_blendv_epi8(units, p.second, inside);
-    return {first, _mm256_sub_epi32(end, first)};
+    const I8 j = _mm256_min_epu32(i, I8(n - 2));
+    const Pair8 p = gather_pairs(start, base + j);
+    const M8 inside = i == j;  // not the last cell
+    const I8 first = select(inside, p.first, p.second);
+    return {first, select(inside, p.second, I8(kCdfUnits)) - first};
 }
 
 // Widths to float, as static_cast<float>(uint32_t): a width is at most 2^31, which as a
 // signed 32-bit value is -2^31 and converts exactly; adding 2^32 then gives 2^31.
 ENVMIS_AVX2 F8 width_to_float(I8 w) noexcept {
-    const F8 f = _mm256_cvtepi32_ps(w);
-    return _mm256_add_ps(f, select(less(f, splat(0.0f)), splat(0x1p32f), splat(0.0f)));
-}
-
-// detail::sincos_steps (fast_math.h): sin and cos of 2 pi x / kTurnSteps.
-struct SinCos8 {
-    F8 sin, cos;
-};
-ENVMIS_AVX2 SinCos8 sincos_steps8(const SinCos* turns, F8 x) noexcept {
-    constexpr float kRound = 0x1.8p23f;
-    constexpr float c = 2 * kPiF / kTurnSteps;
-    const F8 rounded = _mm256_add_ps(x, splat(kRound));
-    const F8 f = _mm256_sub_ps(x, _mm256_sub_ps(rounded, splat(kRound))), f2 = _mm256_mul_ps(f, f);
-    const F8 sin_d =
-        _mm256_sub_ps(_mm256_mul_ps(splat(c), f), _mm256_mul_ps(f2, _mm256_mul_ps(splat(c * c * c / 6), f)));
-    const F8 cos_d = _mm256_sub_ps(splat(1.0f), _mm256_mul_ps(splat(c * c / 2), f2));
-    const I8 k =
-        _mm256_slli_epi32(_mm256_and_si256(_mm256_castps_si256(rounded), _mm256_set1_epi32(kTurnSteps - 1)), 1);
-    const Pair8 entry = gather_pairs(turns, k);
-    const F8 s = _mm256_castsi256_ps(entry.first), co = _mm256_castsi256_ps(entry.second);
-    return {_mm256_add_ps(_mm256_mul_ps(s, cos_d), _mm256_mul_ps(co, sin_d)),
-            _mm256_sub_ps(_mm256_mul_ps(co, cos_d), _mm256_mul_ps(s, sin_d))};
-}
-// sincos_turns and sincos_half_turns.
-ENVMIS_AVX2 SinCos8 sincos_turns8(const SinCos* turns, F8 t) noexcept {
-    return sincos_steps8(turns, _mm256_mul_ps(t, splat(static_cast<float>(kTurnSteps))));
-}
-ENVMIS_AVX2 SinCos8 sincos_half_turns8(const SinCos* turns, F8 t) noexcept {
-    return sincos_steps8(turns, _mm256_mul_ps(t, splat(static_cast<float>(kTurnSteps / 2))));
+    const F8 f = to_float(w);
+    return f + select(f < 0.0f, 0x1p32f, 0.0f);
 }
 
 // Distribution2DView::pdf_of: a cell's image-space density from its row's and its own
 // widths.
 ENVMIS_AVX2 F8 image_pdf8(const Distribution2DView& d, I8 row_width, I8 cell_width) noexcept {
-    return _mm256_mul_ps(_mm256_mul_ps(width_to_float(row_width), width_to_float(cell_width)), splat(d.pdf_scale));
+    return width_to_float(row_width) * width_to_float(cell_width) * d.pdf_scale;
 }
-
-// EnvMapView::solid_angle_pdf.
-ENVMIS_AVX2 F8 solid_angle_pdf8(F8 image_pdf, F8 sin_theta) noexcept {
-    const F8 pdf = _mm256_div_ps(image_pdf, _mm256_mul_ps(splat(kTwoPiSquared), sin_theta));
-    return select(_mm256_cmp_ps(sin_theta, splat(0.0f), _CMP_GT_OQ), pdf, splat(0.0f));
-}
-
-// The equal-area solid-angle pdf (EnvMapView::at_equal_area, image_to_solid_angle).
-ENVMIS_AVX2 F8 equal_area_pdf8(F8 image_pdf) noexcept { return _mm256_mul_ps(image_pdf, splat(1 / kFourPi)); }
 
 // The radiance of eight texels (row-major indices), stored from lane l on.
 ENVMIS_AVX2 void store_radiance8(const Rgb* radiance, I8 texel, float* r, float* g, float* b, uint32_t l) noexcept {
-    const I8 three = _mm256_add_epi32(texel, _mm256_add_epi32(texel, texel));
+    const I8 three = texel + texel + texel;
     const float* rgb = &radiance->r;
     const Pair8 rg = gather_pairs(rgb, three);
-    _mm256_storeu_ps(r + l, _mm256_castsi256_ps(rg.first));
-    _mm256_storeu_ps(g + l, _mm256_castsi256_ps(rg.second));
-    _mm256_storeu_ps(b + l, _mm256_i32gather_ps(rgb + 2, three, 4));
+    store(r + l, from_bits(rg.first));
+    store(g + l, from_bits(rg.second));
+    store(b + l, _mm256_i32gather_ps(rgb + 2, three, 4));
 }
 
 // Where eight directions fall: their cells, the first texel of their rows (y w) and
@@ -212,27 +148,28 @@ struct Cells8 {
 // groups of eight had a lane whose line nobody had asked for (measured:
 // docs/performance-log.md, 'locate8').
 ENVMIS_AVX2 Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l) noexcept {
-    const Vec8 d =
-        to_canonical8(env.axes, {_mm256_loadu_ps(in.x + l), _mm256_loadu_ps(in.y + l), _mm256_loadu_ps(in.z + l)});
-    const Uv8 p = env.mapping == Mapping::equal_area ? equal_area_uv8(d) : equirect_uv8(d);
-    const I8 x = cell8(p.u, env.distribution.w), y = cell8(p.v, env.distribution.h);
+    const Vec3x8 d = to_canonical<F8>(env.axes, {load(in.x + l), load(in.y + l), load(in.z + l)});
+    const Vec2x8 p = env.mapping == Mapping::equal_area ? equal_area_uv<F8>(d) : equirect_uv<F8>(d);
+    const I8 x = cell8(p.x, env.distribution.w), y = cell8(p.y, env.distribution.h);
     alignas(32) uint32_t column[8], row[8];
-    _mm256_store_si256(reinterpret_cast<I8*>(column), x);
-    _mm256_store_si256(reinterpret_cast<I8*>(row), y);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(column), x);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(row), y);
     for (int lane = 0; lane < 8; ++lane) env.prefetch_cell(column[lane], row[lane]);
-    return {x, y, _mm256_mullo_epi32(y, _mm256_set1_epi32(static_cast<int>(env.distribution.w))), p.v};
+    return {x, y, y * I8(env.distribution.w), p.y};
+}
+
+// The solid-angle pdf at image row v for an image-space density (image_to_solid_angle).
+ENVMIS_AVX2 F8 solid_angle_pdf8(const EnvMapView& env, F8 image_pdf, F8 v) noexcept {
+    if (env.mapping == Mapping::equal_area) return image_pdf * (1 / kFourPi);
+    return EnvMapView::solid_angle_pdf(image_pdf, sincos_half_turns(env.turns, v).sin);
 }
 
 // Radiance and solid-angle pdf at eight located directions, stored from lane l on.
 ENVMIS_AVX2 void fetch8(const EnvMapView& env, const Cells8& c, LookupArrays out, uint32_t l) noexcept {
     const Distribution2DView& d = env.distribution;
-    store_radiance8(env.radiance, _mm256_add_epi32(c.row, c.x), out.r, out.g, out.b, l);
-    const I8 row_width = span8(d.marginal.start, _mm256_setzero_si256(), c.y, d.h).width;
-    const F8 image_pdf = image_pdf8(d, row_width, span8(d.start, c.row, c.x, d.w).width);
-    const F8 pdf = env.mapping == Mapping::equal_area
-                       ? equal_area_pdf8(image_pdf)
-                       : solid_angle_pdf8(image_pdf, sincos_half_turns8(env.turns, c.v).sin);
-    _mm256_storeu_ps(out.pdf + l, pdf);
+    store_radiance8(env.radiance, c.row + c.x, out.r, out.g, out.b, l);
+    const I8 row_width = span8(d.marginal.start, I8(0u), c.y, d.h).width;
+    store(out.pdf + l, solid_angle_pdf8(env, image_pdf8(d, row_width, span8(d.start, c.row, c.x, d.w).width), c.v));
 }
 
 // Lanes [0, n - n % 8) in groups of eight, up to four groups at a time: start(first)
@@ -266,14 +203,13 @@ struct Unit8 {
     I8 t, k;
 };
 ENVMIS_AVX2 Unit8 unit8(F8 u, uint32_t n) noexcept {
-    const F8 inside = min8(u, splat(kOneMinusEpsilon));  // unit_point
-    const F8 point = select(_mm256_cmp_ps(u, splat(0.0f), _CMP_GT_OQ), inside, splat(0.0f));
-    const F8 x = _mm256_mul_ps(point, splat(static_cast<float>(kCdfUnits)));
-    const I8 t = _mm256_cvttps_epi32(x);  // x < 2^31
-    const I8 nn = _mm256_set1_epi32(static_cast<int>(n));
+    // unit_point, in CDF units; x < 2^31, so truncate's signed conversion is exact.
+    const F8 x = select(u > 0.0f, min(u, kOneMinusEpsilon), 0.0f) * static_cast<float>(kCdfUnits);
+    const I8 t = truncate(x);
+    const I8 nn(n);
     const I8 even = _mm256_srli_epi64(_mm256_mul_epu32(t, nn), 31);
     const I8 odd = _mm256_slli_epi64(_mm256_srli_epi64(_mm256_mul_epu32(_mm256_srli_epi64(t, 32), nn), 31), 32);
-    return {x, t, _mm256_min_epu32(_mm256_blend_epi32(even, odd, 0xAA), _mm256_set1_epi32(static_cast<int>(n - 1)))};
+    return {x, t, _mm256_min_epu32(_mm256_blend_epi32(even, odd, 0xAA), I8(n - 1))};
 }
 
 // The rest of CdfView::invert for eight units, lane i searching the CDF of n >= 2 cells
@@ -285,32 +221,27 @@ struct Hit8 {
 };
 ENVMIS_AVX2 Hit8 search8(const uint32_t* start, const uint16_t* guide, I8 base, uint32_t n,
                          const Unit8& unit) noexcept {
-    const F8 x = unit.x;
-    const I8 t = unit.t, k = unit.k, last = _mm256_set1_epi32(static_cast<int>(n - 1));
+    const I8 t = unit.t, k = unit.k;
     // guide[k] and guide[k + 1] (or n - 1 after the last bucket) from one 32-bit gather of
     // the pair at j = min(k, n - 2), which stays inside the guide's n entries.
-    const I8 j = _mm256_min_epu32(k, _mm256_set1_epi32(static_cast<int>(n - 2)));
-    const I8 pair = _mm256_i32gather_epi32(reinterpret_cast<const int*>(guide), _mm256_add_epi32(base, j), 2);
-    const I8 inside = _mm256_cmpeq_epi32(k, j), low = _mm256_and_si256(pair, _mm256_set1_epi32(0xffff));
-    const I8 high = _mm256_srli_epi32(pair, 16);
-    I8 lo = _mm256_blendv_epi8(high, low, inside), hi = _mm256_blendv_epi8(last, high, inside);
+    const I8 j = _mm256_min_epu32(k, I8(n - 2));
+    const I8 pair = _mm256_i32gather_epi32(reinterpret_cast<const int*>(guide), base + j, 2);
+    const M8 inside = k == j;
+    I8 lo = select(inside, pair & 0xffffu, pair >> 16), hi = select(inside, pair >> 16, I8(n - 1));
     // The scalar search, all lanes in step: a lane whose lo = hi keeps them (mid = lo,
     // whose start is <= t), so the loop runs until the longest search ends.
-    const I8 one = _mm256_set1_epi32(1);
     for (;;) {
         const I8 open = _mm256_cmpgt_epi32(hi, lo);
         if (_mm256_testz_si256(open, open)) break;
-        const I8 mid = _mm256_srli_epi32(_mm256_add_epi32(_mm256_add_epi32(lo, hi), one), 1);
-        const I8 s = gather(start, _mm256_add_epi32(base, mid));
-        const I8 at_most_t = _mm256_cmpeq_epi32(_mm256_max_epu32(s, t), t);  // unsigned s <= t
-        lo = _mm256_blendv_epi8(lo, mid, at_most_t);
-        hi = _mm256_blendv_epi8(_mm256_sub_epi32(mid, one), hi, at_most_t);
+        const I8 mid = (lo + hi + 1u) >> 1;
+        const M8 at_most_t = I8(_mm256_max_epu32(gather(start, base + mid), t)) == t;  // unsigned start <= t
+        lo = select(at_most_t, mid, lo);
+        hi = select(at_most_t, hi, mid - 1u);
     }
     const Span8 cell = span8(start, base, lo, n);
-    const I8 before = _mm256_sub_epi32(t, cell.start);  // < 2^31
-    const F8 offset = _mm256_div_ps(_mm256_add_ps(_mm256_cvtepi32_ps(before), _mm256_sub_ps(x, _mm256_cvtepi32_ps(t))),
-                                    width_to_float(cell.width));
-    return {lo, min8(offset, splat(kOneMinusEpsilon)), cell.width};
+    const F8 offset =
+        (to_float(t - cell.start) + (unit.x - to_float(t))) / width_to_float(cell.width);  // t - start < 2^31
+    return {lo, min(offset, kOneMinusEpsilon), cell.width};
 }
 
 // Eight points of EnvMapView::sample with their rows found (the marginal is small and
@@ -326,16 +257,13 @@ struct Rows8 {
 // (Distribution2DView::hot_row_units).
 ENVMIS_AVX2 Rows8 rows8(const EnvMapView& env, PointArrays in, uint32_t l, uint32_t hot_units) noexcept {
     const Distribution2DView& d = env.distribution;
-    const I8 zero = _mm256_setzero_si256();
-    const Hit8 r = search8(d.marginal.start, d.marginal.guide, zero, d.h, unit8(_mm256_loadu_ps(in.y + l), d.h));
-    const Rows8 rows{r, _mm256_mullo_epi32(r.index, _mm256_set1_epi32(static_cast<int>(d.w))),
-                     unit8(_mm256_loadu_ps(in.x + l), d.w)};
+    const Hit8 r = search8(d.marginal.start, d.marginal.guide, I8(0u), d.h, unit8(load(in.y + l), d.h));
+    const Rows8 rows{r, r.index * I8(d.w), unit8(load(in.x + l), d.w)};
     alignas(32) uint32_t y[8], t[8];
-    _mm256_store_si256(reinterpret_cast<I8*>(y), r.index);
-    _mm256_store_si256(reinterpret_cast<I8*>(t), rows.column.t);
-    const I8 cap = _mm256_set1_epi32(static_cast<int>(hot_units));
-    const I8 cold = _mm256_cmpeq_epi32(_mm256_min_epu32(r.width, cap), r.width);  // unsigned width <= cap
-    for (auto m = static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(cold))); m != 0; m &= m - 1) {
+    _mm256_store_si256(reinterpret_cast<__m256i*>(y), r.index);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(t), rows.column.t);
+    const M8 cold = I8(_mm256_min_epu32(r.width, I8(hot_units))) == r.width;  // unsigned width <= hot_units
+    for (auto m = static_cast<uint32_t>(_mm256_movemask_ps(cold.v)); m != 0; m &= m - 1) {
         const int lane = __builtin_ctz(m);
         prefetch_column(env, y[lane], t[lane]);
     }
@@ -345,32 +273,31 @@ ENVMIS_AVX2 Rows8 rows8(const EnvMapView& env, PointArrays in, uint32_t l, uint3
 // EnvMapView::at for eight image points with their image-space density: the direction
 // and its solid-angle pdf.
 struct Direction8 {
-    Vec8 d;
+    Vec3x8 d;
     F8 pdf;
 };
-ENVMIS_AVX2 Direction8 at8(const EnvMapView& env, F8 u, F8 v, F8 image_pdf) noexcept {
+ENVMIS_AVX2 Direction8 at8(const EnvMapView& env, Vec2x8 p, F8 image_pdf) noexcept {
     if (env.mapping == Mapping::equal_area)
-        return {to_world8(env.axes, equal_area_direction8(u, v)), equal_area_pdf8(image_pdf)};
-    const SinCos8 theta = sincos_half_turns8(env.turns, v), phi = sincos_turns8(env.turns, u);
-    const Vec8 canonical{_mm256_mul_ps(theta.sin, phi.cos), _mm256_mul_ps(theta.sin, phi.sin), theta.cos};
-    return {to_world8(env.axes, canonical), solid_angle_pdf8(image_pdf, theta.sin)};
+        return {to_world<F8>(env.axes, equal_area_direction<F8>(p)), image_pdf * (1 / kFourPi)};
+    const SinCos8 theta = sincos_half_turns(env.turns, p.y), phi = sincos_turns(env.turns, p.x);
+    const Vec3x8 canonical{theta.sin * phi.cos, theta.sin * phi.sin, theta.cos};
+    return {to_world<F8>(env.axes, canonical), EnvMapView::solid_angle_pdf(image_pdf, theta.sin)};
 }
 
 // EnvMapView::sample for the eight points from lane l on, their rows found.
 ENVMIS_AVX2 void sample8(const EnvMapView& env, const Rows8& rows, SampleArrays out, uint32_t l) noexcept {
     const Distribution2DView& d = env.distribution;
     const Hit8& r = rows.r;
-    const I8 row = rows.row;
-    const Hit8 c = search8(d.start, d.guide, row, d.w, rows.column);
-    const F8 u = point_in_cell8(c.index, c.offset, d.w), v = point_in_cell8(r.index, r.offset, d.h);
-    const Direction8 e = at8(env, u, v, image_pdf8(d, r.width, c.width));
-    if (out.u) _mm256_storeu_ps(out.u + l, u);
-    if (out.v) _mm256_storeu_ps(out.v + l, v);
-    _mm256_storeu_ps(out.x + l, e.d.x);
-    _mm256_storeu_ps(out.y + l, e.d.y);
-    _mm256_storeu_ps(out.z + l, e.d.z);
-    _mm256_storeu_ps(out.pdf + l, e.pdf);
-    store_radiance8(env.radiance, _mm256_add_epi32(row, c.index), out.r, out.g, out.b, l);
+    const Hit8 c = search8(d.start, d.guide, rows.row, d.w, rows.column);
+    const Vec2x8 p{point_in_cell8(c.index, c.offset, d.w), point_in_cell8(r.index, r.offset, d.h)};
+    const Direction8 e = at8(env, p, image_pdf8(d, r.width, c.width));
+    if (out.u) store(out.u + l, p.x);
+    if (out.v) store(out.v + l, p.y);
+    store(out.x + l, e.d.x);
+    store(out.y + l, e.d.y);
+    store(out.z + l, e.d.z);
+    store(out.pdf + l, e.pdf);
+    store_radiance8(env.radiance, rows.row + c.index, out.r, out.g, out.b, l);
 }
 
 // Rows found and columns' data prefetched for up to four groups before the first

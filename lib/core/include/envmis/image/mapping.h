@@ -45,22 +45,26 @@ struct ENVMIS_CORE_API Axes {
     friend bool operator==(const Axes&, const Axes&) = default;
 };
 
-ENVMIS_HD inline float axis_component(Vec3 v, int8_t code) noexcept {
-    const float c = v[(code < 0 ? -code : code) - 1];
+// On one float or eight lanes (math.h's lane types), as the mappings below.
+template <class F = float>
+ENVMIS_HD ENVMIS_INLINE F axis_component(const Vec3Of<F>& v, int8_t code) noexcept {
+    const F c = v[(code < 0 ? -code : code) - 1];
     return code < 0 ? -c : c;
 }
 
 // Both return early for the default frame, which most renderers use: the general
 // permutation takes some thirty instructions and three branches per call.
-ENVMIS_HD inline Vec3 to_world(const Axes& a, Vec3 canonical) noexcept {
+template <class F = float>
+ENVMIS_HD ENVMIS_INLINE Vec3Of<F> to_world(const Axes& a, const Vec3Of<F>& canonical) noexcept {
     if (a.identity()) return canonical;
-    return {axis_component(canonical, a.code[0]), axis_component(canonical, a.code[1]),
-            axis_component(canonical, a.code[2])};
+    return {axis_component<F>(canonical, a.code[0]), axis_component<F>(canonical, a.code[1]),
+            axis_component<F>(canonical, a.code[2])};
 }
 
-ENVMIS_HD inline Vec3 to_canonical(const Axes& a, Vec3 world) noexcept {
+template <class F = float>
+ENVMIS_HD ENVMIS_INLINE Vec3Of<F> to_canonical(const Axes& a, const Vec3Of<F>& world) noexcept {
     if (a.identity()) return world;
-    float c[3] = {0, 0, 0};
+    F c[3] = {world.x, world.y, world.z};
     for (int i = 0; i < 3; ++i) {
         const int8_t code = a.code[i];
         c[(code < 0 ? -code : code) - 1] = code < 0 ? -world[i] : world[i];
@@ -77,12 +81,13 @@ ENVMIS_HD inline Vec3 equirect_direction(Vec2 uv, float* sin_theta = nullptr) no
 }
 
 // Image point of a canonical unit direction; the inverse of equirect_direction.
-ENVMIS_HD inline Vec2 equirect_uv(Vec3 d) noexcept {
-    const float z = clamp(d.z, -1.0f, 1.0f);
-    const float theta = fast_atan2(std::sqrt(max(0.0f, (1 - z) * (1 + z))), z);
-    const float phi = fast_atan2(d.y, d.x);
+template <class F = float>
+ENVMIS_HD ENVMIS_INLINE Vec2Of<F> equirect_uv(const Vec3Of<F>& d) noexcept {
+    const F z = clamp(d.z, -1.0f, 1.0f);
+    const F theta = fast_atan2(sqrt_of(max(0.0f, (1.0f - z) * (1.0f + z))), z);
+    const F phi = fast_atan2(d.y, d.x);
     constexpr float kInvPi = static_cast<float>(1 / kPi);
-    const float u = 0.5f * kInvPi * (phi < 0 ? phi + 2 * kPiF : phi);
+    const F u = 0.5f * kInvPi * select(phi < 0.0f, phi + 2 * kPiF, phi);
     return {clamp(u, 0.0f, kOneMinusEpsilon), clamp(theta * kInvPi, 0.0f, kOneMinusEpsilon)};
 }
 
@@ -105,37 +110,34 @@ inline constexpr float kFourPi = 4 * kPiF;
 // split in two halves that run side by side (Estrin's scheme, in a^2 and a^4), pi/4
 // scales the numerator before the division, and 1/sqrt 2 goes inside the root, which
 // leaves fewer operations in a row after the division and the root.
-ENVMIS_HD inline Vec3 equal_area_direction(Vec2 uv) noexcept {
-    const float u = 2 * uv.x - 1, v = 2 * uv.y - 1, au = std::abs(u), av = std::abs(v);
+template <class F = float>
+ENVMIS_HD ENVMIS_INLINE Vec3Of<F> equal_area_direction(const Vec2Of<F>& uv) noexcept {
+    const F u = 2.0f * uv.x - 1.0f, v = 2.0f * uv.y - 1.0f, au = abs_of(u), av = abs_of(v);
     // Signed distance from the diamond |u| + |v| = 1 (the equator); r is the distance
     // from the nearer pole, measured along the square.
-    const float signed_distance = 1 - (au + av), r = 1 - std::abs(signed_distance);
-    const float a = r == 0 ? 0.0f : ((av - au) * (kPiF / 4)) / r;
-    const float a2 = a * a, a3 = a2 * a, a4 = a2 * a2;
-    const float sin_a = a3 * ((8.3321608736e-3f * a2 - 1.6666654611e-1f) + a4 * -1.9515295891e-4f) + a;
-    const float cos_a =
-        a4 * ((-1.388731625493765e-3f * a2 + 4.166664568298827e-2f) + a4 * 2.443315711809948e-5f) + (1 - 0.5f * a2);
-    const float z = std::copysign(1 - r * r, signed_distance);
-    const float s = r * std::sqrt(1 - (0.5f * r) * r);  // r sqrt(2 - r^2) / sqrt 2; the root's argument is >= 1/2
-    return {std::copysign(cos_a - sin_a, u) * s, std::copysign(cos_a + sin_a, v) * s, z};
+    const F signed_distance = 1.0f - (au + av), r = 1.0f - abs_of(signed_distance);
+    const F a = select(r == 0.0f, 0.0f, ((av - au) * (kPiF / 4)) / r);
+    const F a2 = a * a, a3 = a2 * a, a4 = a2 * a2;
+    const F sin_a = a3 * ((8.3321608736e-3f * a2 - 1.6666654611e-1f) + a4 * -1.9515295891e-4f) + a;
+    const F cos_a =
+        a4 * ((-1.388731625493765e-3f * a2 + 4.166664568298827e-2f) + a4 * 2.443315711809948e-5f) + (1.0f - 0.5f * a2);
+    const F z = copysign_of(1.0f - r * r, signed_distance);
+    const F s = r * sqrt_of(1.0f - (0.5f * r) * r);  // r sqrt(2 - r^2) / sqrt 2; the root's argument is >= 1/2
+    return {copysign_of(cos_a - sin_a, u) * s, copysign_of(cos_a + sin_a, v) * s, z};
 }
 
 // Point of an equal-area square for a canonical unit direction; the inverse of
 // equal_area_direction.
-ENVMIS_HD inline Vec2 equal_area_uv(Vec3 d) noexcept {
-    const float ax = std::abs(d.x), ay = std::abs(d.y), az = min(std::abs(d.z), 1.0f);
-    const float r = std::sqrt(1 - az);
+template <class F = float>
+ENVMIS_HD ENVMIS_INLINE Vec2Of<F> equal_area_uv(const Vec3Of<F>& d) noexcept {
+    const F r = sqrt_of(1.0f - min(abs_of(d.z), 1.0f));
     // The angle within the quadrant, as a fraction of a quarter turn.
-    const float t = fast_atan2(ay, ax) * static_cast<float>(2 / kPi);
-    float v = t * r, u = r - v;
-    if (d.z < 0) {
-        const float old_u = u;
-        u = 1 - v;
-        v = 1 - old_u;
-    }
-    u = std::copysign(u, d.x);
-    v = std::copysign(v, d.y);
-    return {clamp(0.5f * (u + 1), 0.0f, kOneMinusEpsilon), clamp(0.5f * (v + 1), 0.0f, kOneMinusEpsilon)};
+    const F t = fast_atan2(abs_of(d.y), abs_of(d.x)) * static_cast<float>(2 / kPi);
+    const F north_v = t * r, north_u = r - north_v;
+    const auto south = d.z < 0.0f;  // mirrored across the equator
+    const F u = copysign_of(select(south, 1.0f - north_v, north_u), d.x);
+    const F v = copysign_of(select(south, 1.0f - north_u, north_v), d.y);
+    return {clamp(0.5f * (u + 1.0f), 0.0f, kOneMinusEpsilon), clamp(0.5f * (v + 1.0f), 0.0f, kOneMinusEpsilon)};
 }
 
 // sin(theta) at the centre of image row y of h: the row's weight in every

@@ -18,46 +18,49 @@ struct SinCos {
     float sin = 0, cos = 1;
 };
 
-ENVMIS_HD inline SinCos fast_sincos(float x) noexcept {
-    const float sign = x < 0 ? -1.0f : 1.0f;
-    x = std::abs(x);
+// On one float or eight lanes (math.h's lane types), as everything below but
+// make_turn_table.
+template <class F>
+ENVMIS_HD ENVMIS_INLINE SinCosOf<F> fast_sincos(F x) noexcept {
+    const F sign = select(x < 0.0f, -1.0f, 1.0f);
+    x = abs_of(x);
     // Quadrant j of x (even), and x - j pi/4 in three exactly representable parts.
-    auto j = static_cast<int32_t>(x * 1.27323954473516f);
-    j = (j + 1) & ~1;
-    const auto y = static_cast<float>(j);
-    const float r = ((x - y * 0.78515625f) - y * 2.4187564849853515625e-4f) - y * 3.77489497744594108e-8f;
-    const float z = r * r;
-    const float s = ((-1.9515295891e-4f * z + 8.3321608736e-3f) * z - 1.6666654611e-1f) * z * r + r;
-    const float c =
-        ((2.443315711809948e-5f * z - 1.388731625493765e-3f) * z + 4.166664568298827e-2f) * z * z - 0.5f * z + 1;
-    const int q = (j >> 1) & 3;  // which quarter turn
-    const float sin_x = (q & 1) ? c : s, cos_x = (q & 1) ? s : c;
-    return {((q & 2) ? -sin_x : sin_x) * sign, ((q + 1) & 2) ? -cos_x : cos_x};
+    const IntOf<F> j = (truncate(x * 1.27323954473516f) + 1u) & ~1u;
+    const F y = to_float(j);
+    const F r = ((x - y * 0.78515625f) - y * 2.4187564849853515625e-4f) - y * 3.77489497744594108e-8f;
+    const F z = r * r;
+    const F s = ((-1.9515295891e-4f * z + 8.3321608736e-3f) * z - 1.6666654611e-1f) * z * r + r;
+    const F c =
+        ((2.443315711809948e-5f * z - 1.388731625493765e-3f) * z + 4.166664568298827e-2f) * z * z - 0.5f * z + 1.0f;
+    const IntOf<F> q = (j >> 1) & 3u;  // which quarter turn
+    const auto odd = (q & 1u) != 0u;
+    const F sin_x = select(odd, c, s), cos_x = select(odd, s, c);
+    return {select((q & 2u) != 0u, -sin_x, sin_x) * sign, select(((q + 1u) & 2u) != 0u, -cos_x, cos_x)};
 }
 
 // atan2(y, x) in [-pi, pi]; 0 for (0, 0). Branch-free: the quadrant and range choices
 // are selects, since directions arrive in random octants and mispredicted branches
 // would cost more than the arithmetic. One division: atan(n / d) with n <= d, reduced
 // to |r| <= tan(pi/8) by atan(n / d) = pi/4 + atan((n - d) / (n + d)).
-ENVMIS_HD inline float fast_atan2(float y, float x) noexcept {
-    const float ax = std::abs(x), ay = std::abs(y);
-    const bool swap = ay > ax;
-    const float n = swap ? ax : ay, d = swap ? ay : ax;
-    const bool reduce = n > 0.41421356237309515f * d;
-    const float num = reduce ? n - d : n, den = reduce ? n + d : d;
-    const float r = den > 0 ? num / den : 0.0f, z = r * r;
-    float a =
-        (((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z - 3.33329491539e-1f) * z * r + r;
-    a += reduce ? kPiF / 4 : 0.0f;
-    a = swap ? kPiF / 2 - a : a;
-    a = x < 0 ? kPiF - a : a;
-    return std::copysign(a, y);
+template <class F>
+ENVMIS_HD ENVMIS_INLINE F fast_atan2(F y, F x) noexcept {
+    const F ax = abs_of(x), ay = abs_of(y);
+    const auto swap = ay > ax;
+    const F n = select(swap, ax, ay), d = select(swap, ay, ax);
+    const auto reduce = n > 0.41421356237309515f * d;
+    const F num = select(reduce, n - d, n), den = select(reduce, n + d, d);
+    const F r = select(den > 0.0f, num / den, 0.0f), z = r * r;
+    F a = (((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z - 3.33329491539e-1f) * z * r + r;
+    a = a + select(reduce, kPiF / 4, 0.0f);
+    a = select(swap, kPiF / 2 - a, a);
+    a = select(x < 0.0f, kPiF - a, a);
+    return copysign_of(a, y);
 }
 
 // x^y for x >= 0 and y >= 0 (x^y <= FLT_MAX), as 2^(y log2 x) in float multiplies, adds,
-// one division and bit manipulation: Phong's lobe (cos^n and u^(1/(n+1)), bsdf.h) in the
-// estimator's AVX2 lanes repeats it operation for operation, bit for bit, which std::pow
-// (glibc's powf works in double) cannot be. log: FreeBSD's logf (x = m 2^e with m in
+// one division and bit manipulation: Phong's lobe (cos^n and u^(1/(n+1)), bsdf.h) gets the
+// same bits from it on one float and in the estimator's eight AVX2 lanes, which std::pow
+// (glibc's powf works in double) cannot give. log: FreeBSD's logf (x = m 2^e with m in
 // [sqrt(1/2), sqrt(2)), log m = log1p(m - 1) by a minimax polynomial in s = f / (2 + f),
 // within an ulp); 2^t: nearest integer k plus a Cephes polynomial for t - k in
 // [-1/2, 1/2]. The error grows with |t| = |y log2 x|, as t's rounding scales the result:
@@ -65,27 +68,28 @@ ENVMIS_HD inline float fast_atan2(float y, float x) noexcept {
 // so 5e-6 at t = -32, a result of 2e-10; tests/core/math/fast_math_test.cpp). Subnormal
 // x are scaled into range first; results below 2^-126 (t < -126) are 0, as is 0^y (also
 // for y = 0, where std::pow gives 1); x^0 = 1 and 1^y = 1 exactly. About 30 flops.
-ENVMIS_HD inline float fast_pow(float x, float y) noexcept {
+template <class F>
+ENVMIS_HD ENVMIS_INLINE F fast_pow(F x, F y) noexcept {
     // log2 x = e + log(m) / ln 2
-    const bool subnormal = x < 0x1p-126f;
-    const uint32_t bits = bit_cast<uint32_t>(subnormal ? x * 0x1p24f : x) + (0x3f800000u - 0x3f3504f3u);
-    const auto e = static_cast<float>(static_cast<int32_t>(bits >> 23) - (subnormal ? 127 + 24 : 127));
-    const float f = bit_cast<float>((bits & 0x007fffffu) + 0x3f3504f3u) - 1;
-    const float s = f / (2 + f), z = s * s, w = z * z;
-    const float r = z * (0.66666662693f + w * 0.28498786688f) + w * (0.40000972152f + w * 0.24279078841f);
-    const float half_f2 = 0.5f * f * f;
-    const float t = y * ((f - (half_f2 - s * (half_f2 + r))) * 1.44269504089f + e);
+    const auto subnormal = x < 0x1p-126f;
+    const IntOf<F> bits = to_bits(select(subnormal, x * 0x1p24f, x)) + (0x3f800000u - 0x3f3504f3u);
+    const F e = to_float((bits >> 23) - select(subnormal, IntOf<F>(127u + 24u), IntOf<F>(127u)));
+    const F f = from_bits((bits & 0x007fffffu) + 0x3f3504f3u) - 1.0f;
+    const F s = f / (2.0f + f), z = s * s, w = z * z;
+    const F r = z * (0.66666662693f + w * 0.28498786688f) + w * (0.40000972152f + w * 0.24279078841f);
+    const F half_f2 = 0.5f * f * f;
+    const F t = y * ((f - (half_f2 - s * (half_f2 + r))) * 1.44269504089f + e);
     // 2^t = 2^k 2^(t - k), k = t rounded to the nearest integer in the low mantissa bits
     constexpr float kRound = 0x1.8p23f;
-    const float shifted = t + kRound, g = t - (shifted - kRound);
-    float p = 1.535336188319500e-4f * g + 1.339887440266574e-3f;
+    const F shifted = t + kRound, g = t - (shifted - kRound);
+    F p = 1.535336188319500e-4f * g + 1.339887440266574e-3f;
     p = p * g + 9.618437357674640e-3f;
     p = p * g + 5.550332471162809e-2f;
     p = p * g + 2.402264791363012e-1f;
     p = p * g + 6.931472028550421e-1f;
-    p = p * g + 1;
-    const float scale = bit_cast<float>((bit_cast<uint32_t>(shifted) + (127u - 0x4b400000u)) << 23);
-    return x > 0 && t >= -126 ? p * scale : 0.0f;
+    p = p * g + 1.0f;
+    const F scale = from_bits((to_bits(shifted) + (127u - 0x4b400000u)) << 23);
+    return select(x > 0.0f && t >= -126.0f, p * scale, 0.0f);
 }
 
 // sin and cos of a whole turn's fraction, 2 pi t, from a table of kTurnSteps entries and
@@ -102,26 +106,31 @@ namespace detail {
 // add instead of two int/float conversions, the slowest part of this function
 // (measured). It relies on IEEE addition, as every compiler does unless told to
 // reassociate (-ffast-math would fold (x + c) - c to x).
-ENVMIS_HD inline SinCos sincos_steps(const SinCos* table, float x) noexcept {
+ENVMIS_HD inline SinCos turn_entry(const SinCos* table, uint32_t k) noexcept { return table[k]; }
+
+template <class F>
+ENVMIS_HD ENVMIS_INLINE SinCosOf<F> sincos_steps(const SinCos* table, F x) noexcept {
     constexpr float kRound = 0x1.8p23f;
-    const uint32_t bits = bit_cast<uint32_t>(x + kRound);
+    const F rounded = x + kRound;
     // sin d and cos d of the remainder d = c f, written in f so that each term is one
     // multiply nearer to f (the samplers wait on this chain).
     constexpr float c = 2 * kPiF / kTurnSteps;
-    const float f = x - (bit_cast<float>(bits) - kRound), f2 = f * f;
-    const float sin_d = c * f - f2 * (c * c * c / 6 * f), cos_d = 1 - (c * c / 2) * f2;
-    const SinCos e = table[bits & (kTurnSteps - 1)];  // periodic
+    const F f = x - (rounded - kRound), f2 = f * f;
+    const F sin_d = c * f - f2 * (c * c * c / 6 * f), cos_d = 1.0f - (c * c / 2) * f2;
+    const SinCosOf<F> e = turn_entry(table, to_bits(rounded) & (kTurnSteps - 1));  // periodic
     return {e.sin * cos_d + e.cos * sin_d, e.cos * cos_d - e.sin * sin_d};
 }
 
 }  // namespace detail
 
 // For |t| < 4096; the scale by kTurnSteps is exact.
-ENVMIS_HD inline SinCos sincos_turns(const SinCos* table, float t) noexcept {
+template <class F>
+ENVMIS_HD ENVMIS_INLINE SinCosOf<F> sincos_turns(const SinCos* table, F t) noexcept {
     return detail::sincos_steps(table, t * static_cast<float>(kTurnSteps));
 }
 // sin and cos of pi t (half turns), as precise: the equirectangular map's theta = pi v.
-ENVMIS_HD inline SinCos sincos_half_turns(const SinCos* table, float t) noexcept {
+template <class F>
+ENVMIS_HD ENVMIS_INLINE SinCosOf<F> sincos_half_turns(const SinCos* table, F t) noexcept {
     return detail::sincos_steps(table, t * static_cast<float>(kTurnSteps / 2));
 }
 

@@ -112,4 +112,40 @@ ENVMIS_HD constexpr T clamp(T v, T lo, T hi) noexcept {
     return v < lo ? lo : (hi < v ? hi : v);
 }
 
+// Lane types. The sampling functions that a batch call runs eight at a time are
+// templates on a lane type F: float here, or eight floats in AVX2 (simd::F8,
+// lib/common/detail/simd.h), written once for both. Lanes<F> names the integer and
+// vector types of F, and the functions below are float's forms of the operations F8
+// has: a comparison gives a bool (an M8), select(c, a, b) is c ? a : b with both
+// evaluated, and a lane integer is a uint32_t (wrapping, >> logical; to_float reads it
+// as signed, truncate as a signed conversion).
+struct SinCos;
+template <class F>
+struct Lanes;
+template <>
+struct Lanes<float> {
+    using Int = uint32_t;
+    using Vec2 = envmis::Vec2;
+    using Vec3 = envmis::Vec3;
+    using SinCos = envmis::SinCos;
+};
+template <class F>
+using IntOf = typename Lanes<F>::Int;
+template <class F>
+using Vec2Of = typename Lanes<F>::Vec2;
+template <class F>
+using Vec3Of = typename Lanes<F>::Vec3;
+template <class F>
+using SinCosOf = typename Lanes<F>::SinCos;
+
+ENVMIS_HD inline float select(bool c, float a, float b) noexcept { return c ? a : b; }
+ENVMIS_HD inline uint32_t select(bool c, uint32_t a, uint32_t b) noexcept { return c ? a : b; }
+ENVMIS_HD inline float abs_of(float v) noexcept { return std::abs(v); }
+ENVMIS_HD inline float sqrt_of(float v) noexcept { return std::sqrt(v); }
+ENVMIS_HD inline float copysign_of(float magnitude, float sign) noexcept { return std::copysign(magnitude, sign); }
+ENVMIS_HD inline float to_float(uint32_t v) noexcept { return static_cast<float>(static_cast<int32_t>(v)); }
+ENVMIS_HD inline uint32_t truncate(float v) noexcept { return static_cast<uint32_t>(static_cast<int32_t>(v)); }
+ENVMIS_HD inline uint32_t to_bits(float v) noexcept { return bit_cast<uint32_t>(v); }
+ENVMIS_HD inline float from_bits(uint32_t v) noexcept { return bit_cast<float>(v); }
+
 }  // namespace envmis

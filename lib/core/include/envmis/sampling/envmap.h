@@ -177,8 +177,10 @@ struct EnvMapView {
         return {eval_uv(uv), pdf_uv(uv)};
     }
     // Image density to solid angle; 0 at the poles, where the mapping degenerates.
-    ENVMIS_HD static float solid_angle_pdf(float image_pdf, float sin_theta) noexcept {
-        return sin_theta > 0 ? image_pdf / (kTwoPiSquared * sin_theta) : 0.0f;
+    // On one float or eight lanes (math.h's lane types).
+    template <class F>
+    ENVMIS_HD ENVMIS_INLINE static F solid_angle_pdf(F image_pdf, F sin_theta) noexcept {
+        return select(sin_theta > 0.0f, image_pdf / (kTwoPiSquared * sin_theta), 0.0f);
     }
 };
 
