@@ -4,15 +4,16 @@
 // functions of math.h (select, abs_of, sqrt_of, copysign_of, min, max, clamp, to_float,
 // truncate, to_bits, from_bits), with the same IEEE results; Lanes<F8> names their
 // vectors. The functions written as templates on a lane type F (fast_math.h, mapping.h,
-// envmap.h, bsdf.h) thus give every lane the result the scalar call gives, bit for bit,
+// envmap.h) thus give every lane the result the scalar call gives, bit for bit,
 // by construction: no fused multiply-add, the operations in the order the template
 // writes them (tests/core/image/mapping8_test.cpp checks the mappings, envmap_test.cpp
 // the batch calls, estimator_test.cpp the estimator's lanes).
 //
 // A function that uses them is compiled for AVX2 (ENVMIS_AVX2) and called only where
-// batch_paths() (envmis/cpu.h) chose AVX2; the templates it calls are always inlined
-// into it (ENVMIS_INLINE), so they are compiled for AVX2 too, and the rest of the library
-// stays runnable on any x86-64 CPU.
+// batch_paths() (envmis/cpu.h) chose AVX2, so the rest of the library stays runnable on
+// any x86-64 CPU. One that calls those templates is also flattened (ENVMIS_AVX2_FLAT):
+// every call in it is inlined, so the templates, which stay plain inline functions for
+// their scalar callers, are compiled into it for AVX2.
 #pragma once
 
 #include "envmis/math/fast_math.h"
@@ -22,18 +23,19 @@
 #include <immintrin.h>
 
 #define ENVMIS_AVX2 __attribute__((target("avx2")))
+#define ENVMIS_AVX2_FLAT __attribute__((target("avx2"), flatten))
 
+// The lane types are laid out as AVX2 sees them: defined under the default target, a
+// struct holding an __m256 has no vector mode, and GCC copies it through memory in
+// 16-byte halves, which the next 32-byte load cannot forward from.
+#pragma GCC push_options
+#pragma GCC target("avx2")
 namespace envmis::simd {
 
 struct M8 {
     __m256 v;
     ENVMIS_AVX2 friend M8 operator&&(M8 a, M8 b) noexcept { return {_mm256_and_ps(a.v, b.v)}; }
-    ENVMIS_AVX2 friend M8 operator||(M8 a, M8 b) noexcept { return {_mm256_or_ps(a.v, b.v)}; }
-    ENVMIS_AVX2 friend M8 operator!(M8 a) noexcept {
-        return {_mm256_xor_ps(a.v, _mm256_castsi256_ps(_mm256_set1_epi32(-1)))};
-    }
 };
-ENVMIS_AVX2 inline bool any(M8 m) noexcept { return _mm256_movemask_ps(m.v) != 0; }
 
 // uint32_t's arithmetic: wrapping, >> logical; to_float reads a lane as signed.
 struct I8 {
@@ -49,7 +51,6 @@ struct I8 {
     ENVMIS_AVX2 friend I8 operator<<(I8 a, int n) noexcept { return _mm256_slli_epi32(a, n); }
     ENVMIS_AVX2 friend I8 operator>>(I8 a, int n) noexcept { return _mm256_srli_epi32(a, n); }
     ENVMIS_AVX2 friend M8 operator==(I8 a, I8 b) noexcept { return {_mm256_castsi256_ps(_mm256_cmpeq_epi32(a, b))}; }
-    ENVMIS_AVX2 friend M8 operator!=(I8 a, I8 b) noexcept { return !(a == b); }
 };
 
 struct F8 {
@@ -100,7 +101,8 @@ struct Vec2x8 {
 };
 struct Vec3x8 {
     F8 x, y, z;
-    ENVMIS_AVX2 F8 operator[](int i) const noexcept { return i == 0 ? x : (i == 1 ? y : z); }
+    // A copy, not a reference: selecting among references would keep the vector in memory.
+    ENVMIS_AVX2 F8 operator[](int i) const noexcept { return i == 0 ? F8(x) : (i == 1 ? F8(y) : F8(z)); }
 };
 struct SinCos8 {
     F8 sin, cos;
@@ -134,6 +136,7 @@ ENVMIS_AVX2 inline SinCos8 turn_entry(const SinCos* table, I8 k) noexcept {
 }
 
 }  // namespace envmis::simd
+#pragma GCC pop_options
 
 namespace envmis {
 template <>

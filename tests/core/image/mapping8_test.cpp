@@ -123,7 +123,7 @@ protected:
 TEST_F(Mapping8, ImagePointsOfDirectionsAreTheScalarOnesInBothMappings) {
     const std::vector<Vec3> d = hard_directions();
     for (const Mapping m : {Mapping::equirect, Mapping::equal_area}) {
-        const auto got = per_lane(d, [m](const simd::Vec3x8& v) ENVMIS_AVX2 {
+        const auto got = per_lane(d, [m](const simd::Vec3x8& v) ENVMIS_AVX2_FLAT {
             const simd::Vec2x8 p = m == Mapping::equal_area ? equal_area_uv<simd::F8>(v) : equirect_uv<simd::F8>(v);
             return simd::Vec3x8{p.x, p.y, 0.0f};
         });
@@ -137,7 +137,7 @@ TEST_F(Mapping8, ImagePointsOfDirectionsAreTheScalarOnesInBothMappings) {
 TEST_F(Mapping8, EqualAreaDirectionsOfImagePointsAreTheScalarOnes) {
     std::vector<Vec3> points;  // (u, v, unused)
     for (const Vec2 p : hard_points()) points.push_back({p.x, p.y, 0.0f});
-    const auto got = per_lane(points, [](const simd::Vec3x8& v) ENVMIS_AVX2 {
+    const auto got = per_lane(points, [](const simd::Vec3x8& v) ENVMIS_AVX2_FLAT {
         return equal_area_direction<simd::F8>({v.x, v.y});
     });
     for (size_t i = 0; i < points.size(); ++i)
@@ -155,10 +155,10 @@ TEST_F(Mapping8, EveryAxesPermutationMovesComponentsAsTheScalarCode) {
                     const Axes axes{{static_cast<int8_t>(signs & 1 ? -a : a), static_cast<int8_t>(signs & 2 ? -b : b),
                                      static_cast<int8_t>(signs & 4 ? -c : c)}};
                     ++permutations;
-                    const auto world =
-                        per_lane(d, [&](const simd::Vec3x8& v) ENVMIS_AVX2 { return to_world<simd::F8>(axes, v); });
-                    const auto canonical =
-                        per_lane(d, [&](const simd::Vec3x8& v) ENVMIS_AVX2 { return to_canonical<simd::F8>(axes, v); });
+                    const auto world = per_lane(
+                        d, [&](const simd::Vec3x8& v) ENVMIS_AVX2_FLAT { return to_world<simd::F8>(axes, v); });
+                    const auto canonical = per_lane(
+                        d, [&](const simd::Vec3x8& v) ENVMIS_AVX2_FLAT { return to_canonical<simd::F8>(axes, v); });
                     for (size_t i = 0; i < d.size(); i += 7) {
                         ASSERT_TRUE(same_bits(world[i], to_world(axes, d[i]), d[i])) << axes.to_string();
                         ASSERT_TRUE(same_bits(canonical[i], to_canonical(axes, d[i]), d[i])) << axes.to_string();
@@ -171,7 +171,7 @@ TEST_F(Mapping8, EveryAxesPermutationMovesComponentsAsTheScalarCode) {
 TEST_F(Mapping8, ArctangentsAreTheScalarOnesOnSpecialAndRandomPairs) {
     std::vector<Vec3> pairs;  // (y, x, unused)
     for (const Vec3 v : hard_directions()) pairs.push_back({v.x, v.y, 0.0f}), pairs.push_back({v.z, v.x, 0.0f});
-    const auto got = per_lane(pairs, [](const simd::Vec3x8& v) ENVMIS_AVX2 {
+    const auto got = per_lane(pairs, [](const simd::Vec3x8& v) ENVMIS_AVX2_FLAT {
         return simd::Vec3x8{fast_atan2(v.x, v.y), 0.0f, 0.0f};
     });
     for (size_t i = 0; i < pairs.size(); ++i)
@@ -182,11 +182,11 @@ TEST_F(Mapping8, SinesCosinesAndPowersAreTheScalarOnes) {
     const std::vector<SinCos> turns = make_turn_table();
     std::vector<Vec3> inputs;  // (angle or turn, base, exponent)
     for (const Vec3 v : hard_directions()) inputs.push_back({8 * v.x, std::abs(v.y), 50 * std::abs(v.z)});
-    const auto sincos = per_lane(inputs, [](const simd::Vec3x8& v) ENVMIS_AVX2 {
+    const auto sincos = per_lane(inputs, [](const simd::Vec3x8& v) ENVMIS_AVX2_FLAT {
         const simd::SinCos8 s = fast_sincos(v.x);
         return simd::Vec3x8{s.sin, s.cos, fast_pow(v.y, v.z)};
     });
-    const auto turned = per_lane(inputs, [&](const simd::Vec3x8& v) ENVMIS_AVX2 {
+    const auto turned = per_lane(inputs, [&](const simd::Vec3x8& v) ENVMIS_AVX2_FLAT {
         const simd::SinCos8 t = sincos_turns(turns.data(), v.x), h = sincos_half_turns(turns.data(), v.y);
         return simd::Vec3x8{t.sin, t.cos, h.sin + h.cos};
     });

@@ -100,15 +100,17 @@ struct Span8 {
     I8 start, width;
 };
 ENVMIS_AVX2 Span8 span8(const uint32_t* start, I8 base, I8 i, uint32_t n) noexcept {
+    I8 first, end = kCdfUnits;
     if (n == 1) {  // i = 0
-        const I8 first = gather(start, base);
-        return {first, I8(kCdfUnits) - first};
+        first = gather(start, base);
+    } else {
+        const I8 j = _mm256_min_epu32(i, I8(n - 2));
+        const Pair8 p = gather_pairs(start, base + j);
+        const M8 inside = i == j;  // not the last cell
+        first = select(inside, p.first, p.second);
+        end = select(inside, p.second, end);
     }
-    const I8 j = _mm256_min_epu32(i, I8(n - 2));
-    const Pair8 p = gather_pairs(start, base + j);
-    const M8 inside = i == j;  // not the last cell
-    const I8 first = select(inside, p.first, p.second);
-    return {first, select(inside, p.second, I8(kCdfUnits)) - first};
+    return {first, end - first};
 }
 
 // Widths to float, as static_cast<float>(uint32_t): a width is at most 2^31, which as a
@@ -147,7 +149,7 @@ struct Cells8 {
 // line: a gather waits for its slowest lane, and with one line a texel prefetched, most
 // groups of eight had a lane whose line nobody had asked for (measured:
 // docs/performance-log.md, 'locate8').
-ENVMIS_AVX2 Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l) noexcept {
+ENVMIS_AVX2_FLAT Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l) noexcept {
     const Vec3x8 d = to_canonical<F8>(env.axes, {load(in.x + l), load(in.y + l), load(in.z + l)});
     const Vec2x8 p = env.mapping == Mapping::equal_area ? equal_area_uv<F8>(d) : equirect_uv<F8>(d);
     const I8 x = cell8(p.x, env.distribution.w), y = cell8(p.y, env.distribution.h);
@@ -159,7 +161,7 @@ ENVMIS_AVX2 Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l
 }
 
 // The solid-angle pdf at image row v for an image-space density (image_to_solid_angle).
-ENVMIS_AVX2 F8 solid_angle_pdf8(const EnvMapView& env, F8 image_pdf, F8 v) noexcept {
+ENVMIS_AVX2_FLAT F8 solid_angle_pdf8(const EnvMapView& env, F8 image_pdf, F8 v) noexcept {
     if (env.mapping == Mapping::equal_area) return image_pdf * (1 / kFourPi);
     return EnvMapView::solid_angle_pdf(image_pdf, sincos_half_turns(env.turns, v).sin);
 }
@@ -276,7 +278,7 @@ struct Direction8 {
     Vec3x8 d;
     F8 pdf;
 };
-ENVMIS_AVX2 Direction8 at8(const EnvMapView& env, Vec2x8 p, F8 image_pdf) noexcept {
+ENVMIS_AVX2_FLAT Direction8 at8(const EnvMapView& env, Vec2x8 p, F8 image_pdf) noexcept {
     if (env.mapping == Mapping::equal_area)
         return {to_world<F8>(env.axes, equal_area_direction<F8>(p)), image_pdf * (1 / kFourPi)};
     const SinCos8 theta = sincos_half_turns(env.turns, p.y), phi = sincos_turns(env.turns, p.x);

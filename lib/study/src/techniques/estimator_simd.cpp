@@ -63,7 +63,7 @@ struct LambertLobe {
         return values8(select(wi.z > 0.0f, s, 0.0f), albedo, s, not_below(wi.z));
     }
     // sample_cosine_hemisphere after sample_disk.
-    ENVMIS_AVX2 Vec3x8 sample(F8 ux, F8 uy) const noexcept {
+    ENVMIS_AVX2_FLAT Vec3x8 sample(F8 ux, F8 uy) const noexcept {
         const F8 a = 2.0f * ux - 1.0f, b = 2.0f * uy - 1.0f;
         const M8 centre = a == 0.0f && b == 0.0f, wide = abs_of(a) > abs_of(b);
         const F8 radius = select(wide, a, b);
@@ -88,13 +88,13 @@ struct PhongLobe {
           pdf_scale((n + 1) / (2 * kPiF)),
           eval_scale((n + 2) / (2 * kPiF)),
           sample_power(1 / (n + 1)) {}
-    ENVMIS_AVX2 Values8 values(const Vec3x8& wi) const noexcept {
+    ENVMIS_AVX2_FLAT Values8 values(const Vec3x8& wi) const noexcept {
         const F8 c = dot8(wi, mirror), power = fast_pow(c, F8(n));
         const M8 in_lobe = c > 0.0f;
         return values8(select(in_lobe, pdf_scale * power, 0.0f), albedo, eval_scale * power * wi.z,
                        not_below(wi.z) && in_lobe);
     }
-    ENVMIS_AVX2 Vec3x8 sample(F8 ux, F8 uy) const noexcept {
+    ENVMIS_AVX2_FLAT Vec3x8 sample(F8 ux, F8 uy) const noexcept {
         const F8 cos_a = fast_pow(ux, F8(sample_power)), sin_a = sqrt_of(max(0.0f, 1.0f - cos_a * cos_a));
         const SinCos8 phi = fast_sincos(2 * kPiF * uy);
         return to_world8(lobe, {sin_a * phi.cos, sin_a * phi.sin, cos_a});
@@ -136,7 +136,7 @@ struct GgxLobe {
         return {pdf, fresnel(f0.r), fresnel(f0.g), fresnel(f0.b)};
     }
     // reflect(wo, ggx::sample_visible_normal(visible, alpha, u))
-    ENVMIS_AVX2 Vec3x8 sample(F8 ux, F8 uy) const noexcept {
+    ENVMIS_AVX2_FLAT Vec3x8 sample(F8 ux, F8 uy) const noexcept {
         const auto [vh, t1, t2] = visible;
         const F8 r = sqrt_of(ux);
         const SinCos8 phi = fast_sincos(2 * kPiF * uy);

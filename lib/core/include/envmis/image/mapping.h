@@ -47,7 +47,7 @@ struct ENVMIS_CORE_API Axes {
 
 // On one float or eight lanes (math.h's lane types), as the mappings below.
 template <class F = float>
-ENVMIS_HD ENVMIS_INLINE F axis_component(const Vec3Of<F>& v, int8_t code) noexcept {
+ENVMIS_HD inline F axis_component(const Vec3Of<F>& v, int8_t code) noexcept {
     const F c = v[(code < 0 ? -code : code) - 1];
     return code < 0 ? -c : c;
 }
@@ -55,14 +55,14 @@ ENVMIS_HD ENVMIS_INLINE F axis_component(const Vec3Of<F>& v, int8_t code) noexce
 // Both return early for the default frame, which most renderers use: the general
 // permutation takes some thirty instructions and three branches per call.
 template <class F = float>
-ENVMIS_HD ENVMIS_INLINE Vec3Of<F> to_world(const Axes& a, const Vec3Of<F>& canonical) noexcept {
+ENVMIS_HD inline Vec3Of<F> to_world(const Axes& a, const Vec3Of<F>& canonical) noexcept {
     if (a.identity()) return canonical;
     return {axis_component<F>(canonical, a.code[0]), axis_component<F>(canonical, a.code[1]),
             axis_component<F>(canonical, a.code[2])};
 }
 
 template <class F = float>
-ENVMIS_HD ENVMIS_INLINE Vec3Of<F> to_canonical(const Axes& a, const Vec3Of<F>& world) noexcept {
+ENVMIS_HD inline Vec3Of<F> to_canonical(const Axes& a, const Vec3Of<F>& world) noexcept {
     if (a.identity()) return world;
     F c[3] = {world.x, world.y, world.z};
     for (int i = 0; i < 3; ++i) {
@@ -82,7 +82,7 @@ ENVMIS_HD inline Vec3 equirect_direction(Vec2 uv, float* sin_theta = nullptr) no
 
 // Image point of a canonical unit direction; the inverse of equirect_direction.
 template <class F = float>
-ENVMIS_HD ENVMIS_INLINE Vec2Of<F> equirect_uv(const Vec3Of<F>& d) noexcept {
+ENVMIS_HD inline Vec2Of<F> equirect_uv(const Vec3Of<F>& d) noexcept {
     const F z = clamp(d.z, -1.0f, 1.0f);
     const F theta = fast_atan2(sqrt_of(max(0.0f, (1.0f - z) * (1.0f + z))), z);
     const F phi = fast_atan2(d.y, d.x);
@@ -111,7 +111,7 @@ inline constexpr float kFourPi = 4 * kPiF;
 // scales the numerator before the division, and 1/sqrt 2 goes inside the root, which
 // leaves fewer operations in a row after the division and the root.
 template <class F = float>
-ENVMIS_HD ENVMIS_INLINE Vec3Of<F> equal_area_direction(const Vec2Of<F>& uv) noexcept {
+ENVMIS_HD inline Vec3Of<F> equal_area_direction(const Vec2Of<F>& uv) noexcept {
     const F u = 2.0f * uv.x - 1.0f, v = 2.0f * uv.y - 1.0f, au = abs_of(u), av = abs_of(v);
     // Signed distance from the diamond |u| + |v| = 1 (the equator); r is the distance
     // from the nearer pole, measured along the square.
@@ -129,7 +129,7 @@ ENVMIS_HD ENVMIS_INLINE Vec3Of<F> equal_area_direction(const Vec2Of<F>& uv) noex
 // Point of an equal-area square for a canonical unit direction; the inverse of
 // equal_area_direction.
 template <class F = float>
-ENVMIS_HD ENVMIS_INLINE Vec2Of<F> equal_area_uv(const Vec3Of<F>& d) noexcept {
+ENVMIS_HD inline Vec2Of<F> equal_area_uv(const Vec3Of<F>& d) noexcept {
     const F r = sqrt_of(1.0f - min(abs_of(d.z), 1.0f));
     // The angle within the quadrant, as a fraction of a quarter turn.
     const F t = fast_atan2(abs_of(d.y), abs_of(d.x)) * static_cast<float>(2 / kPi);

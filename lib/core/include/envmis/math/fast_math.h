@@ -21,7 +21,7 @@ struct SinCos {
 // On one float or eight lanes (math.h's lane types), as everything below but
 // make_turn_table.
 template <class F>
-ENVMIS_HD ENVMIS_INLINE SinCosOf<F> fast_sincos(F x) noexcept {
+ENVMIS_HD inline SinCosOf<F> fast_sincos(F x) noexcept {
     const F sign = select(x < 0.0f, -1.0f, 1.0f);
     x = abs_of(x);
     // Quadrant j of x (even), and x - j pi/4 in three exactly representable parts.
@@ -33,9 +33,9 @@ ENVMIS_HD ENVMIS_INLINE SinCosOf<F> fast_sincos(F x) noexcept {
     const F c =
         ((2.443315711809948e-5f * z - 1.388731625493765e-3f) * z + 4.166664568298827e-2f) * z * z - 0.5f * z + 1.0f;
     const IntOf<F> q = (j >> 1) & 3u;  // which quarter turn
-    const auto odd = (q & 1u) != 0u;
+    const auto odd = (q & 1u) == 1u;
     const F sin_x = select(odd, c, s), cos_x = select(odd, s, c);
-    return {select((q & 2u) != 0u, -sin_x, sin_x) * sign, select(((q + 1u) & 2u) != 0u, -cos_x, cos_x)};
+    return {select((q & 2u) == 2u, -sin_x, sin_x) * sign, select(((q + 1u) & 2u) == 2u, -cos_x, cos_x)};
 }
 
 // atan2(y, x) in [-pi, pi]; 0 for (0, 0). Branch-free: the quadrant and range choices
@@ -43,7 +43,7 @@ ENVMIS_HD ENVMIS_INLINE SinCosOf<F> fast_sincos(F x) noexcept {
 // would cost more than the arithmetic. One division: atan(n / d) with n <= d, reduced
 // to |r| <= tan(pi/8) by atan(n / d) = pi/4 + atan((n - d) / (n + d)).
 template <class F>
-ENVMIS_HD ENVMIS_INLINE F fast_atan2(F y, F x) noexcept {
+ENVMIS_HD inline F fast_atan2(F y, F x) noexcept {
     const F ax = abs_of(x), ay = abs_of(y);
     const auto swap = ay > ax;
     const F n = select(swap, ax, ay), d = select(swap, ay, ax);
@@ -69,7 +69,7 @@ ENVMIS_HD ENVMIS_INLINE F fast_atan2(F y, F x) noexcept {
 // x are scaled into range first; results below 2^-126 (t < -126) are 0, as is 0^y (also
 // for y = 0, where std::pow gives 1); x^0 = 1 and 1^y = 1 exactly. About 30 flops.
 template <class F>
-ENVMIS_HD ENVMIS_INLINE F fast_pow(F x, F y) noexcept {
+ENVMIS_HD inline F fast_pow(F x, F y) noexcept {
     // log2 x = e + log(m) / ln 2
     const auto subnormal = x < 0x1p-126f;
     const IntOf<F> bits = to_bits(select(subnormal, x * 0x1p24f, x)) + (0x3f800000u - 0x3f3504f3u);

@@ -179,7 +179,7 @@ struct EnvMapView {
     // Image density to solid angle; 0 at the poles, where the mapping degenerates.
     // On one float or eight lanes (math.h's lane types).
     template <class F>
-    ENVMIS_HD ENVMIS_INLINE static F solid_angle_pdf(F image_pdf, F sin_theta) noexcept {
+    ENVMIS_HD static F solid_angle_pdf(F image_pdf, F sin_theta) noexcept {
         return select(sin_theta > 0.0f, image_pdf / (kTwoPiSquared * sin_theta), 0.0f);
     }
 };
