@@ -123,7 +123,8 @@ ENVMIS_HD ENVMIS_INLINE SinCosOf<F> sincos_steps(const SinCos* table, F x) noexc
 
 }  // namespace detail
 
-// For |t| < 4096; the scale by kTurnSteps is exact.
+// For |t| < 4096; the scale by kTurnSteps is exact. Always inlined, as the step above:
+// EnvMapView::sample waits on them (performance-log.md, 'sincos_turns').
 template <class F>
 ENVMIS_HD ENVMIS_INLINE SinCosOf<F> sincos_turns(const SinCos* table, F t) noexcept {
     return detail::sincos_steps(table, t * static_cast<float>(kTurnSteps));
