@@ -26,10 +26,12 @@
 #define ENVMIS_AVX2_FLAT __attribute__((target("avx2"), flatten))
 
 // The lane types are laid out as AVX2 sees them: defined under the default target, a
-// struct holding an __m256 has no vector mode, and GCC copies it through memory in
-// 16-byte halves, which the next 32-byte load cannot forward from.
+// struct holding an __m256 has no vector mode in GCC, which copies it through memory in
+// 16-byte halves that the next 32-byte load cannot forward from. (Clang has no such pragma.)
+#if !defined(__clang__)
 #pragma GCC push_options
 #pragma GCC target("avx2")
+#endif
 namespace envmis::simd {
 
 struct M8 {
@@ -136,7 +138,9 @@ ENVMIS_AVX2 inline SinCos8 turn_entry(const SinCos* table, I8 k) noexcept {
 }
 
 }  // namespace envmis::simd
+#if !defined(__clang__)
 #pragma GCC pop_options
+#endif
 
 namespace envmis {
 template <>
