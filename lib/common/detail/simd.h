@@ -37,6 +37,9 @@ namespace envmis::simd {
 struct M8 {
     __m256 v;
     ENVMIS_AVX2 friend M8 operator&&(M8 a, M8 b) noexcept { return {_mm256_and_ps(a.v, b.v)}; }
+    ENVMIS_AVX2 friend M8 operator!(M8 a) noexcept {
+        return {_mm256_xor_ps(a.v, _mm256_castsi256_ps(_mm256_set1_epi32(-1)))};
+    }
 };
 
 // uint32_t's arithmetic: wrapping, >> logical; to_float reads a lane as signed.
@@ -103,9 +106,23 @@ struct Vec2x8 {
 };
 struct Vec3x8 {
     F8 x, y, z;
+    Vec3x8() = default;
+    ENVMIS_AVX2 Vec3x8(F8 x_, F8 y_, F8 z_) noexcept : x(x_), y(y_), z(z_) {}
+    // One vector in every lane, so that Vec3's operations mix with eight lanes'.
+    ENVMIS_AVX2 Vec3x8(Vec3 v) noexcept : x(v.x), y(v.y), z(v.z) {}
     // A copy, not a reference: selecting among references would keep the vector in memory.
     ENVMIS_AVX2 F8 operator[](int i) const noexcept { return i == 0 ? F8(x) : (i == 1 ? F8(y) : F8(z)); }
 };
+// Vec3's operators, dot and normalize (math.h), component by component in its order.
+ENVMIS_AVX2 inline Vec3x8 operator+(const Vec3x8& a, const Vec3x8& b) noexcept {
+    return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+ENVMIS_AVX2 inline Vec3x8 operator-(const Vec3x8& a, const Vec3x8& b) noexcept {
+    return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+ENVMIS_AVX2 inline Vec3x8 operator*(const Vec3x8& a, F8 s) noexcept { return {a.x * s, a.y * s, a.z * s}; }
+ENVMIS_AVX2 inline F8 dot(const Vec3x8& a, const Vec3x8& b) noexcept { return a.x * b.x + a.y * b.y + a.z * b.z; }
+ENVMIS_AVX2 inline Vec3x8 normalize(const Vec3x8& a) noexcept { return a * (1.0f / sqrt_of(dot(a, a))); }
 struct SinCos8 {
     F8 sin, cos;
 };

@@ -160,18 +160,12 @@ ENVMIS_AVX2_FLAT Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint3
     return {x, y, y * I8(env.distribution.w), p.y};
 }
 
-// The solid-angle pdf at image row v for an image-space density (image_to_solid_angle).
-ENVMIS_AVX2_FLAT F8 solid_angle_pdf8(const EnvMapView& env, F8 image_pdf, F8 v) noexcept {
-    if (env.mapping == Mapping::equal_area) return image_pdf * (1 / kFourPi);
-    return EnvMapView::solid_angle_pdf(image_pdf, sincos_half_turns(env.turns, v).sin);
-}
-
 // Radiance and solid-angle pdf at eight located directions, stored from lane l on.
-ENVMIS_AVX2 void fetch8(const EnvMapView& env, const Cells8& c, LookupArrays out, uint32_t l) noexcept {
+ENVMIS_AVX2_FLAT void fetch8(const EnvMapView& env, const Cells8& c, LookupArrays out, uint32_t l) noexcept {
     const Distribution2DView& d = env.distribution;
     store_radiance8(env.radiance, c.row + c.x, out.r, out.g, out.b, l);
     const I8 row_width = span8(d.marginal.start, I8(0u), c.y, d.h).width;
-    store(out.pdf + l, solid_angle_pdf8(env, image_pdf8(d, row_width, span8(d.start, c.row, c.x, d.w).width), c.v));
+    store(out.pdf + l, env.image_to_solid_angle(image_pdf8(d, row_width, span8(d.start, c.row, c.x, d.w).width), c.v));
 }
 
 // Lanes [0, n - n % 8) in groups of eight, up to four groups at a time: start(first)

@@ -233,9 +233,8 @@ template <uint32_t kMaxLanes, BsdfKind K, class Env>
 #endif
         } else {
             for (uint32_t l = 0; l < padded; ++l) {
-                const Vec3 wi = frame.to_local({x[l], y[l], z[l]});
-                const Rgb v = bsdf.eval(wo, wi);
-                b_pdf[l] = bsdf.pdf(wo, wi), v_r[l] = v.r, v_g[l] = v.g, v_b[l] = v.b;
+                const BsdfValues<float> v = bsdf.values(wo, frame.to_local({x[l], y[l], z[l]}));
+                b_pdf[l] = v.pdf, v_r[l] = v.r, v_g[l] = v.g, v_b[l] = v.b;
             }
         }
         add_lanes(0);
@@ -428,9 +427,10 @@ Rgb DirectLightingEstimator::estimate_with(const Env& env, const ShadingPoint& p
         const Vec3 wi = frame.to_local(e.direction);
         const float p_second = t.mixture ? (from_plain ? env.pdf(e.direction) : other_.pdf(e.direction)) : 0.0f;
         const float p_plain = from_plain ? e.pdf : p_second, p_comp = from_plain ? p_second : e.pdf;
-        const float p[2] = {t.mixture ? 0.5f * (p_plain + p_comp) : e.pdf, bsdf.pdf(wo, wi)};
+        const BsdfValues<float> v = bsdf.values(wo, wi);
+        const float p[2] = {t.mixture ? 0.5f * (p_plain + p_comp) : e.pdf, v.pdf};
         const float c[3] = {t.mixture ? p_plain : p[0], t.mixture ? p_comp : p[1], p[1]};
-        contribute(0, e.radiance * bsdf.eval(wo, wi), p, c);
+        contribute(0, e.radiance * Rgb{v.r, v.g, v.b}, p, c);
     };
     auto sample_bsdf = [&] {
         const BsdfSample b = bsdf.sample(wo, rng.uniform2());

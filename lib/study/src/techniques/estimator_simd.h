@@ -1,8 +1,8 @@
 // Internal: steps of the estimator's side-by-side lanes (estimator.cpp) eight lanes at a
-// time with AVX2 (estimator_simd.cpp). Each repeats the scalar code it stands for
-// operation by operation, so that a lane's result is bit-identical to an estimate made
-// alone (the tests of tests/study/techniques/estimator_test.cpp that compare estimates
-// made at once and one at a time, for Lambert, Phong and GGX).
+// time with AVX2 (estimator_simd.cpp): the BSDF's lobes (bsdf.h) and the frame's turns
+// (frame.h) instantiated on eight lanes, and the lanes' sums, so that a lane's result is
+// bit-identical to an estimate made alone (tests/study/techniques/estimator_test.cpp
+// compares estimates made at once and one at a time, for Lambert, Phong and GGX).
 // Lane counts are multiples of kSimdWidth: callers pad their arrays with valid inputs.
 // The functions are declared on x86-64 only (ENVMIS_AVX2_BATCHES); call them where
 // batch_paths().lanes is AVX2 (envmis/cpu.h).

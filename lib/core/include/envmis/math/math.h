@@ -137,6 +137,9 @@ template <class F>
 using Vec3Of = typename Lanes<F>::Vec3;
 template <class F>
 using SinCosOf = typename Lanes<F>::SinCos;
+// The lane type of a vector type: float for Vec2 and Vec3.
+template <class V>
+using LaneOf = decltype(V::x);
 
 ENVMIS_HD inline float select(bool c, float a, float b) noexcept { return c ? a : b; }
 ENVMIS_HD inline uint32_t select(bool c, uint32_t a, uint32_t b) noexcept { return c ? a : b; }

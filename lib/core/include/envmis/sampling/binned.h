@@ -517,7 +517,7 @@ ENVMIS_HD inline float BinView::pdf_uv(Vec2 uv) const noexcept {
     const uint32_t cx = m.cell_column(x), cy = m.cell_row(y);
     const uint32_t row_width = m.cell_rows(cx, cy).width(y - m.row_edges[cy]);
     const float image_pdf = m.texel_pdf(cells.width(cy * m.cells_w + cx), cx, row_width, x, y);
-    return m.plain.image_to_solid_angle(image_pdf, uv);
+    return m.plain.image_to_solid_angle(image_pdf, uv.y);
 }
 
 ENVMIS_HD inline float BinView::pdf(Vec3 direction) const noexcept { return pdf_uv(map->plain.uv_of(direction)); }

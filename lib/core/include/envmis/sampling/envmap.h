@@ -118,11 +118,12 @@ struct EnvMapView {
     // Solid-angle pdf of sampling `direction` (a unit vector in the world frame).
     ENVMIS_HD float pdf(Vec3 direction) const noexcept { return pdf_uv(uv_of(direction)); }
     // Solid-angle pdf at image point uv; bit-identical to sample(u).pdf when uv = sample(u).uv.
-    ENVMIS_HD float pdf_uv(Vec2 uv) const noexcept { return image_to_solid_angle(distribution.pdf(uv), uv); }
-    // An image-space density at uv, per steradian.
-    ENVMIS_HD float image_to_solid_angle(float image_pdf, Vec2 uv) const noexcept {
+    ENVMIS_HD float pdf_uv(Vec2 uv) const noexcept { return image_to_solid_angle(distribution.pdf(uv), uv.y); }
+    // An image-space density at image row v, per steradian; on one float or eight lanes.
+    template <class F>
+    ENVMIS_HD F image_to_solid_angle(F image_pdf, F v) const noexcept {
         if (mapping == Mapping::equal_area) return image_pdf * (1 / kFourPi);
-        return solid_angle_pdf(image_pdf, sincos_half_turns(turns, uv.y).sin);
+        return solid_angle_pdf(image_pdf, sincos_half_turns(turns, v).sin);
     }
     // Image point of a world direction.
     ENVMIS_HD Vec2 uv_of(Vec3 direction) const noexcept {

@@ -13,10 +13,12 @@
 // sampling weight.
 //
 // Phong's powers are fast_pow (fast_math.h: relative error within 1.5e-7 + 1.5e-7 |n log2 c|),
-// not std::pow: the estimator's AVX2 lanes (estimator_simd.cpp) repeat sample, pdf and
-// eval operation for operation, bit for bit, which std::pow's double-precision
-// internals would not allow. Everything else here is IEEE-exact arithmetic, sqrt and
-// fast_sincos, which the lanes repeat as they are.
+// not std::pow, whose double-precision internals have no lane form: each kind's sample,
+// pdf and eval are written once, as a lobe (LambertLobe, PhongLobe, GgxLobe) templated on
+// the vector type, for one direction and for the estimator's eight AVX2 lanes
+// (estimator_simd.cpp), in lane form (both sides of a test computed, one selected), so
+// that every lane gives the single call's result bit for bit. A lobe is built once per
+// view direction: what depends on wo and the parameters alone is computed there.
 //
 // A Bsdf is a small value type (a kind and its parameters) with branch-on-kind methods:
 // no virtual calls, usable on the device.
@@ -34,6 +36,12 @@
 namespace envmis {
 
 enum class BsdfKind : uint32_t { lambert, phong, ggx };
+
+// A BSDF's pdf and value (f cos) per channel at a direction, on lane type F.
+template <class F>
+struct BsdfValues {
+    F pdf, r, g, b;
+};
 
 struct BsdfSample {
     Vec3 wi;
@@ -72,28 +80,37 @@ struct Bsdf {
 
     ENVMIS_HD Rgb eval(Vec3 wo, Vec3 wi) const noexcept;
     ENVMIS_HD float pdf(Vec3 wo, Vec3 wi) const noexcept;
+    // eval and pdf at once.
+    ENVMIS_HD BsdfValues<float> values(Vec3 wo, Vec3 wi) const noexcept;
     ENVMIS_HD BsdfSample sample(Vec3 wo, Vec2 u) const noexcept;
+    // fn(lobe) with this BSDF's lobe for wo, which must be above the surface (wo.z > 0).
+    template <class Fn>
+    ENVMIS_HD auto with_lobe(Vec3 wo, Fn&& fn) const noexcept;
 };
 
 namespace ggx {
 
 // Trowbridge-Reitz normal distribution D(m), m in the local frame.
-ENVMIS_HD inline float distribution(Vec3 m, float alpha) noexcept {
-    if (m.z <= 0) return 0;
-    const float a2 = alpha * alpha, t = m.z * m.z * (a2 - 1) + 1;
-    return a2 / (kPiF * t * t);
+template <class V>
+ENVMIS_HD inline LaneOf<V> distribution(const V& m, float alpha) noexcept {
+    const float a2 = alpha * alpha;
+    const LaneOf<V> t = m.z * m.z * (a2 - 1) + 1.0f;
+    return select(m.z <= 0.0f, 0.0f, a2 / (kPiF * t * t));
 }
 // Smith's Lambda(v) for GGX.
-ENVMIS_HD inline float lambda(Vec3 v, float alpha) noexcept {
-    const float c2 = v.z * v.z, s2 = max(0.0f, 1 - c2);
-    return c2 > 0 ? 0.5f * (std::sqrt(1 + alpha * alpha * s2 / c2) - 1) : 0.0f;
+template <class V>
+ENVMIS_HD inline LaneOf<V> lambda(const V& v, float alpha) noexcept {
+    const LaneOf<V> c2 = v.z * v.z, s2 = max(0.0f, 1.0f - c2);
+    return select(c2 > 0.0f, 0.5f * (sqrt_of(1.0f + alpha * alpha * s2 / c2) - 1.0f), 0.0f);
 }
-ENVMIS_HD inline Rgb schlick(Rgb f0, float cos_theta) noexcept {
-    const float m = 1 - clamp(cos_theta, 0.0f, 1.0f), m5 = m * m * m * m * m;
-    return {f0.r + (1 - f0.r) * m5, f0.g + (1 - f0.g) * m5, f0.b + (1 - f0.b) * m5};
+// Schlick's Fresnel is f0 + (1 - f0) w for this w: (1 - cos)^5.
+template <class F>
+ENVMIS_HD inline F schlick_weight(F cos_theta) noexcept {
+    const F m = 1.0f - clamp(cos_theta, F(0.0f), F(1.0f));
+    return m * m * m * m * m;
 }
 // What sample_visible_normal's hemisphere depends on besides u: wo stretched by alpha
-// (vh) and two tangents to it. The estimator's lanes (one wo, many u) compute it once.
+// (vh) and two tangents to it.
 struct VisibleNormalFrame {
     Vec3 vh, t1, t2;
 };
@@ -104,76 +121,139 @@ ENVMIS_HD inline VisibleNormalFrame visible_normal_frame(Vec3 wo, float alpha) n
     return {vh, t1, cross(vh, t1)};
 }
 // A visible normal for wo (Heitz 2018): sampled proportionally to G1(wo) max(0, wo.m) D(m) / wo.z.
-ENVMIS_HD inline Vec3 sample_visible_normal(const VisibleNormalFrame& frame, float alpha, Vec2 u) noexcept {
+template <class V = Vec2>
+ENVMIS_HD inline Vec3Of<LaneOf<V>> sample_visible_normal(const VisibleNormalFrame& frame, float alpha,
+                                                         const V& u) noexcept {
+    using F = LaneOf<V>;
     const auto [vh, t1, t2] = frame;
-    const float r = std::sqrt(u.x);
-    const SinCos phi = fast_sincos(2 * kPiF * u.y);
-    const float p1 = r * phi.cos, s = 0.5f * (1 + vh.z);
-    const float p2 = (1 - s) * std::sqrt(max(0.0f, 1 - p1 * p1)) + s * r * phi.sin;
-    const Vec3 nh = t1 * p1 + t2 * p2 + vh * std::sqrt(max(0.0f, 1 - p1 * p1 - p2 * p2));
-    return normalize(Vec3{alpha * nh.x, alpha * nh.y, max(1e-7f, nh.z)});
-}
-ENVMIS_HD inline Vec3 sample_visible_normal(Vec3 wo, float alpha, Vec2 u) noexcept {
-    return sample_visible_normal(visible_normal_frame(wo, alpha), alpha, u);
+    const F r = sqrt_of(u.x);
+    const SinCosOf<F> phi = fast_sincos(2 * kPiF * u.y);
+    const float s = 0.5f * (1 + vh.z);
+    const F p1 = r * phi.cos;
+    const F p2 = (1 - s) * sqrt_of(max(0.0f, 1.0f - p1 * p1)) + s * r * phi.sin;
+    const Vec3Of<F> nh = t1 * p1 + t2 * p2 + vh * sqrt_of(max(0.0f, 1.0f - p1 * p1 - p2 * p2));
+    return normalize(Vec3Of<F>{alpha * nh.x, alpha * nh.y, max(1e-7f, nh.z)});
 }
 
 }  // namespace ggx
 
-ENVMIS_HD inline Rgb scale(Rgb c, float s) noexcept { return {c.r * s, c.g * s, c.b * s}; }
+// A lobe's pdf at wi and its value c s per channel where `valid`, 0 elsewhere.
+template <class F, class M>
+ENVMIS_HD inline BsdfValues<F> lobe_values(F pdf, Rgb c, F s, M valid) noexcept {
+    return {pdf, select(valid, c.r * s, 0.0f), select(valid, c.g * s, 0.0f), select(valid, c.b * s, 0.0f)};
+}
 
+// Each kind's lobe for a view direction above the surface: values(wi) at local
+// directions wi (any: eval is 0 below the surface), sample(u) a local direction.
+struct LambertLobe {
+    Rgb albedo;
+
+    // pdf and value share cos theta_i / pi where the direction is above the surface.
+    template <class V>
+    ENVMIS_HD BsdfValues<LaneOf<V>> values(const V& wi) const noexcept {
+        const LaneOf<V> s = wi.z / kPiF;
+        return lobe_values(select(wi.z > 0.0f, s, 0.0f), albedo, s, !(wi.z <= 0.0f));
+    }
+    template <class V>
+    ENVMIS_HD Vec3Of<LaneOf<V>> sample(const V& u) const noexcept {
+        return sample_cosine_hemisphere(u);
+    }
+};
+
+// The normalised lobe cos^n around the mirror direction, drawn below the surface too:
+// such samples carry no value, but their density is part of the pdf.
+struct PhongLobe {
+    Rgb albedo;
+    Vec3 mirror;  // reflect_z(wo)
+    Frame axis;   // around mirror
+    float n, pdf_scale, eval_scale, sample_power;
+
+    ENVMIS_HD PhongLobe(const Bsdf& bsdf, Vec3 wo) noexcept
+        : albedo(bsdf.reflectance),
+          mirror(reflect_z(wo)),
+          axis(Frame::from_normal(mirror)),
+          n(bsdf.exponent),
+          pdf_scale((n + 1) / (2 * kPiF)),
+          eval_scale((n + 2) / (2 * kPiF)),
+          sample_power(1 / (n + 1)) {}
+    template <class V>
+    ENVMIS_HD BsdfValues<LaneOf<V>> values(const V& wi) const noexcept {
+        using F = LaneOf<V>;
+        const F c = dot(wi, mirror), power = fast_pow(c, F(n));
+        const auto in_lobe = c > 0.0f;
+        return lobe_values(select(in_lobe, pdf_scale * power, 0.0f), albedo, eval_scale * power * wi.z,
+                           !(wi.z <= 0.0f) && in_lobe);
+    }
+    template <class V>
+    ENVMIS_HD Vec3Of<LaneOf<V>> sample(const V& u) const noexcept {
+        using F = LaneOf<V>;
+        const F cos_a = fast_pow(u.x, F(sample_power)), sin_a = sqrt_of(max(0.0f, 1.0f - cos_a * cos_a));
+        const SinCosOf<F> phi = fast_sincos(2 * kPiF * u.y);
+        return axis.to_world(Vec3Of<F>{sin_a * phi.cos, sin_a * phi.sin, cos_a});
+    }
+};
+
+// Reflections of wo about visible normals; those that go below the surface are drawn
+// too (with no value), so the density covers them, as for Phong: it integrates to 1 over
+// the sphere, as optimal MIS's control variates must.
+struct GgxLobe {
+    Rgb f0;
+    Vec3 wo;
+    float alpha;
+    ggx::VisibleNormalFrame visible;
+    float one_plus_lambda_wo, g1, four_wo_z;  // 1 + Lambda(wo), G1(wo), 4 wo.z
+
+    ENVMIS_HD GgxLobe(const Bsdf& bsdf, Vec3 view) noexcept
+        : f0(bsdf.reflectance),
+          wo(view),
+          alpha(bsdf.alpha),
+          visible(ggx::visible_normal_frame(wo, alpha)),
+          one_plus_lambda_wo(1 + ggx::lambda(wo, alpha)),
+          g1(1 / one_plus_lambda_wo),
+          four_wo_z(4 * wo.z) {}
+    template <class V>
+    ENVMIS_HD BsdfValues<LaneOf<V>> values(const V& wi) const noexcept {
+        using F = LaneOf<V>;
+        const V m = normalize(wo + wi);
+        const F d = ggx::distribution(m, alpha), g2 = 1.0f / (one_plus_lambda_wo + ggx::lambda(wi, alpha));
+        const F c5 = ggx::schlick_weight(dot(wi, m)), scale = d * g2 / four_wo_z;
+        const auto valid = !(wi.z <= 0.0f);
+        const auto fresnel = [&](float f) { return select(valid, (f + (1 - f) * c5) * scale, 0.0f); };
+        const F pdf = select(dot(wo, m) > 0.0f, g1 * d / four_wo_z, 0.0f);
+        return {pdf, fresnel(f0.r), fresnel(f0.g), fresnel(f0.b)};
+    }
+    template <class V>
+    ENVMIS_HD Vec3Of<LaneOf<V>> sample(const V& u) const noexcept {
+        return reflect(wo, ggx::sample_visible_normal(visible, alpha, u));
+    }
+};
+
+template <class Fn>
+ENVMIS_HD inline auto Bsdf::with_lobe(Vec3 wo, Fn&& fn) const noexcept {
+    switch (kind) {
+        case BsdfKind::phong: return fn(PhongLobe(*this, wo));
+        case BsdfKind::ggx: return fn(GgxLobe(*this, wo));
+        default: return fn(LambertLobe{reflectance});
+    }
+}
+
+ENVMIS_HD inline BsdfValues<float> Bsdf::values(Vec3 wo, Vec3 wi) const noexcept {
+    if (wo.z <= 0) return {};
+    return with_lobe(wo, [&](const auto& lobe) { return lobe.values(wi); });
+}
 ENVMIS_HD inline Rgb Bsdf::eval(Vec3 wo, Vec3 wi) const noexcept {
-    if (wo.z <= 0 || wi.z <= 0) return {};
-    switch (kind) {
-        case BsdfKind::lambert: return scale(reflectance, wi.z / kPiF);
-        case BsdfKind::phong: {
-            const float c = dot(wi, reflect_z(wo));
-            return c > 0 ? scale(reflectance, (exponent + 2) / (2 * kPiF) * fast_pow(c, exponent) * wi.z) : Rgb{};
-        }
-        case BsdfKind::ggx: {
-            const Vec3 m = normalize(wo + wi);
-            const float g2 = 1 / (1 + ggx::lambda(wo, alpha) + ggx::lambda(wi, alpha));
-            return scale(ggx::schlick(reflectance, dot(wi, m)), ggx::distribution(m, alpha) * g2 / (4 * wo.z));
-        }
-    }
-    return {};
+    const BsdfValues<float> v = values(wo, wi);
+    return {v.r, v.g, v.b};
 }
-
-ENVMIS_HD inline float Bsdf::pdf(Vec3 wo, Vec3 wi) const noexcept {
-    if (wo.z <= 0) return 0;
-    switch (kind) {
-        case BsdfKind::lambert: return wi.z > 0 ? wi.z / kPiF : 0.0f;
-        case BsdfKind::phong: {
-            // The lobe around the mirror direction, below the surface too: such samples
-            // are drawn (and carry no value), so their density is part of the pdf.
-            const float c = dot(wi, reflect_z(wo));
-            return c > 0 ? (exponent + 1) / (2 * kPiF) * fast_pow(c, exponent) : 0.0f;
-        }
-        case BsdfKind::ggx: {
-            // Reflections of wo about a visible normal; those that go below the surface
-            // are drawn too (with no value), so the density covers them, as for Phong:
-            // it integrates to 1 over the sphere, as optimal MIS's control variates must.
-            const Vec3 m = normalize(wo + wi);
-            const float g1 = 1 / (1 + ggx::lambda(wo, alpha));
-            return dot(wo, m) > 0 ? g1 * ggx::distribution(m, alpha) / (4 * wo.z) : 0.0f;
-        }
-    }
-    return 0;
-}
+ENVMIS_HD inline float Bsdf::pdf(Vec3 wo, Vec3 wi) const noexcept { return values(wo, wi).pdf; }
 
 ENVMIS_HD inline BsdfSample Bsdf::sample(Vec3 wo, Vec2 u) const noexcept {
     if (wo.z <= 0) return {};
-    Vec3 wi;
-    switch (kind) {
-        case BsdfKind::lambert: wi = sample_cosine_hemisphere(u); break;
-        case BsdfKind::phong: {
-            const float cos_a = fast_pow(u.x, 1 / (exponent + 1)), sin_a = std::sqrt(max(0.0f, 1 - cos_a * cos_a));
-            const SinCos phi = fast_sincos(2 * kPiF * u.y);
-            wi = Frame::from_normal(reflect_z(wo)).to_world({sin_a * phi.cos, sin_a * phi.sin, cos_a});
-            break;
-        }
-        case BsdfKind::ggx: wi = reflect(wo, ggx::sample_visible_normal(wo, alpha, u)); break;
-    }
-    return {wi, pdf(wo, wi), eval(wo, wi)};
+    return with_lobe(wo, [&](const auto& lobe) {
+        const Vec3 wi = lobe.sample(u);
+        const BsdfValues<float> v = lobe.values(wi);
+        return BsdfSample{wi, v.pdf, {v.r, v.g, v.b}};
+    });
 }
 
 }  // namespace envmis

@@ -4,6 +4,12 @@
 // Local coordinates: z is the normal; x and y span the tangent plane. The frame is
 // built branch-free from the normal alone (Duff et al. 2017), so the same normal always
 // gives the same frame, on the host and on the device.
+//
+// The direction functions are templates on a vector type V: one direction (Vec3, Vec2)
+// or eight (the estimator's AVX2 lanes, lib/common/detail/simd.h), written once in lane
+// form (both sides of a test computed, one selected; math.h), so that every lane gives
+// what the single call gives, bit for bit. V defaults to Vec3 or Vec2, so braced
+// arguments such as to_world({x, y, z}) work.
 #pragma once
 
 #include <algorithm>
@@ -22,30 +28,41 @@ struct Frame {
         const float a = -1.0f / (sign + n.z), b = n.x * n.y * a;
         return {{1 + sign * n.x * n.x * a, sign * b, -sign * n.x}, {b, sign + n.y * n.y * a, -n.y}, n};
     }
-    ENVMIS_HD Vec3 to_local(Vec3 v) const noexcept { return {dot(v, x), dot(v, y), dot(v, z)}; }
-    ENVMIS_HD Vec3 to_world(Vec3 v) const noexcept { return x * v.x + y * v.y + z * v.z; }
+    template <class V = Vec3>
+    ENVMIS_HD V to_local(const V& v) const noexcept {
+        return {dot(v, x), dot(v, y), dot(v, z)};
+    }
+    template <class V = Vec3>
+    ENVMIS_HD V to_world(const V& v) const noexcept {
+        return x * v.x + y * v.y + z * v.z;
+    }
 };
 
 // Mirror of v about the local z axis: the specular reflection of a direction.
 ENVMIS_HD inline Vec3 reflect_z(Vec3 v) noexcept { return {-v.x, -v.y, v.z}; }
 // Mirror of v about a unit vector m.
-ENVMIS_HD inline Vec3 reflect(Vec3 v, Vec3 m) noexcept { return m * (2 * dot(v, m)) - v; }
+template <class V = Vec3>
+ENVMIS_HD inline V reflect(Vec3 v, const V& m) noexcept {
+    return m * (2.0f * dot(v, m)) - v;
+}
 
 // Concentric map of [0,1)^2 onto the unit disk (Shirley and Chiu 1997): area-preserving
 // and low-distortion, so stratified u stays stratified.
-ENVMIS_HD inline Vec2 sample_disk(Vec2 u) noexcept {
-    const float a = 2 * u.x - 1, b = 2 * u.y - 1;
-    if (a == 0 && b == 0) return {0, 0};
-    const bool wide = std::abs(a) > std::abs(b);
-    const float r = wide ? a : b;
-    const SinCos p = fast_sincos(wide ? (kPiF / 4) * (b / a) : (kPiF / 2) - (kPiF / 4) * (a / b));
-    return {r * p.cos, r * p.sin};
+template <class V = Vec2>
+ENVMIS_HD inline V sample_disk(const V& u) noexcept {
+    using F = LaneOf<V>;
+    const F a = 2.0f * u.x - 1.0f, b = 2.0f * u.y - 1.0f;
+    const auto centre = a == 0.0f && b == 0.0f, wide = abs_of(a) > abs_of(b);
+    const F r = select(wide, a, b);
+    const SinCosOf<F> p = fast_sincos(select(wide, (kPiF / 4) * (b / a), (kPiF / 2) - (kPiF / 4) * (a / b)));
+    return {select(centre, 0.0f, r * p.cos), select(centre, 0.0f, r * p.sin)};
 }
 
 // Direction with density cos(theta) / pi on the upper (z > 0) hemisphere.
-ENVMIS_HD inline Vec3 sample_cosine_hemisphere(Vec2 u) noexcept {
-    const Vec2 d = sample_disk(u);
-    return {d.x, d.y, std::sqrt(max(0.0f, 1 - d.x * d.x - d.y * d.y))};
+template <class V = Vec2>
+ENVMIS_HD inline Vec3Of<LaneOf<V>> sample_cosine_hemisphere(const V& u) noexcept {
+    const V d = sample_disk(u);
+    return {d.x, d.y, sqrt_of(max(0.0f, 1.0f - d.x * d.x - d.y * d.y))};
 }
 
 }  // namespace envmis
