@@ -18,10 +18,10 @@ declare -A links=(
     [common]="core"
     [core]="common"
     [build]="core common"
-    [study]="core common"
+    [study]="build core common"
     [io]="core build"
     [pictures]="io build core"
-    [report]="study core"
+    [report]="study build core"
     [precompute]="io build study core"
 )
 stages=(math image compensation sampling table)

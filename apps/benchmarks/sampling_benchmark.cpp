@@ -13,6 +13,7 @@
 #include <tuple>
 #include <vector>
 
+#include "envmis/build/bins.h"
 #include "envmis/cpu.h"
 #include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"
@@ -186,7 +187,7 @@ const std::vector<envmis::Vec3>& directions() {
 const envmis::BinnedEnvMap& binned(uint32_t w) {
     static std::map<uint32_t, envmis::BinnedEnvMap> maps;
     auto it = maps.find(w);
-    if (it == maps.end()) it = maps.emplace(w, envmis::BinnedEnvMap(EnvMap(sky(w), plain_options()))).first;
+    if (it == maps.end()) it = maps.emplace(w, envmis::build_bins(EnvMap(sky(w), plain_options()))).first;
     return it->second;
 }
 
@@ -219,7 +220,7 @@ void build_bins(benchmark::State& state) {
         state.PauseTiming();
         EnvMap copy = plain;
         state.ResumeTiming();
-        envmis::BinnedEnvMap b(std::move(copy));
+        const envmis::BinnedEnvMap b = envmis::build_bins(std::move(copy));
         benchmark::DoNotOptimize(b);
     }
 }

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
+#include "envmis/build/bins.h"
 #include "envmis/cpu.h"
 #include "reference.h"
 
@@ -403,7 +404,7 @@ BinnedResult measure_binned(const RgbImage& image, const EnvMapOptions& mapped, 
     BinnedOptions options;
     options.bins_per_side = bins_per_side(bins);
     const auto [binned, bins_ms] = build_repeatedly<BinnedEnvMap, EnvMap>(
-        *today[kPlain], repeats, [&](EnvMap& copy) { return BinnedEnvMap(std::move(copy), options, &interrupted()); },
+        *today[kPlain], repeats, [&](EnvMap& copy) { return build_bins(std::move(copy), options, &interrupted()); },
         progress, step);
     result.bins = bins;
     result.cells_w = binned->layout().cell_columns, result.cells_h = binned->layout().cell_rows;

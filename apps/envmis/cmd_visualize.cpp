@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cli.h"
+#include "envmis/build/bins.h"
 #include "envmis/io/image_io.h"
 #include "envmis/pictures/picture.h"
 #include "envmis/study/shading/bsdf.h"
@@ -86,7 +87,7 @@ std::optional<BinPanel> bin_panel(const VisualizeArgs& args, const LoadedMap& lo
     BinPanel p;
     std::optional<Progress> progress(std::in_place, "building bins", 1);
     p.binned = loaded.bins ? std::make_unique<BinnedEnvMap>(EnvMap(plain), *loaded.bins)
-                           : std::make_unique<BinnedEnvMap>(EnvMap(plain), options, &interrupted());
+                           : std::make_unique<BinnedEnvMap>(build_bins(EnvMap(plain), options, &interrupted()));
     progress.reset();
     p.normal = n;
     p.lobe = p.binned->lobe_class(bsdf.phong_exponent());

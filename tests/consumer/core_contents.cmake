@@ -30,7 +30,8 @@ execute_process(COMMAND ${NM} -C --defined-only ${ARCHIVE} OUTPUT_VARIABLE symbo
 foreach(foreign "envmis::Bsdf" "envmis::Frame" "envmis::Technique" "envmis::DirectLightingEstimator"
                 "envmis::compare" "envmis::choose_alpha" "envmis::io::" "envmis::pictures::" "Eigen::"
                 "envmis::write_table(" "envmis::rgbe_round(" "envmis::remap(" "envmis::AtomicFile"
-                "envmis::write_file_atomically(" "OpenImageIO" "OCIO" "Imf_")
+                "envmis::write_file_atomically(" "envmis::build_bins(" "envmis::choose_bin_layout("
+                "choose_bins(" "OpenImageIO" "OCIO" "Imf_")
   string(FIND "${symbols}" "${foreign}" at)
   if(NOT at EQUAL -1)
     message(FATAL_ERROR "libenvmis_core.a defines a symbol of another library: '${foreign}'")

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <string>
 
+#include "envmis/build/bins.h"
 #include "envmis/build/remap.h"
 #include "envmis/build/table_writer.h"
 #include "envmis/interrupt.h"
@@ -39,7 +40,7 @@ TEST(StopFlag, ASetFlagStopsABinnedBuild) {
     options.compensation.enabled = false;
     const EnvMap plain(test::random_map(64, 32, kSeed), options);
     const std::atomic<bool> stop{true};
-    EXPECT_THROW(BinnedEnvMap(EnvMap(plain), BinnedOptions{}, &stop), Interrupted);
+    EXPECT_THROW(build_bins(EnvMap(plain), BinnedOptions{}, &stop), Interrupted);
 }
 
 TEST(StopFlag, ASetFlagStopsARemap) {

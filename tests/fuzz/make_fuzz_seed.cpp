@@ -5,6 +5,7 @@
 #include <exception>
 #include <filesystem>
 
+#include "envmis/build/bins.h"
 #include "envmis/build/table_writer.h"
 
 namespace {
@@ -44,7 +45,7 @@ int main(int argc, char** argv) {
         envmis::BinnedOptions bins;
         bins.bins_per_side = 2;
         bins.cell_columns = 4;
-        const envmis::BinnedEnvMap binned(envmis::EnvMap(sky(16, 8), plain), bins);
+        const envmis::BinnedEnvMap binned = envmis::build_bins(envmis::EnvMap(sky(16, 8), plain), bins);
         envmis::write_table(dir / "binned_16x8.envmis", binned, source);
         envmis::write_table(dir / "binned_compact_16x8.envmis", binned, source, envmis::TableEncoding::compact);
 

@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "envmis/build/bins.h"
 #include "envmis/io/colour.h"
 #include "envmis/io/image_io.h"
 #include "envmis/math/hash.h"
@@ -59,7 +60,7 @@ void build_pixels(RgbImage image, const BuildRequest& r, LumaCoefficients luma, 
             return;
         }
         const auto bins_start = std::chrono::steady_clock::now();
-        built.binned.emplace(std::move(map), binned_options(r), stop);
+        built.binned.emplace(build_bins(std::move(map), binned_options(r), stop));
         built.bins_ms = milliseconds_since(bins_start);
     } catch (const std::invalid_argument& e) {
         throw std::invalid_argument(name + ": " + e.what());

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "binned_checks.h"
+#include "envmis/build/bins.h"
 #include "envmis/io/image_io.h"
 #include "envmis/study/comparison/alpha.h"
 
@@ -20,7 +21,7 @@ protected:
         EnvMapOptions options;
         options.compensation.enabled = false;
         options.luma = image.luma;
-        return BinnedEnvMap(EnvMap(downsample(image.image, 128), options));
+        return build_bins(EnvMap(downsample(image.image, 128), options));
     }
 };
 

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "binned_checks.h"
+#include "envmis/build/bins.h"
 #include "envmis/sampling/binned.h"
 #include "forced_path.h"
 #include "maps.h"
@@ -24,8 +25,8 @@ using test::test_normals;
 using test::texel_probabilities;
 
 TEST(Binned, SamplesFollowTheirPdfForNormalsAtCentresBordersAndPoles) {
-    const BinnedEnvMap sun(plain_map(test::sun_sky_map(64, 32)));
-    const BinnedEnvMap noise(plain_map(test::random_map(48, 24, 3)));
+    const BinnedEnvMap sun = build_bins(plain_map(test::sun_sky_map(64, 32)));
+    const BinnedEnvMap noise = build_bins(plain_map(test::random_map(48, 24, 3)));
     uint64_t seed = 1;
     for (uint32_t lobe : {0u, 2u})  // each class on its own grid's centres and borders
         for (Vec3 n : test_normals(sun.layout().side(lobe))) {
@@ -35,13 +36,13 @@ TEST(Binned, SamplesFollowTheirPdfForNormalsAtCentresBordersAndPoles) {
 }
 
 TEST(Binned, EqualAreaMapsFollowTheirPdf) {
-    const BinnedEnvMap map(plain_map(test::random_map(32, 32, 8), Mapping::equal_area));
+    const BinnedEnvMap map = build_bins(plain_map(test::random_map(32, 32, 8), Mapping::equal_area));
     uint64_t seed = 100;
     for (Vec3 n : test_normals(map.layout().side(1))) expect_samples_follow_pdf(map, n, 1, ++seed);
 }
 
 TEST(Binned, SolidAnglePdfIntegratesToOne) {
-    const BinnedEnvMap map(plain_map(test::sun_sky_map(64, 32)));
+    const BinnedEnvMap map = build_bins(plain_map(test::sun_sky_map(64, 32)));
     const BinnedEnvMapView view = map.view();
     for (Vec3 n : test_normals(map.layout().side(0)))
         for (float choice : {0.1f, 0.5f, 0.9f})
@@ -49,7 +50,7 @@ TEST(Binned, SolidAnglePdfIntegratesToOne) {
 }
 
 TEST(Binned, SampleAgreesWithPdfAndEvalFromItsDirection) {
-    const BinnedEnvMap map(plain_map(test::sun_sky_map(128, 64)));
+    const BinnedEnvMap map = build_bins(plain_map(test::sun_sky_map(128, 64)));
     const BinnedEnvMapView view = map.view();
     Rng rng(9);
     int edge_cases = 0;
@@ -68,7 +69,7 @@ TEST(Binned, SampleAgreesWithPdfAndEvalFromItsDirection) {
 
 TEST(Binned, InsideACellTexelsArePickedByThePlainDensity) {
     const EnvMap plain = plain_map(test::random_map(64, 32, 5));
-    const BinnedEnvMap map(plain);
+    const BinnedEnvMap map = build_bins(plain);
     const BinnedEnvMapView view = map.view();
     const BinView bin = view.nearest_bin({0, 0, 1}, 0);
     const std::vector<double> p = texel_probabilities(bin, map.plain());
@@ -84,12 +85,12 @@ TEST(Binned, InsideACellTexelsArePickedByThePlainDensity) {
 }
 
 TEST(Binned, PdfCoversWhatEveryNormalOfTheBinSeesAcrossBinBorders) {
-    expect_coverage(BinnedEnvMap(plain_map(test::sun_sky_map(64, 32))), 0);
-    expect_coverage(BinnedEnvMap(plain_map(test::random_map(64, 32, 2))), 2);
+    expect_coverage(build_bins(plain_map(test::sun_sky_map(64, 32))), 0);
+    expect_coverage(build_bins(plain_map(test::random_map(64, 32, 2))), 2);
     BinnedOptions uncompensated;
     uncompensated.auto_alpha = false;
     uncompensated.alpha = 0;
-    const BinnedEnvMap plain_bins(plain_map(test::random_map(64, 32, 2)), uncompensated);
+    const BinnedEnvMap plain_bins = build_bins(plain_map(test::random_map(64, 32, 2)), uncompensated);
     EXPECT_TRUE(plain_bins.complete(0));
     expect_coverage(plain_bins, 0);
 }
@@ -98,7 +99,7 @@ TEST(Binned, CompensatedBinsAreIncomplete) {
     BinnedOptions fixed;
     fixed.auto_alpha = false;
     fixed.alpha = 1;
-    EXPECT_FALSE(BinnedEnvMap(plain_map(test::sun_sky_map(64, 32)), fixed).complete(0));
+    EXPECT_FALSE(build_bins(plain_map(test::sun_sky_map(64, 32)), fixed).complete(0));
 }
 
 // Counts of a lobe class's plain and compensated choices.
@@ -124,7 +125,7 @@ TEST(Binned, AHigherCostKeepsCompensationOnlyInTheBinsWhereItPaysMore) {
     for (uint32_t lobe : {0u, 1u, 2u}) {
         uint32_t previous = ~0u;
         for (float cost : {1.0f, 1.5f, 3.0f, 100.0f}) {
-            const ChoiceCounts c = choice_counts(BinnedEnvMap(plain, costing(cost)), lobe);
+            const ChoiceCounts c = choice_counts(build_bins(plain, costing(cost)), lobe);
             EXPECT_LE(c.compensated, previous) << "lobe " << lobe << " cost " << cost;
             previous = c.compensated;
             if (cost == 1.0f) {
@@ -138,7 +139,7 @@ TEST(Binned, AHigherCostKeepsCompensationOnlyInTheBinsWhereItPaysMore) {
 }
 
 TEST(Binned, APlainChoiceSamplesAndWeighsExactlyAsThePlainMapDoes) {
-    const BinnedEnvMap map(plain_map(test::sun_sky_map(64, 32)), costing(100));
+    const BinnedEnvMap map = build_bins(plain_map(test::sun_sky_map(64, 32)), costing(100));
     const BinnedEnvMapView view = map.view();
     const EnvMapView plain = map.plain().view();
     Rng rng(21);
@@ -156,7 +157,7 @@ TEST(Binned, APlainChoiceSamplesAndWeighsExactlyAsThePlainMapDoes) {
 }
 
 TEST(Binned, TablesMixingPlainAndCompensatedBinsFollowTheirPdf) {
-    const BinnedEnvMap map(plain_map(test::sun_sky_map(64, 32)), costing(1.5f));
+    const BinnedEnvMap map = build_bins(plain_map(test::sun_sky_map(64, 32)), costing(1.5f));
     const ChoiceCounts mixed = choice_counts(map, 1);
     ASSERT_GT(mixed.plain, 0u);
     ASSERT_GT(mixed.compensated, 0u);
@@ -197,14 +198,14 @@ void expect_batch_bit_identical(const BinnedEnvMapView& view) {
 TEST(Binned, BatchCallsAreBitIdenticalToSingleCalls) {
     ENVMIS_SKIP_IF_FORCED_PATH_UNAVAILABLE();
     for (float cost : {1.0f, 1.5f}) {  // compensated bins; plain and compensated ones mixed
-        const BinnedEnvMap map(plain_map(test::sun_sky_map(64, 32)), costing(cost));
+        const BinnedEnvMap map = build_bins(plain_map(test::sun_sky_map(64, 32)), costing(cost));
         expect_batch_bit_identical(map.view());
     }
 }
 
 TEST(Binned, RebuildingFromTheLayoutIsBitIdentical) {
     const EnvMap plain = plain_map(test::sun_sky_map(96, 48));
-    const BinnedEnvMap built(plain);
+    const BinnedEnvMap built = build_bins(plain);
     const BinnedEnvMap rebuilt(plain, built.layout());
     Rng rng(12);
     for (int i = 0; i < 2000; ++i) {
@@ -239,7 +240,7 @@ TEST(Binned, NormalsFindTheirOctahedralBin) {
 
 TEST(Binned, TheDiffuseClassHasItsOwnFinerGridOfNormals) {
     const EnvMap plain = plain_map(test::sun_sky_map(64, 32));
-    const BinnedEnvMap defaults{EnvMap(plain)};
+    const BinnedEnvMap defaults = build_bins(EnvMap(plain));
     EXPECT_EQ(defaults.layout().bins_per_side, 11u);
     EXPECT_EQ(defaults.layout().diffuse_bins_per_side, 21u);
     EXPECT_EQ(defaults.layout().choices.size(), 21u * 21 + 2 * 11 * 11);
@@ -255,12 +256,12 @@ TEST(Binned, TheDiffuseClassHasItsOwnFinerGridOfNormals) {
     BinnedOptions o;
     o.bins_per_side = 5;
     o.diffuse_bins_per_side = 3;
-    const BinnedEnvMap chosen{EnvMap(plain), o};
+    const BinnedEnvMap chosen = build_bins(EnvMap(plain), o);
     EXPECT_EQ(chosen.diffuse_bins(), 9u);
     EXPECT_EQ(chosen.bins(), 25u);
     EXPECT_EQ(BinnedEnvMap(EnvMap(plain), chosen.layout()).layout().choices.size(), 9u + 2 * 25);
     o.diffuse_bins_per_side = 65;
-    EXPECT_THROW(BinnedEnvMap(EnvMap(plain), o), std::invalid_argument);
+    EXPECT_THROW(build_bins(EnvMap(plain), o), std::invalid_argument);
     EXPECT_EQ(diffuse_side(64), 64u);
     EXPECT_EQ(diffuse_side(1), 1u);
 }
@@ -278,7 +279,7 @@ TEST(Binned, LobeClassesPickTheNearestSharpness) {
 TEST(Binned, TinyBlackAndConstantMapsWork) {
     for (RgbImage image : {test::constant_map(1, 1, {1, 1, 1}), test::constant_map(3, 2, {0, 0, 0}),
                            test::constant_map(5, 3, {2, 2, 2}), test::random_map(2, 1, 9)}) {
-        const BinnedEnvMap map(plain_map(image));
+        const BinnedEnvMap map = build_bins(plain_map(image));
         const BinnedEnvMapView view = map.view();
         Rng rng(1);
         for (Vec3 n : test_normals(map.layout().side(0))) {
@@ -315,7 +316,7 @@ void expect_finite_everywhere(const BinnedEnvMap& map, uint64_t seed, const std:
 TEST(Binned, BlackTexelsBesideLitOnesInOneCellGetPdfZeroNotNaN) {
     // Lit in one row of a cell and black in the next: the black row's segment has no
     // plain mass (0 / 0 before).
-    const BinnedEnvMap one(plain_map(test::single_texel_map(64, 32, 10, 3)));
+    const BinnedEnvMap one = build_bins(plain_map(test::single_texel_map(64, 32, 10, 3)));
     const BinnedEnvMapView view = one.view();  // the bin points into it
     const BinView bin = view.nearest_bin({0, 0, 1}, 0);
     for (uint32_t y = 0; y < 32; ++y)
@@ -324,9 +325,9 @@ TEST(Binned, BlackTexelsBesideLitOnesInOneCellGetPdfZeroNotNaN) {
             ASSERT_EQ(p > 0, x == 10 && y == 3) << x << "," << y << ": " << p;
         }
     expect_finite_everywhere(one, 1, "single texel");
-    expect_finite_everywhere(BinnedEnvMap(plain_map(test::softboxes_map(256, 128))), 2, "softboxes");
-    expect_finite_everywhere(BinnedEnvMap(plain_map(test::black_ground_map(128, 64, 3))), 3, "black ground");
-    expect_finite_everywhere(BinnedEnvMap(plain_map(test::black_ground_map(32, 32, 4), Mapping::equal_area)), 4,
+    expect_finite_everywhere(build_bins(plain_map(test::softboxes_map(256, 128))), 2, "softboxes");
+    expect_finite_everywhere(build_bins(plain_map(test::black_ground_map(128, 64, 3))), 3, "black ground");
+    expect_finite_everywhere(build_bins(plain_map(test::black_ground_map(32, 32, 4), Mapping::equal_area)), 4,
                              "black ground, equal-area");
 }
 
@@ -341,7 +342,7 @@ TEST(Binned, RandomSparseMapsNeverGiveANaNOrInfinitePdfOrSample) {
         BinnedOptions o;
         o.bins_per_side = 1 + static_cast<uint32_t>(rng.uniform() * 12);
         expect_finite_everywhere(
-            BinnedEnvMap(plain_map(image, mapping), o), k,
+            build_bins(plain_map(image, mapping), o), k,
             "sparse map " + std::to_string(k) + " (" + std::to_string(w) + " wide, lit " + std::to_string(lit) + ")");
     }
 }
@@ -383,26 +384,26 @@ TEST(Binned, PicksFollowTheBilinearWeightsWhichChangeWithoutSteps) {
 }
 
 TEST(Binned, RejectsCompensatedMapsAndInvalidOptionsAndLayouts) {
-    EXPECT_THROW(BinnedEnvMap(EnvMap(test::sun_sky_map(16, 8))), std::invalid_argument);
+    EXPECT_THROW(build_bins(EnvMap(test::sun_sky_map(16, 8))), std::invalid_argument);
     const EnvMap plain = plain_map(test::sun_sky_map(16, 8));
     BinnedOptions o;
     o.bins_per_side = 0;
-    EXPECT_THROW(BinnedEnvMap(plain, o), std::invalid_argument);
+    EXPECT_THROW(build_bins(plain, o), std::invalid_argument);
     o = {};
     o.lobe_exponents = {5, 20};
-    EXPECT_THROW(BinnedEnvMap(plain, o), std::invalid_argument);
+    EXPECT_THROW(build_bins(plain, o), std::invalid_argument);
     o = {};
     o.candidates = {-1};
-    EXPECT_THROW(BinnedEnvMap(plain, o), std::invalid_argument);
+    EXPECT_THROW(build_bins(plain, o), std::invalid_argument);
     for (float cost : {0.5f, 101.0f, std::nanf("")})
-        EXPECT_THROW(BinnedEnvMap(plain, costing(cost)), std::invalid_argument);
-    BinLayout layout = BinnedEnvMap(plain).layout();
+        EXPECT_THROW(build_bins(plain, costing(cost)), std::invalid_argument);
+    BinLayout layout = build_bins(plain).layout();
     layout.choices.pop_back();
     EXPECT_THROW(BinnedEnvMap(plain, layout), std::invalid_argument);
-    layout = BinnedEnvMap(plain).layout();
+    layout = build_bins(plain).layout();
     layout.cell_columns = 17;
     EXPECT_THROW(BinnedEnvMap(plain, layout), std::invalid_argument);
-    layout = BinnedEnvMap(plain).layout();
+    layout = build_bins(plain).layout();
     layout.choices[0] = {1, 0.3f};  // not on the histogram grid
     EXPECT_THROW(BinnedEnvMap(plain, layout), std::invalid_argument);
 }

@@ -11,6 +11,7 @@
 #include <limits>
 #include <vector>
 
+#include "envmis/build/bins.h"
 #include "envmis/build/table_writer.h"
 #include "envmis/math/hash.h"
 #include "envmis/table/table.h"
@@ -572,7 +573,7 @@ EnvMap plain_sky() {
 BinnedEnvMap small_binned(EnvMap plain) {
     BinnedOptions o;
     o.bins_per_side = 4;
-    return BinnedEnvMap(std::move(plain), o);
+    return build_bins(std::move(plain), o);
 }
 
 // `loaded` samples exactly as `expected`, for every lobe class and normals across all bins.

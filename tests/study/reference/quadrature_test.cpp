@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "envmis/build/bins.h"
 #include "envmis/study/reference/quadrature.h"
 #include "envmis/study/statistics/statistics.h"
 #include "envmis/study/techniques/estimator.h"
@@ -82,7 +83,7 @@ TEST(Quadrature, ExactVarianceMatchesMeasuredVariance) {
 // facing up and one facing down (another bin, another compensation) on the same map.
 TEST(Quadrature, ExactVarianceOfBinnedMisMatchesMeasuredVariance) {
     const RgbImage image = test::random_map(64, 32, 3, 1.5f);
-    const BinnedEnvMap binned{EnvMap(image, plain())};
+    const BinnedEnvMap binned = build_bins(EnvMap(image, plain()));
     const Technique t = Technique::parse("mis-balance-bins");
     const DirectLightingEstimator estimator(binned, t);
     for (const ShadingPoint& p : {ShadingPoint{normalize(Vec3{0.1f, 0.2f, 1}), normalize(Vec3{0.5f, 0, 1})},

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "envmis/build/bins.h"
 #include "envmis/io/image_io.h"
 #include "envmis/study/reference/quadrature.h"
 #include "envmis/study/statistics/statistics.h"
@@ -57,7 +58,7 @@ double standard_error(const BinnedEnvMap& binned, const Bsdf& bsdf, const Shadin
 }
 
 void expect_unbiased(const std::string& name, const EnvMap& plain, uint64_t seed) {
-    const BinnedEnvMap binned{EnvMap(plain)};
+    const BinnedEnvMap binned = build_bins(EnvMap(plain));
     for (const Bsdf& bsdf : kBsdfs)
         for (const ShadingPoint& p : points()) {
             const double reference = reflected_radiance(plain, bsdf, p, {1e-5, 32}).luminance;
@@ -92,7 +93,7 @@ TEST(BinnedEstimator, BatchesAreUnbiasedWithPlainAndCompensatedBinsMixed) {
     for (float cost : {1.5f, 100.0f}) {
         BinnedOptions options;
         options.cost = cost;
-        const BinnedEnvMap binned(EnvMap(plain), options);
+        const BinnedEnvMap binned = build_bins(EnvMap(plain), options);
         const DirectLightingEstimator estimator(binned, Technique::parse("mis-balance-bins"));
         for (const Bsdf& bsdf : kBsdfs)
             for (const ShadingPoint& p : points()) {
@@ -114,7 +115,7 @@ TEST(BinnedEstimator, BatchesAreUnbiasedWithPlainAndCompensatedBinsMixed) {
 TEST(BinnedEstimator, MapsWithBlackBesideLitGiveFiniteEstimatesNeverNaN) {
     for (const RgbImage& image : {test::single_texel_map(64, 32, 10, 3), test::softboxes_map(128, 64),
                                   test::black_ground_map(128, 64, 5), test::sparse_map(96, 48, 6, 0.01f)}) {
-        const BinnedEnvMap binned{plain_map(image)};
+        const BinnedEnvMap binned = build_bins(plain_map(image));
         Pcg32 rng(3);
         for (const Technique& t : bins_techniques()) {
             const DirectLightingEstimator estimator(binned, t);
@@ -148,13 +149,13 @@ TEST(BinnedEstimator, ManyEstimatesAtOnceEqualTheSameEstimatesOneAtATime) {
     for (float cost : {1.2f, 100.0f}) {  // some bins plain; every bin plain
         BinnedOptions options;
         options.cost = cost;
-        expect_batches_equal_single(BinnedEnvMap(plain_map(test::sun_sky_map(128, 64)), options));
+        expect_batches_equal_single(build_bins(plain_map(test::sun_sky_map(128, 64)), options));
     }
 }
 
 TEST(BinnedEstimator, ABinsTechniqueNeedsABinnedMapAndOthersRefuseOne) {
     const EnvMap plain = plain_map(test::sun_sky_map(64, 32));
-    const BinnedEnvMap binned{EnvMap(plain)};
+    const BinnedEnvMap binned = build_bins(EnvMap(plain));
     EXPECT_THROW(DirectLightingEstimator(plain, Technique::parse("mis-balance-bins")), std::invalid_argument);
     EXPECT_THROW(DirectLightingEstimator(binned, Technique::parse("mis-balance")), std::invalid_argument);
     EXPECT_THROW(DirectLightingEstimator(binned, Technique::parse("mis-balance-bins"), {0, 2}), std::invalid_argument);
@@ -165,7 +166,7 @@ TEST(BinnedEstimator, LobeClassFollowsTheBsdfsSharpness) {
     EXPECT_EQ(Bsdf::lambert().phong_exponent(), 0.0f);
     EXPECT_EQ(Bsdf::phong(200).phong_exponent(), 200.0f);
     EXPECT_NEAR(Bsdf::ggx(0.1f).phong_exponent(), 49.5f, 1e-2f);
-    const BinnedEnvMap binned{plain_map(test::sun_sky_map(64, 32))};
+    const BinnedEnvMap binned = build_bins(plain_map(test::sun_sky_map(64, 32)));
     EXPECT_EQ(binned.lobe_class(Bsdf::lambert().phong_exponent()), 0u);
     EXPECT_EQ(binned.lobe_class(Bsdf::phong(20).phong_exponent()), 1u);
     EXPECT_EQ(binned.lobe_class(Bsdf::ggx(0.1f).phong_exponent()), 1u);

@@ -1,6 +1,9 @@
-// The build of BinnedEnvMap (binned.h): geometry of bins and cells, cell histograms,
-// per-bin thresholds, the exact-variance choice of alpha, and the flat tables.
+// BinnedEnvMap (binned.h) from a layout: geometry of bins and cells, cell histograms and
+// masses (bin_cells.h), and the flat tables. The layout's choice is envmis::build's
+// (lib/build/src/bins.cpp).
 #include "envmis/sampling/binned.h"
+
+#include "envmis/sampling/bin_cells.h"
 
 #include <algorithm>
 #include <bit>
@@ -10,7 +13,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "binned_choice.h"
 #include "detail/luminance.h"
 #include "detail/parallel.h"
 #include "detail/pipeline.h"
@@ -169,12 +171,6 @@ float Geometry::weight(uint32_t bin, size_t cell, bool glossy) const noexcept {
     return std::max({typical, kFloor * b, glossy ? kGlossyFloor : 0.0f});
 }
 
-}  // namespace detail
-
-namespace {
-
-using detail::CellGrid;
-
 void check_options(const BinnedOptions& o) {
     if (o.bins_per_side < 1 || o.bins_per_side > 64)
         throw std::invalid_argument("bins per side must be 1 to 64, got " + std::to_string(o.bins_per_side));
@@ -200,38 +196,96 @@ void check_cells(uint32_t columns, uint32_t rows) {
                                     std::to_string(rows));
 }
 
-CellGrid grid_for(const EnvMap& plain, uint32_t columns) {
-    const uint32_t w = plain.width(), h = plain.height();
-    if (columns == 0) columns = std::clamp(w / 32, 1u, 128u);
-    if (columns > 4096)
-        throw std::invalid_argument("cell columns must be at most 4096, got " + std::to_string(columns));
-    const bool square = plain.options().mapping == Mapping::equal_area;
-    columns = std::min(columns, w);
-    const uint32_t rows = std::min(square ? columns : std::max(1u, columns / 2), h);
-    check_cells(columns, rows);
-    return CellGrid(w, h, columns, rows, plain.options().mapping);
+CellHistogram histogram(const EnvMap& plain, const CellGrid& grid, std::span<const float> thresholds, StopFlag stop) {
+    CellHistogram hist;
+    int64_t lo = std::numeric_limits<int64_t>::max(), hi = 0;
+    for (float t : thresholds) {
+        const int64_t id = std::bit_cast<uint32_t>(t) >> kHistogramShift;
+        if (t > 0) lo = std::min(lo, id), hi = std::max(hi, id);
+    }
+    hist.first = lo > hi ? 0 : lo;
+    hist.buckets = lo > hi ? 1 : static_cast<uint32_t>(hi - lo + 2);
+    const size_t cells = size_t{grid.cw} * grid.ch, b = hist.buckets;
+    hist.suffix_l.assign(cells * b, 0);
+    hist.suffix_w.assign(cells * b, 0);
+    hist.total_l.assign(cells, 0);
+    hist.max_l.assign(cells, 0);
+    const Rgb* pixels = plain.radiance().pixels.data();
+    const LumaCoefficients luma = plain.options().luma;
+    parallel_for(grid.ch, 1, stop, [&](uint32_t r0, uint32_t r1) {
+        for (uint32_t cy = r0; cy < r1; ++cy)
+            for (uint32_t y = grid.row_edges[cy]; y < grid.row_edges[cy + 1]; ++y) {
+                const double w = row_weight(grid.mapping, y, grid.h);
+                for (uint32_t cx = 0; cx < grid.cw; ++cx) {
+                    const size_t cell = size_t{cy} * grid.cw + cx;
+                    for (uint32_t x = grid.column_edges[cx]; x < grid.column_edges[cx + 1]; ++x) {
+                        const float l = texel_luminance(pixels[size_t{y} * grid.w + x], luma);
+                        if (!(l > 0)) continue;
+                        hist.total_l[cell] += l * w;
+                        hist.max_l[cell] = std::max(hist.max_l[cell], l);
+                        const int64_t k =
+                            static_cast<int64_t>(std::bit_cast<uint32_t>(l) >> kHistogramShift) - hist.first;
+                        if (k < 0) continue;
+                        const size_t at = cell * b + static_cast<size_t>(std::min<int64_t>(k, b - 1));
+                        hist.suffix_l[at] += l * w;
+                        hist.suffix_w[at] += w;
+                    }
+                }
+            }
+        for (size_t cell = size_t{r0} * grid.cw; cell < size_t{r1} * grid.cw; ++cell)
+            for (size_t k = b - 1; k-- > 0;) {
+                hist.suffix_l[cell * b + k] += hist.suffix_l[cell * b + k + 1];
+                hist.suffix_w[cell * b + k] += hist.suffix_w[cell * b + k + 1];
+            }
+    });
+    return hist;
 }
 
-}  // namespace
+std::vector<std::vector<float>> bin_masses(const EnvMap& plain, const CellGrid& grid, const Geometries& geometries,
+                                           const BinLayout& layout, StopFlag stop) {
+    std::vector<float> thresholds;
+    for (const BinChoice& c : layout.choices) thresholds.push_back(c.plain() ? 0.0f : c.threshold);
+    const CellHistogram hist = histogram(plain, grid, thresholds, stop);
+    const size_t cells = size_t{grid.cw} * grid.ch;
+    std::vector<std::vector<float>> masses(layout.choices.size(), std::vector<float>(cells));
+    parallel_for(static_cast<uint32_t>(masses.size()), 1, stop, [&](uint32_t lo, uint32_t hi) {
+        for (uint32_t cb = lo; cb < hi; ++cb) {
+            const uint32_t c = layout.class_of(cb), b = static_cast<uint32_t>(cb - layout.first(c));
+            const BinChoice& choice = layout.choices[cb];
+            for (size_t cell = 0; cell < cells; ++cell) {
+                const double bound = choice.plain() ? 1.0 : geometries.of(c).weight(b, cell, c > 0);
+                const double s = hist.above(cell, choice.plain() ? 0.0f : choice.threshold);
+                const auto m = static_cast<float>(bound * s);
+                masses[cb][cell] = bound > 0 && s > 0 ? std::max(m, std::numeric_limits<float>::min()) : 0.0f;
+            }
+        }
+    });
+    return masses;
+}
 
-BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinnedOptions& options, StopFlag stop) : plain_(std::move(plain)) {
-    if (plain_.options().compensation.enabled && plain_.stats().fallback == DensityFallback::none)
-        throw std::invalid_argument("a binned map is built over the plain (uncompensated) map");
-    check_options(options);
-    const auto started = std::chrono::steady_clock::now();
-    const CellGrid grid = grid_for(plain_, options.cell_columns);
-    layout_.bins_per_side = options.bins_per_side;
-    layout_.diffuse_bins_per_side =
-        options.diffuse_bins_per_side ? options.diffuse_bins_per_side : diffuse_side(options.bins_per_side);
-    layout_.cell_columns = grid.cw, layout_.cell_rows = grid.ch;
-    layout_.lobe_exponents = options.lobe_exponents;
-    const detail::Geometries geometries(plain_, grid, layout_);
-    layout_.choices = detail::choose_bins(plain_, grid, geometries, layout_, options, stop);
-    choice_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+}  // namespace detail
+
+using detail::CellGrid;
+
+BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinLayout& layout, StopFlag stop, double choice_seconds)
+    : plain_(std::move(plain)), layout_(layout), choice_seconds_(choice_seconds) {
+    check_layout();
+    const CellGrid grid(plain_.width(), plain_.height(), layout_.cell_columns, layout_.cell_rows,
+                        plain_.options().mapping);
+    build(detail::bin_masses(plain_, grid, detail::Geometries(plain_, grid, layout_), layout_, stop), stop);
+}
+
+BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinLayout& layout, const detail::Geometries& geometries, StopFlag stop,
+                           double choice_seconds)
+    : plain_(std::move(plain)), layout_(layout), choice_seconds_(choice_seconds) {
+    check_layout();
+    const CellGrid grid(plain_.width(), plain_.height(), layout_.cell_columns, layout_.cell_rows,
+                        plain_.options().mapping);
     build(detail::bin_masses(plain_, grid, geometries, layout_, stop), stop);
 }
 
-BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinLayout& layout) : plain_(std::move(plain)), layout_(layout) {
+void BinnedEnvMap::check_layout() const {
+    const BinLayout& layout = layout_;
     const uint32_t g = layout.bins_per_side, gd = layout.diffuse_bins_per_side, w = plain_.width(), h = plain_.height();
     if (g < 1 || g > 64 || gd < 1 || gd > 64 || layout.cell_columns < 1 || layout.cell_columns > std::min(w, 4096u) ||
         layout.cell_rows < 1 || layout.cell_rows > h)
@@ -239,10 +293,10 @@ BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinLayout& layout) : plain_(std::
                                     " glossy bins per side, " + std::to_string(layout.cell_columns) + "x" +
                                     std::to_string(layout.cell_rows) + " cells does not fit a " + std::to_string(w) +
                                     "x" + std::to_string(h) + " map");
-    check_cells(layout.cell_columns, layout.cell_rows);
+    detail::check_cells(layout.cell_columns, layout.cell_rows);
     BinnedOptions check;
     check.lobe_exponents = layout.lobe_exponents;
-    check_options(check);
+    detail::check_options(check);
     if (layout.choices.size() != layout.choice_count())
         throw std::invalid_argument("bin layout: " + std::to_string(layout.choices.size()) + " choices for " +
                                     std::to_string(layout.choice_count()) + " bins");
@@ -250,8 +304,6 @@ BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinLayout& layout) : plain_(std::
         if (!(std::isfinite(c.alpha) && c.threshold >= 0 && std::isfinite(c.threshold) &&
               detail::on_histogram_edge(c.threshold)))
             throw std::invalid_argument("bin layout: invalid alpha or threshold");
-    const CellGrid grid(w, h, layout.cell_columns, layout.cell_rows, plain_.options().mapping);
-    build(detail::bin_masses(plain_, grid, detail::Geometries(plain_, grid, layout_), layout_), nullptr);
 }
 
 void BinnedEnvMap::build(const std::vector<std::vector<float>>& masses, StopFlag stop) {

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "envmis/build/bins.h"
 #include "envmis/study/shading/frame.h"
 #include "envmis/study/statistics/statistics.h"
 
@@ -296,7 +297,7 @@ Comparison compare(const StudyInputs& inputs, const RunControl& control) {
     const size_t runs = inputs.compensated.maps.size();
     // Callers that only name the techniques get the default bins.
     std::optional<BinnedEnvMap> own_bins;
-    if (!inputs.binned && uses_bins(options.techniques)) own_bins.emplace(EnvMap(inputs.plain));
+    if (!inputs.binned && uses_bins(options.techniques)) own_bins.emplace(build_bins(EnvMap(inputs.plain)));
     const BinnedEnvMap* binned = inputs.binned ? inputs.binned : (own_bins ? &*own_bins : nullptr);
     std::vector<std::optional<BsdfComparison>> slots(options.bsdfs.size());
     Comparison merged{{}, inputs.points.size(), inputs.points.size()};

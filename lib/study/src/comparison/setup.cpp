@@ -1,4 +1,5 @@
 #include "envmis/study/comparison/setup.h"
+#include "envmis/build/bins.h"
 
 #include <algorithm>
 #include <cmath>
@@ -59,7 +60,7 @@ std::shared_ptr<const BinnedEnvMap> study_bins(const EnvMap& plain, uint32_t g, 
     options.auto_alpha = !request.bin_alpha;
     options.alpha = request.bin_alpha.value_or(options.alpha);
     options.cost = request.bin_cost;
-    return std::make_shared<const BinnedEnvMap>(EnvMap(plain), options, stop);
+    return std::make_shared<const BinnedEnvMap>(build_bins(EnvMap(plain), options, stop));
 }
 
 }  // namespace

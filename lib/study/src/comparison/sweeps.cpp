@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "envmis/build/bins.h"
 #include "envmis/study/comparison/alpha.h"
 
 namespace envmis {
@@ -116,7 +117,7 @@ AlphaSweep run_alpha_sweep(const StudyInputs& inputs, std::span<const float> alp
             }
             bins.auto_alpha = false;
             bins.alpha = alphas[i];
-            binned.emplace(EnvMap(inputs.plain), bins);
+            binned.emplace(build_bins(EnvMap(inputs.plain), bins));
         }
         Comparison c = compare({inputs.plain, compensated, points, sweep_options(options), binned ? &*binned : nullptr},
                                run_control(control, i, alphas.size(), points.size()));

@@ -392,17 +392,23 @@ ENVMIS_CORE_API void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, Dir
 ENVMIS_CORE_API void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axes, const float* choices,
                                  PointArrays in, SampleArrays out, uint32_t n) noexcept;
 
+namespace detail {
+struct Geometries;  // bin_cells.h
+}
+
 class ENVMIS_CORE_API BinnedEnvMap {
 public:
     BinnedEnvMap() = default;
-    // Builds the bins over `plain`, which must be uncompensated (its density is the
-    // texel level of every bin). Throws std::invalid_argument for a compensated map or
-    // invalid options; throws Interrupted once `stop` is set (interrupt.h; checked every
-    // bin and block of rows).
-    BinnedEnvMap(EnvMap plain, const BinnedOptions& options = {}, StopFlag stop = nullptr);
-    // Rebuilds the bins a layout describes (a table's), bit-identical to the build that
-    // chose it. Throws std::invalid_argument on a layout that does not fit the map.
-    BinnedEnvMap(EnvMap plain, const BinLayout& layout);
+    // Builds the bins a layout describes over `plain` (a table's layout, or the one
+    // envmis::build chose: envmis/build/bins.h), bit-identical to the build that chose
+    // it; choice_seconds is what choosing it took (choice_seconds()). Throws
+    // std::invalid_argument on a layout that does not fit the map; throws Interrupted once
+    // `stop` is set (interrupt.h; checked every bin and block of rows).
+    BinnedEnvMap(EnvMap plain, const BinLayout& layout, StopFlag stop = nullptr, double choice_seconds = 0);
+    // The same with the cells' geometry over `plain` that the choice computed
+    // (bin_cells.h; build_bins passes it rather than have it computed twice).
+    BinnedEnvMap(EnvMap plain, const BinLayout& layout, const detail::Geometries& geometries, StopFlag stop,
+                 double choice_seconds);
 
     BinnedEnvMapView view() const noexcept;
     const EnvMap& plain() const noexcept { return plain_; }
@@ -423,6 +429,8 @@ public:
     double choice_seconds() const noexcept { return choice_seconds_; }
 
 private:
+    // Throws std::invalid_argument where layout_ does not fit plain_.
+    void check_layout() const;
     void build(const std::vector<std::vector<float>>& masses, StopFlag stop);
 
     EnvMap plain_;

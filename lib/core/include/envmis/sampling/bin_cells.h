@@ -1,18 +1,25 @@
-// Private parts of the binned build (binned.h): the cell grid and its geometry, the
-// per-bin thresholds and alphas, and the cell masses of every (class, bin).
+// The cells and bins of a normal-aware map (binned.h), shared by the build that chooses
+// each bin's threshold (envmis::build, envmis/build/bins.h) and the load that rebuilds a
+// table's bins from its layout (BinnedEnvMap(plain, layout)): the cell grid and its
+// geometry, the luminance histograms the thresholds are rounded to, and the cell masses
+// of every (class, bin). Not an API for renderers; its names sit in envmis::detail.
 #pragma once
 
+#include <algorithm>
 #include <bit>
 #include <cstdint>
+#include <span>
 #include <vector>
 
+#include "envmis/core_export.h"
+#include "envmis/interrupt.h"
 #include "envmis/sampling/binned.h"
 
 namespace envmis::detail {
 
 // A w x h map cut into cw x ch cells; cell column c holds texel columns
 // [column_edges[c], column_edges[c + 1]), the same as floor(x cw / w) == c.
-struct CellGrid {
+struct ENVMIS_CORE_API CellGrid {
     uint32_t w, h, cw, ch;
     Mapping mapping;
     std::vector<uint32_t> column_edges, row_edges;
@@ -23,7 +30,7 @@ struct CellGrid {
 // Canonical directions and angular radii (upper bounds) of the cells and the bins: a
 // bin's own square, and its blend support (normal_blend: the normals that may pick it,
 // those of its own and its eight neighbours' squares).
-struct Geometry {
+struct ENVMIS_CORE_API Geometry {
     // cell_light: where a cell's light comes from, the normalised sum of its texels'
     // directions weighted by luminance times solid angle (its centre where it is black).
     std::vector<Vec3> cell_direction, cell_light, bin_normal;
@@ -63,16 +70,42 @@ inline bool on_histogram_edge(float t) noexcept {
     return (std::bit_cast<uint32_t>(t) & ((1u << kHistogramShift) - 1)) == 0;
 }
 
-// The choice of every (class, bin), class-major, for the grids and classes of `shape`
-// (its choices unused), as BinnedOptions asks. Both builds throw Interrupted once `stop`
-// is set (interrupt.h).
-std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, const Geometries& geometries,
-                                   const BinLayout& shape, const BinnedOptions& options, StopFlag stop);
+// Per cell, over its texels: sums of L w (w: the texel's relative solid angle, as the
+// plain density has it) and of w by histogram bucket, as suffix sums (bucket k holds
+// every texel of bucket k and above), the plain mass and the largest luminance.
+struct CellHistogram {
+    int64_t first = 0;     // bucket id of index 0
+    uint32_t buckets = 0;  // per cell; the last gathers every texel above
+    std::vector<double> suffix_l, suffix_w, total_l;
+    std::vector<float> max_l;
+
+    // Sum over the cell of max(L - t, 0) w, for t = 0 or a histogram edge in the window.
+    double above(size_t cell, float t) const noexcept {
+        if (t == 0) return total_l[cell];
+        const auto k = static_cast<int64_t>(std::bit_cast<uint32_t>(t) >> kHistogramShift) - first;
+        const size_t at = cell * buckets + static_cast<size_t>(std::clamp<int64_t>(k, 0, buckets - 1));
+        const double s = suffix_l[at] - static_cast<double>(t) * suffix_w[at];
+        // A texel above t must keep the cell's mass positive, whatever the rounding.
+        return max_l[cell] > t ? std::max(s, static_cast<double>(max_l[cell] - t) * 1e-30) : std::max(s, 0.0);
+    }
+};
+
+// The histograms of the cells, with a window of buckets from the lowest to the highest of
+// `thresholds` (positive histogram edges; at most 512 buckets). Throws Interrupted once
+// `stop` is set (interrupt.h).
+ENVMIS_CORE_API CellHistogram histogram(const EnvMap& plain, const CellGrid& grid, std::span<const float> thresholds,
+                                        StopFlag stop);
+
+// Throw std::invalid_argument for options a build refuses, and for a grid of more cells
+// than a bin's CDF can name (uint16 guide entries: at most 65536).
+ENVMIS_CORE_API void check_options(const BinnedOptions& options);
+ENVMIS_CORE_API void check_cells(uint32_t columns, uint32_t rows);
 
 // The cell masses (cw ch floats) of every (class, bin) of the layout: the weight times the sum
 // over the cell of max(L - threshold, 0) times the texels' relative solid angle, or the
 // plain mass for a plain choice. Deterministic: the same for any number of threads.
-std::vector<std::vector<float>> bin_masses(const EnvMap& plain, const CellGrid& grid, const Geometries& geometries,
-                                           const BinLayout& layout, StopFlag stop = nullptr);
+ENVMIS_CORE_API std::vector<std::vector<float>> bin_masses(const EnvMap& plain, const CellGrid& grid,
+                                                           const Geometries& geometries, const BinLayout& layout,
+                                                           StopFlag stop = nullptr);
 
 }  // namespace envmis::detail

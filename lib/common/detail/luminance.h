@@ -1,6 +1,6 @@
-// Private to envmis::core: the luminance that the density builds (envmap.cpp, the bins'
-// histograms in binned_choice.cpp) take from a repaired pixel, one definition so that
-// both read the same value from the same texel.
+// Private to envmis::core and envmis::build: the luminance that the density builds
+// (envmap.cpp), the bins' histograms (binned.cpp) and the bins' choice (bins.cpp) take
+// from a repaired pixel, one definition so that all read the same value from a texel.
 #pragma once
 
 #include <algorithm>

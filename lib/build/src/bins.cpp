@@ -1,81 +1,22 @@
-#include "binned_choice.h"
+// The bins' build (envmis/build/bins.h): the grid for the options, the choice of every
+// bin's threshold by exact variance, and the map built from the layout.
+#include "envmis/build/bins.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "detail/luminance.h"
 #include "detail/parallel.h"
+#include "envmis/sampling/bin_cells.h"
 
-namespace envmis::detail {
+namespace envmis {
 namespace {
 
-// Per cell, over its texels: sums of L w (w: the texel's relative solid angle, as the
-// plain density has it) and of w by histogram bucket, as suffix sums (bucket k holds
-// every texel of bucket k and above), the plain mass and the largest luminance.
-struct CellHistogram {
-    int64_t first = 0;     // bucket id of index 0
-    uint32_t buckets = 0;  // per cell; the last gathers every texel above
-    std::vector<double> suffix_l, suffix_w, total_l;
-    std::vector<float> max_l;
-
-    // Sum over the cell of max(L - t, 0) w, for t = 0 or a histogram edge in the window.
-    double above(size_t cell, float t) const noexcept {
-        if (t == 0) return total_l[cell];
-        const auto k = static_cast<int64_t>(std::bit_cast<uint32_t>(t) >> kHistogramShift) - first;
-        const size_t at = cell * buckets + static_cast<size_t>(std::clamp<int64_t>(k, 0, buckets - 1));
-        const double s = suffix_l[at] - static_cast<double>(t) * suffix_w[at];
-        // A texel above t must keep the cell's mass positive, whatever the rounding.
-        return max_l[cell] > t ? std::max(s, static_cast<double>(max_l[cell] - t) * 1e-30) : std::max(s, 0.0);
-    }
-};
-
-// The histograms of the cells, with a window of buckets from the lowest to the highest of
-// `thresholds` (positive histogram edges; at most 512 buckets, see clamp_thresholds).
-CellHistogram histogram(const EnvMap& plain, const CellGrid& grid, std::span<const float> thresholds, StopFlag stop) {
-    CellHistogram hist;
-    int64_t lo = std::numeric_limits<int64_t>::max(), hi = 0;
-    for (float t : thresholds) {
-        const int64_t id = std::bit_cast<uint32_t>(t) >> kHistogramShift;
-        if (t > 0) lo = std::min(lo, id), hi = std::max(hi, id);
-    }
-    hist.first = lo > hi ? 0 : lo;
-    hist.buckets = lo > hi ? 1 : static_cast<uint32_t>(hi - lo + 2);
-    const size_t cells = size_t{grid.cw} * grid.ch, b = hist.buckets;
-    hist.suffix_l.assign(cells * b, 0);
-    hist.suffix_w.assign(cells * b, 0);
-    hist.total_l.assign(cells, 0);
-    hist.max_l.assign(cells, 0);
-    const Rgb* pixels = plain.radiance().pixels.data();
-    const LumaCoefficients luma = plain.options().luma;
-    parallel_for(grid.ch, 1, stop, [&](uint32_t r0, uint32_t r1) {
-        for (uint32_t cy = r0; cy < r1; ++cy)
-            for (uint32_t y = grid.row_edges[cy]; y < grid.row_edges[cy + 1]; ++y) {
-                const double w = row_weight(grid.mapping, y, grid.h);
-                for (uint32_t cx = 0; cx < grid.cw; ++cx) {
-                    const size_t cell = size_t{cy} * grid.cw + cx;
-                    for (uint32_t x = grid.column_edges[cx]; x < grid.column_edges[cx + 1]; ++x) {
-                        const float l = texel_luminance(pixels[size_t{y} * grid.w + x], luma);
-                        if (!(l > 0)) continue;
-                        hist.total_l[cell] += l * w;
-                        hist.max_l[cell] = std::max(hist.max_l[cell], l);
-                        const int64_t k =
-                            static_cast<int64_t>(std::bit_cast<uint32_t>(l) >> kHistogramShift) - hist.first;
-                        if (k < 0) continue;
-                        const size_t at = cell * b + static_cast<size_t>(std::min<int64_t>(k, b - 1));
-                        hist.suffix_l[at] += l * w;
-                        hist.suffix_w[at] += w;
-                    }
-                }
-            }
-        for (size_t cell = size_t{r0} * grid.cw; cell < size_t{r1} * grid.cw; ++cell)
-            for (size_t k = b - 1; k-- > 0;) {
-                hist.suffix_l[cell * b + k] += hist.suffix_l[cell * b + k + 1];
-                hist.suffix_w[cell * b + k] += hist.suffix_w[cell * b + k + 1];
-            }
-    });
-    return hist;
-}
+using namespace detail;
 
 // Node grid for the choice: each cell cut into k x k nodes, at most kNodeColumns wide.
 // The brightest texels (at least kHotShare of the brightest, at most kMaxHotTexels of
@@ -257,8 +198,6 @@ std::vector<WeightedNormal> bin_samples(uint32_t bin, uint32_t g) {
     return samples;
 }
 
-}  // namespace
-
 std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, const Geometries& geometries,
                                    const BinLayout& shape, const BinnedOptions& options, StopFlag stop) {
     const Nodes nodes = nodes_of(plain, grid, stop);
@@ -326,26 +265,56 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
     return choices;
 }
 
-std::vector<std::vector<float>> bin_masses(const EnvMap& plain, const CellGrid& grid, const Geometries& geometries,
-                                           const BinLayout& layout, StopFlag stop) {
-    std::vector<float> thresholds;
-    for (const BinChoice& c : layout.choices) thresholds.push_back(c.plain() ? 0.0f : c.threshold);
-    const CellHistogram hist = histogram(plain, grid, thresholds, stop);
-    const size_t cells = size_t{grid.cw} * grid.ch;
-    std::vector<std::vector<float>> masses(layout.choices.size(), std::vector<float>(cells));
-    parallel_for(static_cast<uint32_t>(masses.size()), 1, stop, [&](uint32_t lo, uint32_t hi) {
-        for (uint32_t cb = lo; cb < hi; ++cb) {
-            const uint32_t c = layout.class_of(cb), b = static_cast<uint32_t>(cb - layout.first(c));
-            const BinChoice& choice = layout.choices[cb];
-            for (size_t cell = 0; cell < cells; ++cell) {
-                const double bound = choice.plain() ? 1.0 : geometries.of(c).weight(b, cell, c > 0);
-                const double s = hist.above(cell, choice.plain() ? 0.0f : choice.threshold);
-                const auto m = static_cast<float>(bound * s);
-                masses[cb][cell] = bound > 0 && s > 0 ? std::max(m, std::numeric_limits<float>::min()) : 0.0f;
-            }
-        }
-    });
-    return masses;
+// The cell grid for the options over `plain`, after the checks every build makes.
+CellGrid grid_for(const EnvMap& plain, const BinnedOptions& options) {
+    if (plain.options().compensation.enabled && plain.stats().fallback == DensityFallback::none)
+        throw std::invalid_argument("a binned map is built over the plain (uncompensated) map");
+    check_options(options);
+    const uint32_t w = plain.width(), h = plain.height();
+    uint32_t columns = options.cell_columns;
+    if (columns == 0) columns = std::clamp(w / 32, 1u, 128u);
+    if (columns > 4096)
+        throw std::invalid_argument("cell columns must be at most 4096, got " + std::to_string(columns));
+    const bool square = plain.options().mapping == Mapping::equal_area;
+    columns = std::min(columns, w);
+    const uint32_t rows = std::min(square ? columns : std::max(1u, columns / 2), h);
+    check_cells(columns, rows);
+    return CellGrid(w, h, columns, rows, plain.options().mapping);
 }
 
-}  // namespace envmis::detail
+// The layout's grids and classes, its choices not yet made.
+BinLayout shape_of(const BinnedOptions& options, const CellGrid& grid) {
+    BinLayout layout;
+    layout.bins_per_side = options.bins_per_side;
+    layout.diffuse_bins_per_side =
+        options.diffuse_bins_per_side ? options.diffuse_bins_per_side : diffuse_side(options.bins_per_side);
+    layout.cell_columns = grid.cw, layout.cell_rows = grid.ch;
+    layout.lobe_exponents = options.lobe_exponents;
+    return layout;
+}
+
+// The layout over `grid` with its geometries, as choose_bin_layout documents.
+BinLayout choose_layout(const EnvMap& plain, const BinnedOptions& options, const CellGrid& grid,
+                        const Geometries& geometries, StopFlag stop) {
+    BinLayout layout = shape_of(options, grid);
+    layout.choices = choose_bins(plain, grid, geometries, layout, options, stop);
+    return layout;
+}
+
+}  // namespace
+
+BinLayout choose_bin_layout(const EnvMap& plain, const BinnedOptions& options, StopFlag stop) {
+    const CellGrid grid = grid_for(plain, options);
+    return choose_layout(plain, options, grid, Geometries(plain, grid, shape_of(options, grid)), stop);
+}
+
+BinnedEnvMap build_bins(EnvMap plain, const BinnedOptions& options, StopFlag stop) {
+    const auto started = std::chrono::steady_clock::now();
+    const CellGrid grid = grid_for(plain, options);
+    const Geometries geometries(plain, grid, shape_of(options, grid));
+    const BinLayout layout = choose_layout(plain, options, grid, geometries, stop);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    return BinnedEnvMap(std::move(plain), layout, geometries, stop, seconds);
+}
+
+}  // namespace envmis
