@@ -173,9 +173,10 @@ Rgb direct_lighting(const Density& env, const Scene& scene, const Hit& hit, Vec3
     if (technique != Technique::bsdf) {
         const envmis::EnvSample light = env.sample(rng.uniform2());  // world direction, solid-angle pdf
         const Vec3 wi = frame.to_local(light.direction);
-        const Rgb f = bsdf.eval(wo, wi);  // f * cos(theta_i)
+        const envmis::BsdfValues<float> b = bsdf.values(wo, wi);  // eval and pdf at once
+        const Rgb f{b.r, b.g, b.b};                               // f * cos(theta_i)
         if (light.pdf > 0 && !is_black(f) && !scene.occluded(hit, light.direction)) {
-            const float weight = technique == Technique::mis ? light.pdf / (light.pdf + bsdf.pdf(wo, wi)) : 1.0f;
+            const float weight = technique == Technique::mis ? light.pdf / (light.pdf + b.pdf) : 1.0f;
             result = result + light.radiance * f * (weight / light.pdf);
         }
     }

@@ -141,9 +141,10 @@ double exact_variance_with(const EnvMap& env, EnvPdf&& env_pdf, Technique techni
     const Vec3 wo = Frame::from_normal(point.normal).to_local(point.wo);
     const LumaCoefficients luma = env.options().luma;
     const Moments m = integrate<Moments>(env, point, subdivisions, stop, [&](Moments& acc, const Node& n) {
-        const double f = luminance(multiply(n.radiance, bsdf.eval(wo, n.wi)), luma);
+        const BsdfValues<float> b = bsdf.values(wo, n.wi);
+        const double f = luminance(multiply(n.radiance, Rgb{b.r, b.g, b.b}), luma);
         if (f == 0) return;
-        const double p_env = env_pdf(n.uv), p_bsdf = bsdf.pdf(wo, n.wi);
+        const double p_env = env_pdf(n.uv), p_bsdf = b.pdf;
         if (strategy == Strategy::one_sample) {
             // total() draws z = f / Q from the mixture Q / total: the estimate's variance
             // is integral f^2 / Q - (integral f)^2 / total. Kept in the env moments.
