@@ -7,9 +7,9 @@
 
 #include <algorithm>
 #include <bit>
-#include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -270,18 +270,14 @@ using detail::CellGrid;
 BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinLayout& layout, StopFlag stop, double choice_seconds)
     : plain_(std::move(plain)), layout_(layout), choice_seconds_(choice_seconds) {
     check_layout();
-    const CellGrid grid(plain_.width(), plain_.height(), layout_.cell_columns, layout_.cell_rows,
-                        plain_.options().mapping);
-    build(detail::bin_masses(plain_, grid, detail::Geometries(plain_, grid, layout_), layout_, stop), stop);
+    build(nullptr, stop);
 }
 
 BinnedEnvMap::BinnedEnvMap(EnvMap plain, const BinLayout& layout, const detail::Geometries& geometries, StopFlag stop,
                            double choice_seconds)
     : plain_(std::move(plain)), layout_(layout), choice_seconds_(choice_seconds) {
     check_layout();
-    const CellGrid grid(plain_.width(), plain_.height(), layout_.cell_columns, layout_.cell_rows,
-                        plain_.options().mapping);
-    build(detail::bin_masses(plain_, grid, geometries, layout_, stop), stop);
+    build(&geometries, stop);
 }
 
 void BinnedEnvMap::check_layout() const {
@@ -306,9 +302,12 @@ void BinnedEnvMap::check_layout() const {
             throw std::invalid_argument("bin layout: invalid alpha or threshold");
 }
 
-void BinnedEnvMap::build(const std::vector<std::vector<float>>& masses, StopFlag stop) {
+void BinnedEnvMap::build(const detail::Geometries* given, StopFlag stop) {
     const CellGrid grid(plain_.width(), plain_.height(), layout_.cell_columns, layout_.cell_rows,
                         plain_.options().mapping);
+    std::optional<detail::Geometries> own;
+    const detail::Geometries& geometries = given ? *given : own.emplace(plain_, grid, layout_);
+    const std::vector<std::vector<float>> masses = detail::bin_masses(plain_, grid, geometries, layout_, stop);
     column_edges_ = grid.column_edges;
     row_edges_ = grid.row_edges;
     plain_bins_.clear();

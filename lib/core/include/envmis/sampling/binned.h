@@ -431,7 +431,8 @@ public:
 private:
     // Throws std::invalid_argument where layout_ does not fit plain_.
     void check_layout() const;
-    void build(const std::vector<std::vector<float>>& masses, StopFlag stop);
+    // The flat tables over layout_'s cells, with the given geometry (null: computed here).
+    void build(const detail::Geometries* given, StopFlag stop);
 
     EnvMap plain_;
     BinLayout layout_;
