@@ -11,9 +11,11 @@
 #include <map>
 #include <random>
 #include <tuple>
+#include <type_traits>
 #include <vector>
 
 #include "envmis/build/bins.h"
+#include "envmis/build/env_map.h"
 #include "envmis/cpu.h"
 #include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"
@@ -53,6 +55,15 @@ envmis::EnvMapOptions options() {
 }
 envmis::EnvMapOptions plain_options() { return options<false>(); }
 
+// Either sampler from an image, as a renderer's set-up builds it.
+template <class Sampler>
+Sampler make_sampler(envmis::RgbImage image, const envmis::EnvMapOptions& options) {
+    if constexpr (std::is_same_v<Sampler, EnvMap>)
+        return envmis::build_env_map(std::move(image), options);
+    else
+        return Sampler(image, options);
+}
+
 template <class Sampler, bool kCompensated = true>
 void build(benchmark::State& state) {
     const envmis::RgbImage& image = sky(static_cast<uint32_t>(state.range(0)));
@@ -60,7 +71,7 @@ void build(benchmark::State& state) {
         state.PauseTiming();
         envmis::RgbImage copy = image;
         state.ResumeTiming();
-        Sampler s(std::move(copy), options<kCompensated>());
+        Sampler s = make_sampler<Sampler>(std::move(copy), options<kCompensated>());
         benchmark::DoNotOptimize(s);
     }
     state.counters["Mtexels/s"] = benchmark::Counter(
@@ -74,7 +85,7 @@ const TextbookEnvMap& hot_path(const TextbookEnvMap& map) { return map; }
 
 template <class Sampler, bool kCompensated = true>
 void sample(benchmark::State& state) {
-    const Sampler s(sky(static_cast<uint32_t>(state.range(0))), options<kCompensated>());
+    const Sampler s = make_sampler<Sampler>(sky(static_cast<uint32_t>(state.range(0))), options<kCompensated>());
     const auto& sampler = hot_path(s);
     const auto& us = uniforms();
     size_t i = 0;
@@ -89,7 +100,7 @@ void sample(benchmark::State& state) {
 // which it equals sample for sample; the compensated sky, whose sun rows are hot.
 template <bool kTuned>
 void distribution_sample(benchmark::State& state) {
-    const EnvMap map(sky(static_cast<uint32_t>(state.range(0))), options());
+    const EnvMap map = build_env_map(sky(static_cast<uint32_t>(state.range(0))), options());
     const envmis::Distribution2DView d = map.view().distribution;
     const auto& us = uniforms();
     size_t i = 0;
@@ -105,7 +116,7 @@ void distribution_sample(benchmark::State& state) {
 // plain search of cdf.h: what the tuning gives a renderer's single call.
 template <bool kTuned>
 void whole_sample(benchmark::State& state) {
-    const EnvMap map(sky(static_cast<uint32_t>(state.range(0))), options());
+    const EnvMap map = build_env_map(sky(static_cast<uint32_t>(state.range(0))), options());
     const EnvMapView view = map.view();
     const auto& us = uniforms();
     size_t i = 0;
@@ -153,7 +164,7 @@ void per_sample(benchmark::State& state, size_t n = kBatch) {
 
 template <bool kCompensated>
 void sample_batch(benchmark::State& state) {
-    const EnvMap map(sky(static_cast<uint32_t>(state.range(0))), options<kCompensated>());
+    const EnvMap map = build_env_map(sky(static_cast<uint32_t>(state.range(0))), options<kCompensated>());
     const EnvMapView view = map.view();
     const BatchPoints& p = batch_points();
     std::vector<float> out(7 * kBatch);
@@ -187,7 +198,7 @@ const std::vector<envmis::Vec3>& directions() {
 const envmis::BinnedEnvMap& binned(uint32_t w) {
     static std::map<uint32_t, envmis::BinnedEnvMap> maps;
     auto it = maps.find(w);
-    if (it == maps.end()) it = maps.emplace(w, envmis::build_bins(EnvMap(sky(w), plain_options()))).first;
+    if (it == maps.end()) it = maps.emplace(w, envmis::build_bins(build_env_map(sky(w), plain_options()))).first;
     return it->second;
 }
 
@@ -215,7 +226,7 @@ const std::vector<float>& choices() {
 }
 
 void build_bins(benchmark::State& state) {
-    const EnvMap plain(sky(static_cast<uint32_t>(state.range(0))), plain_options());
+    const EnvMap plain = build_env_map(sky(static_cast<uint32_t>(state.range(0))), plain_options());
     for (auto _ : state) {
         state.PauseTiming();
         EnvMap copy = plain;
@@ -267,7 +278,7 @@ void pdf_binned(benchmark::State& state) {
 
 template <class Sampler, bool kCompensated = true>
 void pdf(benchmark::State& state) {
-    const Sampler s(sky(static_cast<uint32_t>(state.range(0))), options<kCompensated>());
+    const Sampler s = make_sampler<Sampler>(sky(static_cast<uint32_t>(state.range(0))), options<kCompensated>());
     const auto& sampler = hot_path(s);
     const auto& ds = directions();
     size_t i = 0;
@@ -281,7 +292,7 @@ void pdf(benchmark::State& state) {
 void estimate(benchmark::State& state, const char* technique, envmis::Bsdf bsdf) {
     envmis::EnvMapOptions options;
     options.compensation.enabled = envmis::Technique::parse(technique).compensated;
-    const EnvMap map(sky(static_cast<uint32_t>(state.range(0))), options);
+    const EnvMap map = build_env_map(sky(static_cast<uint32_t>(state.range(0))), options);
     const envmis::DirectLightingEstimator estimator(map, envmis::Technique::parse(technique));
     const auto points = envmis::sphere_points(64);
     envmis::Pcg32 rng(5);
@@ -308,7 +319,7 @@ const EnvMap& mapped_sky(uint32_t w, uint32_t h, envmis::Mapping mapping, bool c
         envmis::EnvMapOptions o = options();
         o.compensation.enabled = compensated;
         o.mapping = mapping;
-        it = maps.emplace(key, EnvMap(envmis::reference::synthetic_sky(w, h, mapping, detail), o)).first;
+        it = maps.emplace(key, build_env_map(envmis::reference::synthetic_sky(w, h, mapping, detail), o)).first;
     }
     return it->second;
 }
@@ -397,7 +408,7 @@ void equal_area_over_equirect(benchmark::State& state) {
 // width, compensated.
 void lookup_over_line_reads(benchmark::State& state) {
     const auto w = static_cast<uint32_t>(state.range(0));
-    const EnvMap map(sky(w), state.range(1) != 0 ? options<true>() : plain_options());
+    const EnvMap map = build_env_map(sky(w), state.range(1) != 0 ? options<true>() : plain_options());
     const EnvMapView view = map.view();
     const envmis::Distribution2DView& d = view.distribution;
     const BatchPoints& p = batch_points();

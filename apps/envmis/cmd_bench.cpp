@@ -16,6 +16,7 @@
 
 #include "cli.h"
 #include "envmis/build/bins.h"
+#include "envmis/build/env_map.h"
 #include "envmis/cpu.h"
 #include "reference.h"
 
@@ -293,8 +294,8 @@ BenchResult measure(const RgbImage& image, const EnvMapOptions& options, const B
     Progress progress("bench", 3 * repeats);
     int step = 0;
     const auto [guided, guided_build] = build_repeatedly<EnvMap, RgbImage>(
-        image, repeats, [&](RgbImage& copy) { return EnvMap(std::move(copy), options, &interrupted()); }, progress,
-        step);
+        image, repeats, [&](RgbImage& copy) { return build_env_map(std::move(copy), options, &interrupted()); },
+        progress, step);
     const auto [textbook, textbook_build] = build_repeatedly<reference::TextbookEnvMap, RgbImage>(
         image, repeats, [&](RgbImage&) { return reference::TextbookEnvMap(image, options); }, progress, step);
     const CallTimes c = time_calls(*guided, *textbook, points, repeats, progress, step);
@@ -396,8 +397,8 @@ BinnedResult measure_binned(const RgbImage& image, const EnvMapOptions& mapped, 
         EnvMapOptions options = mapped;
         options.compensation.enabled = k == kCompensated;
         std::tie(today[k], result.build_ms[k]) = build_repeatedly<EnvMap, RgbImage>(
-            image, repeats, [&](RgbImage& copy) { return EnvMap(std::move(copy), options, &interrupted()); }, progress,
-            step);
+            image, repeats, [&](RgbImage& copy) { return build_env_map(std::move(copy), options, &interrupted()); },
+            progress, step);
         result.bytes[k] = static_cast<double>(today[k]->distribution().bytes()) +
                           static_cast<double>(sizeof(Rgb)) * image.width * image.height;
     }

@@ -16,6 +16,7 @@
 
 #include "cli.h"
 #include "envmis/build/atomic_file.h"
+#include "envmis/build/env_map.h"
 #include "envmis/io/image_io.h"
 #include "envmis/report/inputs.h"
 #include "envmis/report/results.h"
@@ -180,7 +181,8 @@ std::pair<EnvMap, float> load_plain(const CompareArgs& args, std::string& map_na
                                                          : 0.0f;
     EnvMapOptions plain_options = loaded.map.options();
     plain_options.compensation.enabled = false;
-    if (loaded.from_table) return {EnvMap(to_image(loaded.map.radiance()), plain_options, &interrupted()), fixed_alpha};
+    if (loaded.from_table)
+        return {build_env_map(to_image(loaded.map.radiance()), plain_options, &interrupted()), fixed_alpha};
     return {std::move(loaded.map), fixed_alpha};
 }
 

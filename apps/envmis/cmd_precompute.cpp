@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cli.h"
+#include "envmis/build/env_map.h"
 #include "library.h"
 
 namespace envmis::cli {
@@ -27,7 +28,7 @@ void print_compact_error(std::ostream& out, const EnvMap& map) {
         const double l = luminance(map.radiance().pixels[i], map.options().luma);
         if (l > 0) worst = std::max(worst, std::abs(luminance(rounded.pixels[i], map.options().luma) - l) / l);
     }
-    const std::vector<float> p = map.density(), q = EnvMap(rounded, map.options(), &interrupted()).density();
+    const std::vector<float> p = map.density(), q = build_env_map(rounded, map.options(), &interrupted()).density();
     double sum_p = 0, sum_q = 0, distance = 0;
     for (size_t i = 0; i < p.size(); ++i) sum_p += p[i], sum_q += q[i];
     for (size_t i = 0; i < p.size(); ++i) distance += std::abs(p[i] / sum_p - q[i] / sum_q);

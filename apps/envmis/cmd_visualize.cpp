@@ -13,6 +13,7 @@
 
 #include "cli.h"
 #include "envmis/build/bins.h"
+#include "envmis/build/env_map.h"
 #include "envmis/io/image_io.h"
 #include "envmis/pictures/picture.h"
 #include "envmis/study/shading/bsdf.h"
@@ -116,7 +117,7 @@ struct Densities {
 EnvMap opposite_density(const EnvMap& map) {
     EnvMapOptions options = map.options();
     options.compensation.enabled = !options.compensation.enabled;
-    return EnvMap(to_image(map.radiance()), options, &interrupted());
+    return build_env_map(to_image(map.radiance()), options, &interrupted());
 }
 
 // The picture and what the command says about it.

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_run.h"
+#include "envmis/build/env_map.h"
 #include "envmis/io/image_io.h"
 #include "envmis/study/reference/quadrature.h"
 #include "maps.h"
@@ -41,7 +42,7 @@ TEST(Compare, SinglePointVariancesMatchTheExactVariances) {
 
     EnvMapOptions plain_options;
     plain_options.compensation.enabled = false;
-    const EnvMap plain(image, plain_options), compensated(image);
+    const EnvMap plain = build_env_map(image, plain_options), compensated = build_env_map(image);
     const ShadingPoint point{normalize(Vec3{0.2f, -0.3f, 1}), normalize(Vec3{0.6f, 0.1f, 1})};
     ASSERT_EQ(results["results"].size(), 10u);
     for (const auto& r : results["results"]) {

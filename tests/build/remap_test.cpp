@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "envmis/build/env_map.h"
 #include "envmis/build/remap.h"
 #include "envmis/sampling/distribution.h"
 #include "envmis/study/reference/quadrature.h"
@@ -105,10 +106,10 @@ TEST(Remap, SmoothMapSurvivesARoundTrip) {
 // (which handles both mappings) agrees within the conversion's filtering.
 TEST(Remap, ConvertedMapGivesTheSameLighting) {
     const RgbImage sky = test::sun_sky_map(128, 64, 2e3f);
-    const EnvMap original(sky, {});
+    const EnvMap original = build_env_map(sky, {});
     EnvMapOptions o;
     o.mapping = Mapping::equal_area;
-    const EnvMap square(remap(sky, Mapping::equirect, Mapping::equal_area, 96, 96).image, o);
+    const EnvMap square = build_env_map(remap(sky, Mapping::equirect, Mapping::equal_area, 96, 96).image, o);
     for (const Vec3 n : {Vec3{0, 0, 1}, Vec3{0.6f, 0, 0.8f}, Vec3{0, -1, 0}})
         for (const Bsdf& bsdf : {Bsdf::lambert(), Bsdf::phong(20)}) {
             const ShadingPoint point{n, n};

@@ -31,7 +31,7 @@ foreach(foreign "envmis::Bsdf" "envmis::Frame" "envmis::Technique" "envmis::Dire
                 "envmis::compare" "envmis::choose_alpha" "envmis::io::" "envmis::pictures::" "Eigen::"
                 "envmis::write_table(" "envmis::rgbe_round(" "envmis::remap(" "envmis::AtomicFile"
                 "envmis::write_file_atomically(" "envmis::build_bins(" "envmis::choose_bin_layout("
-                "choose_bins(" "OpenImageIO" "OCIO" "Imf_")
+                "choose_bins(" "envmis::build_env_map(" "OpenImageIO" "OCIO" "Imf_")
   string(FIND "${symbols}" "${foreign}" at)
   if(NOT at EQUAL -1)
     message(FATAL_ERROR "libenvmis_core.a defines a symbol of another library: '${foreign}'")

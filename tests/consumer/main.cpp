@@ -5,9 +5,10 @@
 //        consumer_core WORK_FOLDER TABLE
 // consumer_build (envmis::core and envmis::build) builds a sampler from an image, saves it
 // as WORK_FOLDER/sky.envmis, loads it back and samples it. consumer_core (envmis::core
-// alone, a renderer) builds the same sampler and loads TABLE, the table consumer_build
-// wrote: both must sample alike. consumer_io also writes the image as EXR, loads it
-// through OpenImageIO and OpenColorIO ($OCIO: the installed config) and samples that.
+// alone, a renderer) loads TABLE, the table consumer_build wrote, copied and mapped: it
+// must hold the same sky, and both loads must sample alike. consumer_io also writes the
+// image as EXR, loads it through OpenImageIO and OpenColorIO ($OCIO: the installed
+// config) and samples that.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -122,12 +123,19 @@ int main(int argc, char** argv) {
     try {
         const std::filesystem::path work = argv[1];
         std::filesystem::create_directories(work);
-        const envmis::EnvMap map(sky(64, 32));
-        check(map.compensated() && !map.complete(), "the synthetic sky should be compensated and incomplete");
 #ifdef ENVMIS_CONSUMER_BUILD
+        const envmis::EnvMap map = envmis::build_env_map(sky(64, 32));
+        check(map.compensated() && !map.complete(), "the synthetic sky should be compensated and incomplete");
         check_map(map, work / "sky.envmis");
 #else
-        check_normalised(map);
+        const envmis::EnvMap map = envmis::read_table(argv[2], envmis::TableLoading::copy).map;
+        const envmis::RgbImage expected = sky(64, 32);
+        check(map.width() == expected.width && map.height() == expected.height, "the table is not the sky's size");
+        for (size_t i = 0; i < expected.pixels.size(); ++i)
+            check(map.radiance().pixels[i].r == expected.pixels[i].r &&
+                      map.radiance().pixels[i].b == expected.pixels[i].b,
+                  "the table's radiance is not the sky's at texel " + std::to_string(i));
+        check(map.compensated() && !map.complete(), "the synthetic sky should be compensated and incomplete");
         check_table(map, argv[2]);
 #endif
 #ifdef ENVMIS_CONSUMER_IO
@@ -139,7 +147,7 @@ int main(int argc, char** argv) {
         check(loaded.image.pixels[0].g == map.radiance().pixels[0].g, "the EXR round trip changed the pixels");
         envmis::EnvMapOptions options;
         options.luma = loaded.luma;
-        check_map(envmis::EnvMap(loaded.image, options), work / "sky_from_exr.envmis");
+        check_map(envmis::build_env_map(loaded.image, options), work / "sky_from_exr.envmis");
 #endif
     } catch (const std::exception& e) {
         std::fprintf(stderr, "%s: %s\n", argv[0], e.what());

@@ -8,11 +8,13 @@
 #include <cmath>
 #include <cstdio>
 
+#include "envmis/build/env_map.h"
 #include "envmis/study.h"
 
 int main() {
     const uint32_t w = 32, h = 16;
-    const envmis::EnvMap plain(envmis::RgbImage{w, h, envmis::RgbPixels(size_t{w} * h, {1, 1, 1})});
+    const envmis::EnvMap plain =
+        envmis::build_env_map(envmis::RgbImage{w, h, envmis::RgbPixels(size_t{w} * h, {1, 1, 1})});
     const envmis::DirectLightingEstimator estimator(plain, envmis::Technique::parse("mis-balance"));
     const envmis::Bsdf bsdf = envmis::Bsdf::parse("lambert");
     envmis::Pcg32 rng(7, 0);

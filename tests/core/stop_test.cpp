@@ -8,6 +8,7 @@
 #include <string>
 
 #include "envmis/build/bins.h"
+#include "envmis/build/env_map.h"
 #include "envmis/build/remap.h"
 #include "envmis/build/table_writer.h"
 #include "envmis/interrupt.h"
@@ -25,12 +26,13 @@ constexpr uint64_t kSeed = 7;
 
 TEST(StopFlag, ASetFlagStopsAnEnvMapBuild) {
     const std::atomic<bool> stop{true};
-    EXPECT_THROW(EnvMap(test::random_map(64, 32, kSeed), {}, &stop), Interrupted);
+    EXPECT_THROW(build_env_map(test::random_map(64, 32, kSeed), {}, &stop), Interrupted);
 }
 
 TEST(StopFlag, AClearFlagBuildsTheSameMapAsNone) {
     const std::atomic<bool> stop{false};
-    const EnvMap watched(test::random_map(64, 32, kSeed), {}, &stop), plain(test::random_map(64, 32, kSeed));
+    const EnvMap watched = build_env_map(test::random_map(64, 32, kSeed), {}, &stop),
+                 plain = build_env_map(test::random_map(64, 32, kSeed));
     EXPECT_EQ(watched.density(), plain.density());
     EXPECT_EQ(watched.stats().mean_luminance, plain.stats().mean_luminance);
 }
@@ -38,7 +40,7 @@ TEST(StopFlag, AClearFlagBuildsTheSameMapAsNone) {
 TEST(StopFlag, ASetFlagStopsABinnedBuild) {
     EnvMapOptions options;
     options.compensation.enabled = false;
-    const EnvMap plain(test::random_map(64, 32, kSeed), options);
+    const EnvMap plain = build_env_map(test::random_map(64, 32, kSeed), options);
     const std::atomic<bool> stop{true};
     EXPECT_THROW(build_bins(EnvMap(plain), BinnedOptions{}, &stop), Interrupted);
 }
@@ -53,7 +55,7 @@ TEST(StopFlag, ASetFlagStopsATableWriteAndLeavesNoFile) {
     const fs::path folder = fs::temp_directory_path() / ("envmis_stop_test_" + std::to_string(::getpid()));
     fs::remove_all(folder);
     fs::create_directories(folder);
-    const EnvMap map(test::random_map(64, 32, kSeed));
+    const EnvMap map = build_env_map(test::random_map(64, 32, kSeed));
     const std::atomic<bool> stop{true};
     EXPECT_THROW(write_table(folder / "map.envmis", map, {}, TableEncoding::full, &stop), Interrupted);
     EXPECT_TRUE(fs::is_empty(folder));

@@ -22,6 +22,7 @@
 #include <system_error>
 #include <utility>
 
+#include "envmis/build/env_map.h"
 #include "envmis/io/image_io.h"
 #include "envmis/sampling/envmap.h"
 
@@ -69,7 +70,7 @@ void load(const fs::path& file) {
         return;
     }
     try {
-        const envmis::EnvMap map(std::move(loaded.image));
+        const envmis::EnvMap map = envmis::build_env_map(std::move(loaded.image));
         sink = map.sample({0.37f, 0.61f}).pdf + static_cast<float>(map.stats().bad_pixels.total());
     } catch (const std::invalid_argument&) {
         // The one image a map refuses: finite pixels whose power overflows float.

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "envmis/build/bins.h"
+#include "envmis/build/env_map.h"
 #include "envmis/build/table_writer.h"
 
 namespace {
@@ -34,24 +35,24 @@ int main(int argc, char** argv) {
         std::filesystem::create_directories(dir);
         const envmis::TableSource source{"seed.exr", 0x1234, "lin_rec709", "lin_rec709", ""};
 
-        envmis::write_table(dir / "compensated_4x2.envmis", envmis::EnvMap(sky(4, 2)), source);
+        envmis::write_table(dir / "compensated_4x2.envmis", envmis::build_env_map(sky(4, 2)), source);
 
         envmis::EnvMapOptions plain;
         plain.compensation.enabled = false;
         plain.axes = envmis::Axes::parse("y-up");
-        envmis::write_table(dir / "uncompensated_16x8.envmis", envmis::EnvMap(sky(16, 8), plain), source);
+        envmis::write_table(dir / "uncompensated_16x8.envmis", envmis::build_env_map(sky(16, 8), plain), source);
 
         // A bins section, after a full and after a compact payload.
         envmis::BinnedOptions bins;
         bins.bins_per_side = 2;
         bins.cell_columns = 4;
-        const envmis::BinnedEnvMap binned = envmis::build_bins(envmis::EnvMap(sky(16, 8), plain), bins);
+        const envmis::BinnedEnvMap binned = envmis::build_bins(envmis::build_env_map(sky(16, 8), plain), bins);
         envmis::write_table(dir / "binned_16x8.envmis", binned, source);
         envmis::write_table(dir / "binned_compact_16x8.envmis", binned, source, envmis::TableEncoding::compact);
 
         // A black map: the uniform fallback.
         envmis::RgbImage black{8, 4, envmis::RgbPixels(32)};
-        envmis::write_table(dir / "black_8x4.envmis", envmis::EnvMap(black), source);
+        envmis::write_table(dir / "black_8x4.envmis", envmis::build_env_map(black), source);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "envmis_make_fuzz_seed: %s\n", e.what());
         return 1;

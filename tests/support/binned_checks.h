@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "envmis/build/env_map.h"
 #include "envmis/sampling/binned.h"
 #include "stats.h"
 
@@ -23,7 +24,7 @@ inline EnvMap plain_map(RgbImage image, Mapping mapping = Mapping::equirect) {
     EnvMapOptions o;
     o.compensation.enabled = false;
     o.mapping = mapping;
-    return EnvMap(std::move(image), o);
+    return build_env_map(std::move(image), o);
 }
 
 // Normals that test the bins: two bin centres, points just either side of a bin border

@@ -11,6 +11,7 @@
 
 #include "detail/luminance.h"
 #include "detail/parallel.h"
+#include "envmis/build/mis_variance.h"
 #include "envmis/sampling/bin_cells.h"
 
 namespace envmis {
@@ -131,8 +132,8 @@ float window_floor(float highest) noexcept {
     return id > kMaxBuckets ? std::bit_cast<float>((id - kMaxBuckets) << kHistogramShift) : 0.0f;
 }
 
-// Exact variance of one 1 + 1 balance MIS estimate at one normal, on the nodes: f and
-// p_bsdf per node in the hemisphere (`visible`), p_env from cell probabilities.
+// The lobe of a class at one normal, on the nodes: f and p_bsdf per node in the
+// hemisphere (`visible`); mis_variance adds p_env from cell probabilities.
 struct Lobe {
     std::vector<uint32_t> visible;
     std::vector<double> f, p_bsdf;
@@ -156,19 +157,17 @@ Lobe lobe_at(const Nodes& n, Vec3 normal, float exponent) {
     return lobe;
 }
 
+// Exact variance of one 1 + 1 balance MIS estimate at the lobe's normal (mis_variance.h).
 double mis_variance(const Nodes& n, const Lobe& lobe, std::span<const double> cell_probability,
                     std::span<const double> cell_mass) {
-    double a = 0, b_env = 0, b_bsdf = 0;
+    MisMoments m;
     for (size_t j = 0; j < lobe.visible.size(); ++j) {
         const uint32_t i = lobe.visible[j];
         const double omega = n.sum_w[i] * n.steradians_per_weight;
         const double share = cell_mass[n.cell[i]] > 0 ? n.sum_l[i] / cell_mass[n.cell[i]] : 0;
-        const double pe = cell_probability[n.cell[i]] * share / omega, pb = lobe.p_bsdf[j];
-        const double q = pe + pb, f = lobe.f[j];
-        a += f * f / q * omega;  // both techniques' second moments: f^2 (pe + pb) / q^2
-        b_env += f * pe / q * omega, b_bsdf += f * pb / q * omega;
+        m.add_balance({lobe.f[j], omega, cell_probability[n.cell[i]] * share / omega, lobe.p_bsdf[j]}, {});
     }
-    return a - b_env * b_env - b_bsdf * b_bsdf;
+    return m.variance({});
 }
 
 // Cell probabilities of a density given by cell masses; empty if it has no mass.

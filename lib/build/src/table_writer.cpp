@@ -6,6 +6,7 @@
 
 #include "detail/parallel.h"
 #include "envmis/build/atomic_file.h"
+#include "envmis/build/env_map.h"
 #include "envmis/math/hash.h"
 #include "envmis/table/format.h"
 
@@ -165,7 +166,7 @@ void write_map(const std::filesystem::path& path, const EnvMap& map, const Table
         // The table holds the rounded map: its statistics (Lbar, threshold) are the
         // rounded map's, which the reader's rebuild reproduces exactly; the bad-pixel
         // counts are the source's.
-        const EnvMap rounded(rgbe_round(map.radiance()), map.options(), stop);
+        const EnvMap rounded = build_env_map(rgbe_round(map.radiance()), map.options(), stop);
         EnvMapStats stats = rounded.stats();
         stats.bad_pixels = map.stats().bad_pixels;
         std::vector<uint32_t> rgbe(radiance.size());

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "envmis/build/bins.h"
+#include "envmis/build/env_map.h"
 #include "envmis/io/colour.h"
 #include "envmis/io/image_io.h"
 #include "envmis/math/hash.h"
@@ -53,7 +54,7 @@ void build_pixels(RgbImage image, const BuildRequest& r, LumaCoefficients luma, 
             options.compensation.alpha = built.alpha_choice->alpha;
         }
         const auto start = std::chrono::steady_clock::now();
-        EnvMap map(std::move(image), options, stop);
+        EnvMap map = build_env_map(std::move(image), options, stop);
         built.build_ms = milliseconds_since(start);
         if (r.bins == 0) {
             built.map = std::move(map);

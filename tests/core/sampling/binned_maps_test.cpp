@@ -8,6 +8,7 @@
 
 #include "binned_checks.h"
 #include "envmis/build/bins.h"
+#include "envmis/build/env_map.h"
 #include "envmis/io/image_io.h"
 #include "envmis/study/comparison/alpha.h"
 
@@ -21,7 +22,7 @@ protected:
         EnvMapOptions options;
         options.compensation.enabled = false;
         options.luma = image.luma;
-        return build_bins(EnvMap(downsample(image.image, 128), options));
+        return build_bins(build_env_map(downsample(image.image, 128), options));
     }
 };
 

@@ -8,6 +8,7 @@
 
 #include "binned_checks.h"
 #include "envmis/build/bins.h"
+#include "envmis/build/env_map.h"
 #include "envmis/sampling/binned.h"
 #include "forced_path.h"
 #include "maps.h"
@@ -384,7 +385,7 @@ TEST(Binned, PicksFollowTheBilinearWeightsWhichChangeWithoutSteps) {
 }
 
 TEST(Binned, RejectsCompensatedMapsAndInvalidOptionsAndLayouts) {
-    EXPECT_THROW(build_bins(EnvMap(test::sun_sky_map(16, 8))), std::invalid_argument);
+    EXPECT_THROW(build_bins(build_env_map(test::sun_sky_map(16, 8))), std::invalid_argument);
     const EnvMap plain = plain_map(test::sun_sky_map(16, 8));
     BinnedOptions o;
     o.bins_per_side = 0;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "envmis/build/bins.h"
+#include "envmis/build/env_map.h"
 #include "envmis/build/table_writer.h"
 #include "envmis/math/hash.h"
 #include "envmis/table/table.h"
@@ -38,7 +39,7 @@ protected:
         EnvMapOptions o;
         o.compensation.alpha = 0.75f;
         o.axes = Axes::parse("y-up");
-        map_ = EnvMap(test::sun_sky_map(96, 48), o);
+        map_ = build_env_map(test::sun_sky_map(96, 48), o);
         const fs::path path = dir_ / "sky.envmis";
         write_table(path, map_, source_);
         return path;
@@ -146,7 +147,7 @@ TEST_F(TableTest, CompactTablesHoldTheRoundedMap) {
     o.compensation.alpha = 0.75f;
     RgbImage image = test::random_map(96, 48, 11, 8);
     image.pixels[5] = {NAN, 1, 2};  // repaired and counted by the map; the count is kept
-    const EnvMap map(image, o);
+    const EnvMap map = build_env_map(image, o);
     const fs::path path = dir_ / "compact.envmis";
     write_table(path, map, source_, TableEncoding::compact);
     const fs::path full = dir_ / "full.envmis";
@@ -154,7 +155,7 @@ TEST_F(TableTest, CompactTablesHoldTheRoundedMap) {
     EXPECT_EQ(fs::file_size(full) - fs::file_size(path), 96u * 48 * 12);
 
     const Table loaded = read_table(path);
-    const EnvMap rounded(rgbe_round(map.radiance()), o);
+    const EnvMap rounded = build_env_map(rgbe_round(map.radiance()), o);
     EXPECT_EQ(loaded.map.stats().bad_pixels.nan, 1u);
     EXPECT_EQ(loaded.map.stats().threshold, rounded.stats().threshold);
     expect_identical_samples(rounded, loaded.map, 12, 10000);
@@ -194,7 +195,7 @@ TEST(Rgbe, RoundingErrorIsBounded) {
 TEST_F(TableTest, EqualAreaTablesRoundTrip) {
     EnvMapOptions o;
     o.mapping = Mapping::equal_area;
-    const EnvMap map(test::sun_sky_map(48, 48), o);
+    const EnvMap map = build_env_map(test::sun_sky_map(48, 48), o);
     const fs::path path = dir_ / "square.envmis";
     write_table(path, map, source_);
     const Table loaded = read_table(path);
@@ -380,7 +381,7 @@ TEST_F(TableTest, MetadataPaddingIsZerosToAMultipleOfEight) {
 // (large_vector.h): lookups read it at random texels.
 TEST_F(TableTest, ACopiedLoadOfALargeMapHoldsItsRadianceFromAHugePageBoundary) {
     const fs::path path = dir_ / "large.envmis";
-    write_table(path, EnvMap(test::constant_map(1024, 512, {1, 1, 1})), source_);  // 6 MiB of pixels
+    write_table(path, build_env_map(test::constant_map(1024, 512, {1, 1, 1})), source_);  // 6 MiB of pixels
     const Table copied = read_table(path, TableLoading::copy);
     EXPECT_EQ(reinterpret_cast<uintptr_t>(copied.map.radiance().pixels.data()) % (size_t{2} << 20), 0u);
 }
@@ -415,7 +416,7 @@ TEST_F(TableTest, AMappedMapOutlivesItsTableAndTheFilesReplacement) {
         const Table t = read_table(path);
         kept = t.map;
     }
-    write_table(path, EnvMap(test::constant_map(8, 4, {1, 2, 3})), source_);
+    write_table(path, build_env_map(test::constant_map(8, 4, {1, 2, 3})), source_);
     expect_identical_samples(map_, kept, 7, 10000);
 }
 
@@ -533,7 +534,7 @@ TEST_F(TableTest, HeaderFactsThatThePayloadContradictsAreRejectedNamingThem) {
 // The statistics of a black map and of a constant one (fallbacks) are what the reader expects.
 TEST_F(TableTest, FallbackTablesPassTheStatisticsChecks) {
     for (const Rgb c : {Rgb{0, 0, 0}, Rgb{0.5f, 0.5f, 0.5f}}) {
-        const EnvMap map(test::constant_map(16, 8, c));
+        const EnvMap map = build_env_map(test::constant_map(16, 8, c));
         write_table(dir_ / "fallback.envmis", map, source_);
         EXPECT_EQ(read_table(dir_ / "fallback.envmis").map.stats().fallback, map.stats().fallback);
     }
@@ -546,7 +547,7 @@ TEST_F(TableTest, WritingIsAtomic) {
     EXPECT_THROW(write_table(dir_ / "missing" / "x.envmis", map_, source_), TableError);
     EXPECT_FALSE(fs::exists(dir_ / "missing"));
     // Overwriting replaces the file whole and leaves no temporary file.
-    write_table(path, EnvMap(test::constant_map(8, 4, {1, 2, 3})), source_);
+    write_table(path, build_env_map(test::constant_map(8, 4, {1, 2, 3})), source_);
     EXPECT_NE(bytes_of(path).size(), before.size());
     size_t files = 0;
     for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir_)) ++files;
@@ -567,7 +568,7 @@ EnvMap plain_sky() {
     EnvMapOptions o;
     o.compensation.enabled = false;
     o.axes = Axes::parse("y-up");
-    return EnvMap(test::sun_sky_map(96, 48), o);
+    return build_env_map(test::sun_sky_map(96, 48), o);
 }
 
 BinnedEnvMap small_binned(EnvMap plain) {
@@ -659,7 +660,7 @@ TEST_F(BinnedTableTest, CompactBinnedTablesRebuildTheBinsOverTheRoundedMap) {
     const BinnedEnvMap binned = small_binned(plain_sky());
     const fs::path path = dir_ / "compact.envmis";
     write_table(path, binned, source_, TableEncoding::compact);
-    const BinnedEnvMap expected(EnvMap(rgbe_round(binned.plain().radiance()), binned.plain().options()),
+    const BinnedEnvMap expected(build_env_map(rgbe_round(binned.plain().radiance()), binned.plain().options()),
                                 binned.layout());
     expect_identical_binned_samples(expected, binned_map(read_table(path)), 23, 10000);
 }

@@ -7,6 +7,7 @@
 #include <limits>
 #include <vector>
 
+#include "envmis/build/env_map.h"
 #include "envmis/compensation/compensation.h"
 #include "envmis/study/comparison/alpha.h"
 #include "envmis/study/reference/quadrature.h"
@@ -128,7 +129,7 @@ TEST(ChooseAlpha, CriterionIsTheExactVarianceRatioOnTheDownsampledMap) {
     EnvMapOptions plain_options, comp_options;
     plain_options.compensation.enabled = false;
     comp_options.compensation.alpha = 0.5f;
-    const EnvMap plain(image, plain_options), comp(image, comp_options);
+    const EnvMap plain = build_env_map(image, plain_options), comp = build_env_map(image, comp_options);
     const auto ratios =
         geometric_mean_ratios(exact_variances(comp, Technique::parse("mis-balance-comp"), {}, o.bsdfs, o.points, 1),
                               exact_variances(plain, Technique::parse("mis-balance"), {}, o.bsdfs, o.points, 1), 1);

@@ -2,6 +2,7 @@
 // limits and list rules both front ends refuse with, the maps a request builds and the
 // exact figures of --exact.
 #include "envmis/study/comparison/setup.h"
+#include "envmis/build/env_map.h"
 
 #include <gtest/gtest.h>
 
@@ -24,7 +25,7 @@ std::vector<Technique> techniques(std::initializer_list<const char*> names) {
 std::shared_ptr<const EnvMap> sky(bool compensated) {
     EnvMapOptions options;
     options.compensation.enabled = compensated;
-    return std::make_shared<const EnvMap>(test::sun_sky_map(64, 32), options);
+    return std::make_shared<const EnvMap>(build_env_map(test::sun_sky_map(64, 32), options));
 }
 
 // Two BSDFs, few points and estimates: a set-up in milliseconds.

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "envmis/build/bins.h"
+#include "envmis/build/env_map.h"
 #include "envmis/study/reference/quadrature.h"
 #include "envmis/study/statistics/statistics.h"
 #include "envmis/study/techniques/estimator.h"
@@ -20,7 +21,7 @@ EnvMapOptions plain() {
 }
 
 TEST(Quadrature, ConstantWhiteSkyOnLambertGivesTheAlbedo) {
-    const EnvMap map(test::constant_map(64, 32, {1, 1, 1}), plain());
+    const EnvMap map = build_env_map(test::constant_map(64, 32, {1, 1, 1}), plain());
     for (Vec3 n : {Vec3{0, 0, 1}, normalize(Vec3{0.3f, -0.5f, 0.2f})}) {
         const QuadratureResult r = reflected_radiance(map, Bsdf::lambert({0.5f, 0.6f, 0.7f}), {n, n}, {1e-5, 64});
         EXPECT_NEAR(r.value.r, 0.5, 2e-4);
@@ -30,7 +31,7 @@ TEST(Quadrature, ConstantWhiteSkyOnLambertGivesTheAlbedo) {
 }
 
 TEST(Quadrature, SubdivisionConverges) {
-    const EnvMap map(test::sun_sky_map(128, 64), plain());
+    const EnvMap map = build_env_map(test::sun_sky_map(128, 64), plain());
     const ShadingPoint p{normalize(Vec3{0.2f, 0.1f, 1}), normalize(Vec3{-0.3f, 0.4f, 1})};
     for (const Bsdf& bsdf : {Bsdf::lambert(), Bsdf::phong(50), Bsdf::ggx(0.1f)}) {
         double previous_change = INFINITY;
@@ -53,7 +54,7 @@ TEST(Quadrature, SingleBrightTexelMatchesItsClosedForm) {
     // One texel of radiance 1 elsewhere black: L_o = f cos at the texel times its solid angle.
     RgbImage image = test::constant_map(256, 128, {});
     image.pixels[40 * 256 + 100] = {1, 1, 1};
-    const EnvMap map(image, plain());
+    const EnvMap map = build_env_map(image, plain());
     const ShadingPoint p{{0, 0, 1}, {0, 0, 1}};
     const double theta_top = kPi * 40 / 128, theta_bottom = kPi * 41 / 128;
     const double solid_angle = 2 * kPi / 256 * (std::cos(theta_top) - std::cos(theta_bottom));
@@ -64,7 +65,7 @@ TEST(Quadrature, SingleBrightTexelMatchesItsClosedForm) {
 
 TEST(Quadrature, ExactVarianceMatchesMeasuredVariance) {
     const RgbImage image = test::random_map(64, 32, 3, 1.5f);
-    const EnvMap plain_map(image, plain()), compensated(image);
+    const EnvMap plain_map = build_env_map(image, plain()), compensated = build_env_map(image);
     const ShadingPoint p{normalize(Vec3{0.1f, 0.2f, 1}), normalize(Vec3{0.5f, 0, 1})};
     for (const Bsdf& bsdf : {Bsdf::lambert(), Bsdf::phong(20)})
         for (const char* name : {"env", "bsdf", "mis-balance", "mis-power", "mis-balance-comp"}) {
@@ -83,7 +84,7 @@ TEST(Quadrature, ExactVarianceMatchesMeasuredVariance) {
 // facing up and one facing down (another bin, another compensation) on the same map.
 TEST(Quadrature, ExactVarianceOfBinnedMisMatchesMeasuredVariance) {
     const RgbImage image = test::random_map(64, 32, 3, 1.5f);
-    const BinnedEnvMap binned = build_bins(EnvMap(image, plain()));
+    const BinnedEnvMap binned = build_bins(build_env_map(image, plain()));
     const Technique t = Technique::parse("mis-balance-bins");
     const DirectLightingEstimator estimator(binned, t);
     for (const ShadingPoint& p : {ShadingPoint{normalize(Vec3{0.1f, 0.2f, 1}), normalize(Vec3{0.5f, 0, 1})},

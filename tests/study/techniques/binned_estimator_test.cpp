@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "envmis/build/bins.h"
+#include "envmis/build/env_map.h"
 #include "envmis/io/image_io.h"
 #include "envmis/study/reference/quadrature.h"
 #include "envmis/study/statistics/statistics.h"
@@ -24,7 +25,7 @@ EnvMap plain_map(const RgbImage& image, LumaCoefficients luma = {}) {
     EnvMapOptions o;
     o.luma = luma;
     o.compensation.enabled = false;
-    return EnvMap(image, o);
+    return build_env_map(image, o);
 }
 
 EnvMap load_plain(const std::string& file) {

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "envmis/build/env_map.h"
 #include "envmis/io/image_io.h"
 #include "envmis/study/comparison/comparison.h"
 #include "envmis/study/reference/quadrature.h"
@@ -29,9 +30,9 @@ Maps make_maps(std::string name, const RgbImage& image, LumaCoefficients luma = 
     EnvMapOptions o;
     o.luma = luma;
     o.compensation.enabled = false;
-    EnvMap plain(image, o);
+    EnvMap plain = build_env_map(image, o);
     o.compensation.enabled = true;
-    return {std::move(name), std::move(plain), EnvMap(image, o)};
+    return {std::move(name), std::move(plain), build_env_map(image, o)};
 }
 
 Maps load_maps(const std::string& file) {

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "detail/parallel.h"
+#include "envmis/build/env_map.h"
 #include "envmis/study/reference/quadrature.h"
 
 namespace envmis {
@@ -111,7 +112,7 @@ AlphaChoice choose_alpha(RgbImageView radiance, const EnvMapOptions& map, const 
     const RgbImage small = downsample(radiance, options.max_width, map.mapping);
     EnvMapOptions plain_options = map;
     plain_options.compensation.enabled = false;
-    const EnvMap plain(small, plain_options);
+    const EnvMap plain = build_env_map(small, plain_options);
     const Technique balance = Technique::parse("mis-balance"), balance_comp = Technique::parse("mis-balance-comp");
     // One subdivision: texels are constant, and the ratio only ranks candidates.
     const std::vector<double> baseline =
@@ -121,7 +122,7 @@ AlphaChoice choose_alpha(RgbImageView radiance, const EnvMapOptions& map, const 
     for (float alpha : alphas) {
         EnvMapOptions compensated_options = map;
         compensated_options.compensation = {true, alpha};
-        const EnvMap compensated(small, compensated_options);
+        const EnvMap compensated = build_env_map(small, compensated_options);
         const std::vector<LogRatios> logs =
             log_ratios(exact_variances(compensated, balance_comp, options.allocation, options.bsdfs, options.points, 1),
                        baseline, options.bsdfs.size());

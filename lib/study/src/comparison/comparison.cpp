@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "envmis/build/bins.h"
+#include "envmis/build/env_map.h"
 #include "envmis/study/shading/frame.h"
 #include "envmis/study/statistics/statistics.h"
 
@@ -273,7 +274,7 @@ Comparison compare_one(const EnvMap& plain, const EnvMap& compensated, const Bin
 EnvMap compensated_map(const EnvMap& plain, float alpha, StopFlag stop) {
     EnvMapOptions options = plain.options();
     options.compensation = {true, alpha};
-    return EnvMap(to_image(plain.radiance()), options, stop);
+    return build_env_map(to_image(plain.radiance()), options, stop);
 }
 
 CompensatedMaps compensated_maps(const EnvMap& plain, std::span<const float> bsdf_alphas, StopFlag stop) {

@@ -1,5 +1,6 @@
 #include "envmis/study/comparison/setup.h"
 #include "envmis/build/bins.h"
+#include "envmis/build/env_map.h"
 
 #include <algorithm>
 #include <cmath>
@@ -49,7 +50,7 @@ std::shared_ptr<const EnvMap> without_compensation(std::shared_ptr<const EnvMap>
     if (!map->options().compensation.enabled) return map;
     EnvMapOptions plain = map->options();
     plain.compensation.enabled = false;
-    return std::make_shared<const EnvMap>(to_image(map->radiance()), plain, stop);
+    return std::make_shared<const EnvMap>(build_env_map(to_image(map->radiance()), plain, stop));
 }
 
 std::shared_ptr<const BinnedEnvMap> study_bins(const EnvMap& plain, uint32_t g, const CompareRequest& request,

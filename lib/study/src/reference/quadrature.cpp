@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "detail/parallel.h"
+#include "envmis/build/mis_variance.h"
 #include "envmis/study/shading/frame.h"
 
 namespace envmis {
@@ -121,14 +122,6 @@ namespace {
 template <class EnvPdf>
 double exact_variance_with(const EnvMap& env, EnvPdf&& env_pdf, Technique technique, Allocation allocation,
                            const Bsdf& bsdf, const ShadingPoint& point, int subdivisions, StopFlag stop) {
-    // First and second moments of the weighted contributions of each sampling technique.
-    struct Moments {
-        double env1 = 0, env2 = 0, bsdf1 = 0, bsdf2 = 0;
-        Moments& operator+=(const Moments& o) {
-            env1 += o.env1, env2 += o.env2, bsdf1 += o.bsdf1, bsdf2 += o.bsdf2;
-            return *this;
-        }
-    };
     if (technique.adaptive() || technique.mixture)
         throw std::invalid_argument("exact_variance: " + technique.name() +
                                     (technique.adaptive()
@@ -136,41 +129,36 @@ double exact_variance_with(const EnvMap& env, EnvPdf&& env_pdf, Technique techni
                                          : " samples two maps; pass one technique of one map"));
     const Strategy strategy = technique.strategy;
     const bool both = strategy == Strategy::mis || strategy == Strategy::one_sample;
-    const double n_env = strategy == Strategy::env ? allocation.total() : (both ? allocation.env : 0);
-    const double n_bsdf = strategy == Strategy::bsdf ? allocation.total() : (both ? allocation.bsdf : 0);
+    const MisCounts n{strategy == Strategy::env ? allocation.total() : (both ? allocation.env : 0.0),
+                      strategy == Strategy::bsdf ? allocation.total() : (both ? allocation.bsdf : 0.0)};
     const Vec3 wo = Frame::from_normal(point.normal).to_local(point.wo);
     const LumaCoefficients luma = env.options().luma;
-    const Moments m = integrate<Moments>(env, point, subdivisions, stop, [&](Moments& acc, const Node& n) {
-        const BsdfValues<float> b = bsdf.values(wo, n.wi);
-        const double f = luminance(multiply(n.radiance, Rgb{b.r, b.g, b.b}), luma);
+    const MisMoments m = integrate<MisMoments>(env, point, subdivisions, stop, [&](MisMoments& acc, const Node& node) {
+        const BsdfValues<float> b = bsdf.values(wo, node.wi);
+        const double f = luminance(multiply(node.radiance, Rgb{b.r, b.g, b.b}), luma);
         if (f == 0) return;
-        const double p_env = env_pdf(n.uv), p_bsdf = b.pdf;
+        const MisNode at{f, node.solid_angle, env_pdf(node.uv), b.pdf};
         if (strategy == Strategy::one_sample) {
             // total() draws z = f / Q from the mixture Q / total: the estimate's variance
-            // is integral f^2 / Q - (integral f)^2 / total. Kept in the env moments.
-            const double q = n_env * p_env + n_bsdf * p_bsdf;
-            acc.env1 += f * n.solid_angle;
-            if (q > 0) acc.env2 += f * f / q * n.solid_angle;
+            // is integral f^2 / Q - (integral f)^2 / total. Kept in env and second.
+            const double q = n.env * at.p_env + n.bsdf * at.p_bsdf;
+            acc.env += f * at.solid_angle;
+            if (q > 0) acc.second += f * f / q * at.solid_angle;
             return;
         }
-        // One technique's contribution: weight against the other, first and second moments.
-        auto add = [&](double n_self, double p_self, double n_other, double p_other, double& first, double& second) {
-            if (!(n_self > 0 && p_self > 0)) return;
-            const double w = strategy == Strategy::mis
-                                 ? mis_weight(technique.heuristic, static_cast<float>(n_self * p_self),
-                                              static_cast<float>(n_other * p_other))
-                                 : 1.0;
-            first += f * w * n.solid_angle;
-            second += f * f * w * w / p_self * n.solid_angle;
+        // The weights the estimator uses (float, as its samples compute them), of the
+        // techniques that can sample the node.
+        const auto weight = [&](double n_self, double p_self, double n_other, double p_other) {
+            if (!(n_self > 0 && p_self > 0)) return 0.0;
+            return strategy == Strategy::mis
+                       ? double{mis_weight(technique.heuristic, static_cast<float>(n_self * p_self),
+                                           static_cast<float>(n_other * p_other))}
+                       : 1.0;
         };
-        add(n_env, p_env, n_bsdf, p_bsdf, acc.env1, acc.env2);
-        add(n_bsdf, p_bsdf, n_env, p_env, acc.bsdf1, acc.bsdf2);
+        acc.add(at, n, weight(n.env, at.p_env, n.bsdf, at.p_bsdf), weight(n.bsdf, at.p_bsdf, n.env, at.p_env));
     });
-    if (strategy == Strategy::one_sample) return m.env2 - m.env1 * m.env1 / allocation.total();
-    double variance = 0;
-    if (n_env > 0) variance += (m.env2 - m.env1 * m.env1) / n_env;
-    if (n_bsdf > 0) variance += (m.bsdf2 - m.bsdf1 * m.bsdf1) / n_bsdf;
-    return variance;
+    if (strategy == Strategy::one_sample) return m.second - m.env * m.env / allocation.total();
+    return m.variance(n);
 }
 
 }  // namespace

@@ -22,7 +22,7 @@ namespace envmis {
 //            load. The table holds the RGBE-rounded map (rgbe_round): channels within
 //            1/255 of the pixel's largest channel, the largest within 0.4% (values
 //            above 1.7e38 saturate); it loads bit-identical to
-//            EnvMap(rgbe_round(radiance), options). Lossless for .hdr sources.
+//            build_env_map(rgbe_round(radiance), options). Lossless for .hdr sources.
 enum class TableEncoding { full, compact };
 
 // Writes atomically (temporary file, then rename; atomic_file.h). Throws TableError on
@@ -34,7 +34,7 @@ ENVMIS_BUILD_API void write_table(const std::filesystem::path& path, const EnvMa
 
 // A binned map: its plain map (as the overload above writes it) and its BinLayout, from
 // which the reader rebuilds the bins bit-identically. A compact table holds the
-// RGBE-rounded plain map and loads as BinnedEnvMap(EnvMap(rgbe_round(radiance),
+// RGBE-rounded plain map and loads as BinnedEnvMap(build_env_map(rgbe_round(radiance),
 // options), layout).
 ENVMIS_BUILD_API void write_table(const std::filesystem::path& path, const BinnedEnvMap& binned,
                                   const TableSource& source, TableEncoding encoding = TableEncoding::full,

@@ -11,7 +11,7 @@
 // 2 pi^2 sin theta (equirect) or 4 pi (equal-area). Radiance is the texel's value
 // (nearest), so it is constant exactly where the density is.
 //
-// Cost: build O(w h), parallel over rows (see `envmis bench` for figures); sample, pdf
+// Cost: build O(w h) (build_env_map, envmis/build/env_map.h), parallel over rows; sample, pdf
 // and eval O(1), noexcept and allocation-free. Memory: 6 bytes per texel for the
 // distribution plus 12 for the RGB radiance (not the map's own when it borrows a
 // memory-mapped table's).
@@ -223,13 +223,12 @@ ENVMIS_CORE_API void density_row(std::span<const Rgb> radiance_row, uint32_t y, 
 class ENVMIS_CORE_API EnvMap {
 public:
     EnvMap() = default;
-    // Builds the sampler from a radiance image, repairing bad pixels (counted in
-    // stats().bad_pixels). Throws std::invalid_argument for an empty image, a pixel count
-    // that does not match the size, more than 2^31 texels, invalid options, or finite
-    // pixels whose power overflows float (4 pi Lbar above 3.4e38: "luminance overflows",
-    // with the factor to scale the map by), which would make every estimate Inf or NaN;
-    // throws Interrupted once `stop` is set (interrupt.h; checked every block of rows).
-    explicit EnvMap(RgbImage image, const EnvMapOptions& options = {}, StopFlag stop = nullptr);
+    // A map from a radiance image is built by envmis::build's build_env_map
+    // (envmis/build/env_map.h), which ends in this constructor: `density` is the
+    // distribution it built from `radiance` (repaired) with these options, and `stats`
+    // what it measured. Checks the sizes and options only: the parts are trusted. Throws
+    // std::invalid_argument where the sizes differ or the options are invalid.
+    EnvMap(RgbImage radiance, Distribution2D density, const EnvMapOptions& options, const EnvMapStats& stats);
 
     // Rebuilds a saved sampler from its parts (the table reader's path): the image
     // density q(x, y) w_y exactly as density() returned it, as float bit patterns; that
@@ -275,9 +274,8 @@ public:
     bool complete() const noexcept { return stats_.zeroed_texels == 0; }
 
 private:
-    // Makes the image's pixels the map's own radiance; returns them, still writable for
-    // the build's repair of bad values.
-    RgbPixels& adopt(RgbImage image);
+    // Makes the image's pixels the map's own radiance.
+    void adopt(RgbImage image);
     // The table constructors' common part: checks the radiance, builds the distribution.
     void rebuild(LargeVector<uint32_t> density_bits);
 
