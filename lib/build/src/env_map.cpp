@@ -60,8 +60,8 @@ EnvMap build_env_map(RgbImage image, const EnvMapOptions& options, StopFlag stop
             rows[y].zeroed = rows[y].positive;
             return;
         }
-        rows[y].zeroed = fill_density_row(cells.data(), w, row_weight(options.mapping, y, h), stats.threshold,
-                                          uniform, row.data());
+        rows[y].zeroed =
+            fill_density_row(cells.data(), w, row_weight(options.mapping, y, h), stats.threshold, uniform, row.data());
     };
     Distribution2D distribution(w, h, std::move(luminance_bits), density);
     throw_if_stopped(stop);
