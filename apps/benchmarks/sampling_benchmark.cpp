@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <random>
 #include <tuple>
 #include <type_traits>
@@ -21,6 +22,7 @@
 #include "envmis/sampling/envmap.h"
 #include "envmis/study/comparison/comparison.h"
 #include "envmis/study/techniques/estimator.h"
+#include "pbrt_style.h"
 #include "reference.h"
 
 namespace {
@@ -396,6 +398,55 @@ void equal_area_over_equirect(benchmark::State& state) {
     });
 }
 
+// The pbrt-v4-style sampler (pbrt_style.h) over an equal-area sky of `side`, compensated
+// or plain, built once per case for every row that times it (the map reads the image
+// it keeps beside it).
+struct PbrtSky {
+    envmis::RgbImage image;
+    envmis::reference::PbrtStyleEnvMap map;
+    PbrtSky(uint32_t side, const envmis::EnvMapOptions& o)
+        : image(envmis::reference::synthetic_sky(side, side, envmis::Mapping::equal_area)), map(image, o) {}
+};
+const envmis::reference::PbrtStyleEnvMap& pbrt_sky(uint32_t side, bool compensated) {
+    static std::map<std::pair<uint32_t, bool>, std::unique_ptr<PbrtSky>> skies;
+    std::unique_ptr<PbrtSky>& sky = skies[{side, compensated}];
+    if (!sky) {
+        envmis::EnvMapOptions o = options();
+        o.compensation.enabled = compensated;
+        o.mapping = envmis::Mapping::equal_area;
+        sky = std::make_unique<PbrtSky>(side, o);
+    }
+    return sky->map;
+}
+
+// envmis against the pbrt-style sampler in turns (in_turns), single calls in blocks of
+// 1024: samples (kPdf false) or pdfs of the same points, envmis on the same equal-area sky
+// or on an equirect one of about as many texels. Manual time: envmis's; the counter
+// pbrt/envmis is the speedup. Arguments: the square's side, envmis's map's width and
+// height (the side twice for equal-area), compensated.
+template <envmis::Mapping kMapping, bool kPdf>
+void over_pbrt(benchmark::State& state) {
+    const bool compensated = state.range(3) != 0;
+    const envmis::reference::PbrtStyleEnvMap& pbrt = pbrt_sky(static_cast<uint32_t>(state.range(0)), compensated);
+    const EnvMapView view =
+        mapped_sky(static_cast<uint32_t>(state.range(1)), static_cast<uint32_t>(state.range(2)), kMapping, compensated)
+            .view();
+    constexpr size_t kBlock = 1024;
+    const auto& us = uniforms();
+    const auto& ds = directions();
+    const auto ratio = in_turns(state, us.size(), kBlock, [&](int m, size_t first) {
+        for (size_t i = first; i < first + kBlock; ++i) {
+            if constexpr (kPdf) {
+                benchmark::DoNotOptimize(m == 0 ? view.pdf(ds[i]) : pbrt.pdf(ds[i]));
+            } else {
+                const envmis::EnvSample e = m == 0 ? view.sample(us[i]) : pbrt.sample(us[i]);
+                benchmark::DoNotOptimize(e);
+            }
+        }
+    });
+    state.counters["pbrt/envmis"] = 1 / ratio;
+}
+
 // lookup_many against the memory's floor: independent reads of the data each of its
 // lookups must fetch (the texel's radiance at both ends, its CDF start and the next, its
 // row's marginal entry), at texels found before timing. On a map beyond the cache those
@@ -489,6 +540,28 @@ BENCHMARK(equal_area_over_equirect<SkyDetail::clear>)
 BENCHMARK(equal_area_over_equirect<SkyDetail::clouds>)
     ->Name("sample/equal-area-over-equirect-clouds")
     ->ArgsProduct({{5792}, {8192}, {4096}, {0, 1}, {0, 1}})
+    ->UseManualTime();
+// The sizes: rooitou_park_1k's square (724^2, about 1024 x 512) and the 8k sky's
+// (5792^2, about 8192 x 4096).
+BENCHMARK(over_pbrt<envmis::Mapping::equal_area, true>)
+    ->Name("pdf/equal-area-over-pbrt")
+    ->ArgsProduct({{724}, {724}, {724}, {0, 1}})
+    ->ArgsProduct({{5792}, {5792}, {5792}, {0, 1}})
+    ->UseManualTime();
+BENCHMARK(over_pbrt<envmis::Mapping::equirect, true>)
+    ->Name("pdf/equirect-over-pbrt")
+    ->ArgsProduct({{724}, {1024}, {512}, {0, 1}})
+    ->ArgsProduct({{5792}, {8192}, {4096}, {0, 1}})
+    ->UseManualTime();
+BENCHMARK(over_pbrt<envmis::Mapping::equal_area, false>)
+    ->Name("sample/equal-area-over-pbrt")
+    ->ArgsProduct({{724}, {724}, {724}, {0, 1}})
+    ->ArgsProduct({{5792}, {5792}, {5792}, {0, 1}})
+    ->UseManualTime();
+BENCHMARK(over_pbrt<envmis::Mapping::equirect, false>)
+    ->Name("sample/equirect-over-pbrt")
+    ->ArgsProduct({{724}, {1024}, {512}, {0, 1}})
+    ->ArgsProduct({{5792}, {8192}, {4096}, {0, 1}})
     ->UseManualTime();
 BENCHMARK(lookup_over_line_reads)
     ->Name("lookup/many-over-line-reads")

@@ -1,6 +1,7 @@
 // envmis bench [IN | --size WxH] [--bins K]: build and sampling speed of the guided-CDF
-// sampler against the textbook float-CDF sampler, measured in the same run on the same
-// map; with --bins, also the binned sampler (binned.h) against today's EnvMap, plain and
+// sampler against the textbook float-CDF sampler and a sampler following pbrt-v4's
+// (pbrt_style.h; on the equal-area square of the same map), measured in the same run;
+// with --bins, also the binned sampler (binned.h) against today's EnvMap, plain and
 // compensated: what a renderer pays for normal-aware sampling.
 #include <algorithm>
 #include <cmath>
@@ -17,7 +18,9 @@
 #include "cli.h"
 #include "envmis/build/bins.h"
 #include "envmis/build/env_map.h"
+#include "envmis/build/remap.h"
 #include "envmis/cpu.h"
+#include "pbrt_style.h"
 #include "reference.h"
 
 namespace envmis::cli {
@@ -188,7 +191,14 @@ struct BenchMap {
     RgbImage image;
     std::string name;
     EnvMapOptions options;
+    // The pbrt-style sampler's map: the image itself if equal-area, else the same sky
+    // (or the image remapped) on an equal-area square of about as many texels.
+    RgbImage square;
 };
+
+uint32_t square_side(const RgbImage& image) {
+    return std::max(1u, static_cast<uint32_t>(std::lround(std::sqrt(static_cast<double>(image.width) * image.height))));
+}
 
 BenchMap bench_map(const BenchArgs& args) {
     EnvMapOptions options;
@@ -198,14 +208,23 @@ BenchMap bench_map(const BenchArgs& args) {
         if (options.mapping == Mapping::equal_area && size.width != size.height)
             throw std::runtime_error("--size " + args.size + ": an equal-area sky is square, e.g. 5792x5792");
         check_image_size("--size " + args.size, size, kBytesPerTexel);
-        return {reference::synthetic_sky(size.width, size.height, options.mapping), "synthetic-sky", options};
+        BenchMap map{reference::synthetic_sky(size.width, size.height, options.mapping), "synthetic-sky", options, {}};
+        const uint32_t side = square_side(map.image);
+        map.square = options.mapping == Mapping::equal_area ? map.image
+                                                            : reference::synthetic_sky(side, side, Mapping::equal_area);
+        return map;
     }
     BuildRequest request;
     request.compensate = false;
     request.mapping = args.mapping;
     const LoadedMap loaded = load_map(args.input, request);
     options.mapping = loaded.map.options().mapping, options.axes = loaded.map.options().axes;
-    return {to_image(loaded.map.radiance()), args.input, options};
+    BenchMap map{to_image(loaded.map.radiance()), args.input, options, {}};
+    const uint32_t side = square_side(map.image);
+    map.square = options.mapping == Mapping::equal_area
+                     ? map.image
+                     : remap(map.image, options.mapping, Mapping::equal_area, side, side, 0, &interrupted()).image;
+    return map;
 }
 
 // The random points every sampler is timed on: u for sampling, directions for the pdf,
@@ -237,30 +256,39 @@ BenchPoints bench_points(uint32_t n, bool normals, uint32_t samples_per_normal) 
     return points;
 }
 
-// Medians over the repeats: per sampler, and the speedups over the textbook sampler.
+// The guided sampler's speedups over a reference sampler: its time over the guided one's
+// (single and batch calls) or, for the build, the median builds' ratio.
+struct Speedups {
+    double build = 0, sample = 0, pdf = 0, batch_sample = 0, batch_pdf = 0;
+};
+
+// Medians over the repeats: per sampler, and the speedups over the textbook sampler and
+// over the pbrt-style one.
 struct BenchResult {
     std::vector<Timing> timings;
-    double build = 0, sample = 0, pdf = 0, batch_sample = 0, batch_pdf = 0;  // speedups
+    Speedups textbook, pbrt;
     // The batch calls' speedups: sample_many over single samples, lookup_many over single
     // pdf calls (which leave the radiance out) and over single lookups (the same work).
     double batch_over_single_sample = 0, batch_over_single_pdf = 0, batch_over_single_lookup = 0;
 };
 
-// Sampling and pdf times of the two samplers, back to back in each repeat, so that the
+// Sampling and pdf times of the samplers, back to back in each repeat, so that the
 // ratios compare like with like on a machine whose speed drifts. The guided sampler
 // goes through its view, as a renderer's hot loop uses it (the view's flat arrays are
 // read once, not rebuilt from the map at every call); guided-batch is the same sampler
 // through sample_many and lookup_many (the latter finds the radiance too), as a
-// wavefront renderer would call it. times: guided sample, textbook sample, guided pdf,
-// textbook pdf, batch sample, batch lookup, guided single lookup; ratios: textbook over
-// the others, then the batch calls' speedups over the single calls (sample, lookup over
-// pdf, lookup over single lookup).
+// wavefront renderer would call it.
+enum Call { kSample, kTextbookSample, kPdf, kTextbookPdf, kBatchSample, kBatchLookup, kLookup, kPbrtSample, kPbrtPdf };
+constexpr int kCalls = 9;
 struct CallTimes {
-    std::vector<double> times[7], ratios[7];
+    std::vector<double> times[kCalls];
+    std::vector<double> ratios[kCalls][kCalls];  // [a][b]: time a over time b, per repeat
+    double median_ratio(Call a, Call b) const { return median(ratios[a][b]); }
 };
 
-CallTimes time_calls(const EnvMap& guided, const reference::TextbookEnvMap& textbook, const BenchPoints& points,
-                     int repeats, Progress& progress, int& step) {
+CallTimes time_calls(const EnvMap& guided, const reference::TextbookEnvMap& textbook,
+                     const reference::PbrtStyleEnvMap& pbrt, const BenchPoints& points, int repeats, Progress& progress,
+                     int& step) {
     const auto sample_cost = [&](const auto& sampler) {
         return ns_per_call(points.us, [&](Vec2 u) { return every_output(sampler.sample(u)); });
     };
@@ -275,45 +303,53 @@ CallTimes time_calls(const EnvMap& guided, const reference::TextbookEnvMap& text
     CallTimes c;
     for (int r = 0; r < repeats; ++r) {
         throw_if_interrupted();
-        const double t[7] = {sample_cost(view),       sample_cost(textbook),   pdf_cost(view), pdf_cost(textbook),
-                             batch.sample_cost(view), batch.lookup_cost(view), lookup_cost()};
-        for (int k = 0; k < 7; ++k) c.times[k].push_back(t[k]);
-        c.ratios[0].push_back(t[1] / t[0]);
-        c.ratios[1].push_back(t[3] / t[2]);
-        c.ratios[2].push_back(t[1] / t[4]);
-        c.ratios[3].push_back(t[3] / t[5]);
-        c.ratios[4].push_back(t[0] / t[4]);
-        c.ratios[5].push_back(t[2] / t[5]);
-        c.ratios[6].push_back(t[6] / t[5]);
+        const double t[kCalls] = {sample_cost(view),  sample_cost(textbook),   pdf_cost(view),
+                                  pdf_cost(textbook), batch.sample_cost(view), batch.lookup_cost(view),
+                                  lookup_cost(),      sample_cost(pbrt),       pdf_cost(pbrt)};
+        for (int a = 0; a < kCalls; ++a) {
+            c.times[a].push_back(t[a]);
+            for (int b = 0; b < kCalls; ++b) c.ratios[a][b].push_back(t[a] / t[b]);
+        }
         progress.update(++step);
     }
     return c;
 }
 
-BenchResult measure(const RgbImage& image, const EnvMapOptions& options, const BenchPoints& points, int repeats) {
-    Progress progress("bench", 3 * repeats);
+BenchResult measure(const BenchMap& map, const EnvMapOptions& options, const BenchPoints& points, int repeats) {
+    Progress progress("bench", 4 * repeats);
     int step = 0;
+    const RgbImage& image = map.image;
     const auto [guided, guided_build] = build_repeatedly<EnvMap, RgbImage>(
         image, repeats, [&](RgbImage& copy) { return build_env_map(std::move(copy), options, &interrupted()); },
         progress, step);
     const auto [textbook, textbook_build] = build_repeatedly<reference::TextbookEnvMap, RgbImage>(
         image, repeats, [&](RgbImage&) { return reference::TextbookEnvMap(image, options); }, progress, step);
-    const CallTimes c = time_calls(*guided, *textbook, points, repeats, progress, step);
+    EnvMapOptions square_options = options;
+    square_options.mapping = Mapping::equal_area;
+    const auto [pbrt, pbrt_build] = build_repeatedly<reference::PbrtStyleEnvMap, RgbImage>(
+        map.square, repeats, [&](RgbImage&) { return reference::PbrtStyleEnvMap(map.square, square_options); },
+        progress, step);
+    const CallTimes c = time_calls(*guided, *textbook, *pbrt, points, repeats, progress, step);
     const double texels = static_cast<double>(image.width) * image.height;
     const double guided_bytes = guided->distribution().bytes() / texels;
+    const double square_texels = static_cast<double>(map.square.width) * map.square.height;
     BenchResult result;
     result.timings = {
-        {"guided", guided_build, median(c.times[0]), median(c.times[2]), guided_bytes},
-        {"guided-batch", guided_build, median(c.times[4]), median(c.times[5]), guided_bytes},
-        {"textbook", textbook_build, median(c.times[1]), median(c.times[3]), textbook->distribution_bytes() / texels}};
-    result.build = textbook_build / guided_build;
-    result.sample = median(c.ratios[0]);
-    result.pdf = median(c.ratios[1]);
-    result.batch_sample = median(c.ratios[2]);
-    result.batch_pdf = median(c.ratios[3]);
-    result.batch_over_single_sample = median(c.ratios[4]);
-    result.batch_over_single_pdf = median(c.ratios[5]);
-    result.batch_over_single_lookup = median(c.ratios[6]);
+        {"guided", guided_build, median(c.times[kSample]), median(c.times[kPdf]), guided_bytes},
+        {"guided-batch", guided_build, median(c.times[kBatchSample]), median(c.times[kBatchLookup]), guided_bytes},
+        {"textbook", textbook_build, median(c.times[kTextbookSample]), median(c.times[kTextbookPdf]),
+         textbook->distribution_bytes() / texels},
+        {"pbrt-v4-style", pbrt_build, median(c.times[kPbrtSample]), median(c.times[kPbrtPdf]),
+         pbrt->distribution_bytes() / square_texels}};
+    result.textbook = {textbook_build / guided_build, c.median_ratio(kTextbookSample, kSample),
+                       c.median_ratio(kTextbookPdf, kPdf), c.median_ratio(kTextbookSample, kBatchSample),
+                       c.median_ratio(kTextbookPdf, kBatchLookup)};
+    result.pbrt = {pbrt_build / guided_build * texels / square_texels, c.median_ratio(kPbrtSample, kSample),
+                   c.median_ratio(kPbrtPdf, kPdf), c.median_ratio(kPbrtSample, kBatchSample),
+                   c.median_ratio(kPbrtPdf, kBatchLookup)};
+    result.batch_over_single_sample = c.median_ratio(kSample, kBatchSample);
+    result.batch_over_single_pdf = c.median_ratio(kPdf, kBatchLookup);
+    result.batch_over_single_lookup = c.median_ratio(kLookup, kBatchLookup);
     return result;
 }
 
@@ -492,11 +528,13 @@ void print_bench_json(const BenchArgs& args, const BenchMap& map, const BenchRes
                                  {"ns_per_sample", t.ns_per_sample},
                                  {"ns_per_pdf", t.ns_per_pdf},
                                  {"bytes_per_texel", t.bytes_per_texel}});
-    j["speedup_vs_textbook"] = {{"build", result.build},
-                                {"sample", result.sample},
-                                {"pdf", result.pdf},
-                                {"batch_sample", result.batch_sample},
-                                {"batch_pdf", result.batch_pdf}};
+    for (const auto& [key, v] : {std::pair{"speedup_vs_textbook", result.textbook}, {"speedup_vs_pbrt", result.pbrt}})
+        j[key] = {{"build", v.build},
+                  {"sample", v.sample},
+                  {"pdf", v.pdf},
+                  {"batch_sample", v.batch_sample},
+                  {"batch_pdf", v.batch_pdf}};
+    j["pbrt_square"] = {map.square.width, map.square.height};
     j["batch_over_single"] = {{"sample", result.batch_over_single_sample},
                               {"lookup_over_pdf", result.batch_over_single_pdf},
                               {"lookup_over_lookup", result.batch_over_single_lookup}};
@@ -513,10 +551,13 @@ void print_bench_text(const BenchArgs& args, const BenchMap& map, const BenchRes
     for (const Timing& t : result.timings)
         std::printf("sampler=%s build_ms=%.1f ns_per_sample=%.1f ns_per_pdf=%.1f bytes_per_texel=%.2f\n",
                     t.sampler.c_str(), t.build_ms, t.ns_per_sample, t.ns_per_pdf, t.bytes_per_texel);
+    for (const auto& [name, v] : {std::pair{"textbook", result.textbook}, {"pbrt", result.pbrt}})
+        std::printf("speedup_vs_%s build=%.2fx sample=%.2fx pdf=%.2fx batch_sample=%.2fx batch_pdf=%.2fx\n", name,
+                    v.build, v.sample, v.pdf, v.batch_sample, v.batch_pdf);
     std::printf(
-        "speedup_vs_textbook build=%.2fx sample=%.2fx pdf=%.2fx batch_sample=%.2fx "
-        "batch_pdf=%.2fx (sample, pdf: median of the ratios within each repeat)\n",
-        result.build, result.sample, result.pdf, result.batch_sample, result.batch_pdf);
+        "(sample, pdf: median of the ratios within each repeat; pbrt-v4-style on an equal-area %ux%u square, its "
+        "build per texel)\n",
+        map.square.width, map.square.height);
     std::printf(
         "batch_over_single sample=%.2fx lookup_over_pdf=%.2fx lookup_over_lookup=%.2fx (guided-batch against guided: "
         "single sample over sample_many, single pdf, and single lookup (pdf and radiance), over lookup_many; median "
@@ -530,7 +571,7 @@ void run_bench(const BenchArgs& args) {
     EnvMapOptions options = map.options;
     options.compensation.enabled = !args.no_compensate;
     const BenchPoints points = bench_points(args.samples, args.bins > 0, args.samples_per_normal);
-    const BenchResult result = measure(map.image, options, points, args.repeats);
+    const BenchResult result = measure(map, options, points, args.repeats);
     std::optional<BinnedResult> binned;
     if (args.bins > 0) {
         binned = measure_binned(map.image, map.options, args.bins, points, args.repeats);
@@ -547,7 +588,9 @@ void run_bench(const BenchArgs& args) {
 Subcommand add_bench(CLI::App& app) {
     auto args = std::make_shared<BenchArgs>();
     CLI::App* sub = app.add_subcommand(
-        "bench", "Time building and sampling, guided-CDF sampler versus the textbook sampler (medians of repeats)");
+        "bench",
+        "Time building and sampling, guided-CDF sampler versus the textbook sampler and a pbrt-v4-style one (medians "
+        "of repeats)");
     add_bench_flags(*sub, *args);
     return {sub, [args] { run_bench(*args); }};
 }

@@ -315,14 +315,17 @@ TEST_F(Cli, BenchPrintsOneLinePerSamplerWithTheDocumentedFields) {
         r.out, R"((^|\n)map=synthetic-sky size=256x128 mapping=equirect compensated=1 repeats=1 samples=10000)"))
         << r;
     const std::string number = "[0-9]+(\\.[0-9]+)?";
-    for (const char* sampler : {"guided", "guided-batch", "textbook"})
+    for (const char* sampler : {"guided", "guided-batch", "textbook", "pbrt-v4-style"})
         EXPECT_TRUE(contains(r.out, std::string("(^|\\n)sampler=") + sampler + " build_ms=" + number +
                                         " ns_per_sample=" + number + " ns_per_pdf=" + number +
                                         " bytes_per_texel=" + number + "\\n"))
             << sampler << r;
-    EXPECT_TRUE(contains(r.out, "\\nspeedup_vs_textbook build=" + number + "x sample=" + number + "x pdf=" + number +
-                                    "x batch_sample=" + number + "x batch_pdf=" + number + "x "))
-        << r;
+    for (const char* reference : {"textbook", "pbrt"})
+        EXPECT_TRUE(contains(r.out, std::string("\\nspeedup_vs_") + reference + " build=" + number +
+                                        "x sample=" + number + "x pdf=" + number + "x batch_sample=" + number +
+                                        "x batch_pdf=" + number + "x\\n"))
+            << reference << r;
+    EXPECT_TRUE(contains(r.out, "pbrt-v4-style on an equal-area 181x181 square")) << r;
     EXPECT_TRUE(contains(r.out, "\\nbatch_over_single sample=" + number + "x lookup_over_pdf=" + number +
                                     "x lookup_over_lookup=" + number + "x "))
         << r;
@@ -396,15 +399,18 @@ TEST_F(Cli, BenchJsonIsOneObjectWithTheSameFields) {
     EXPECT_EQ(j.at("samples"), 10000);
     EXPECT_EQ(j.at("repeats"), 1);
     EXPECT_EQ(j.at("compensated"), true);
-    ASSERT_EQ(j.at("samplers").size(), 3u);
+    ASSERT_EQ(j.at("samplers").size(), 4u);
     EXPECT_EQ(j["samplers"][0].at("sampler"), "guided");
     EXPECT_EQ(j["samplers"][1].at("sampler"), "guided-batch");
     EXPECT_EQ(j["samplers"][2].at("sampler"), "textbook");
+    EXPECT_EQ(j["samplers"][3].at("sampler"), "pbrt-v4-style");
+    EXPECT_EQ(j.at("pbrt_square"), nlohmann::json::array({181, 181}));  // the square of about as many texels
     for (const auto& s : j["samplers"])
         for (const char* field : {"build_ms", "ns_per_sample", "ns_per_pdf", "bytes_per_texel"})
             EXPECT_TRUE(s.at(field).is_number() && s[field].get<double>() > 0) << field << r;
     for (const char* field : {"build", "sample", "pdf", "batch_sample", "batch_pdf"})
-        EXPECT_TRUE(j.at("speedup_vs_textbook").at(field).is_number()) << field;
+        for (const char* reference : {"speedup_vs_textbook", "speedup_vs_pbrt"})
+            EXPECT_GT(j.at(reference).at(field).get<double>(), 0) << reference << " " << field;
     for (const char* field : {"sample", "lookup_over_pdf", "lookup_over_lookup"})
         EXPECT_GT(j.at("batch_over_single").at(field).get<double>(), 0) << field << r;
 }

@@ -229,7 +229,9 @@ TEST(Distribution2D, TheTunedSampleIsThePlainSearchBitForBit) {
                 ASSERT_EQ(bit_cast<uint32_t>(c.offset), bit_cast<uint32_t>(want.offset));
                 ASSERT_EQ(c.width, want.width);
             }
-            if (row.coarse) ASSERT_EQ(row.invert_cached(u.x).index, want.index);
+            if (row.coarse) {
+                ASSERT_EQ(row.invert_cached(u.x).index, want.index);
+            }
         }
     }
     EXPECT_GT(hot, 10000u);  // the sun's rows (and the small grids' one-cell sun) take the hot path

@@ -116,7 +116,16 @@ struct EnvMapView {
         return {to_world(axes, equal_area_direction(p)), image_pdf * (1 / kFourPi), radiance[texel], p};
     }
     // Solid-angle pdf of sampling `direction` (a unit vector in the world frame).
-    ENVMIS_HD float pdf(Vec3 direction) const noexcept { return pdf_uv(uv_of(direction)); }
+    ENVMIS_HD float pdf(Vec3 direction) const noexcept {
+        if (mapping == Mapping::equal_area) [[unlikely]]
+            return pdf_equal_area(to_canonical(axes, direction));
+        return pdf_uv(equirect_uv(to_canonical(axes, direction)));
+    }
+    // pdf's equal-area half, out of line whole: its mapping and its lookup inlined together
+    // (measured: docs/performance-log.md, 'pdf_equal_area').
+    ENVMIS_NOINLINE ENVMIS_HD float pdf_equal_area(Vec3 canonical) const noexcept {
+        return distribution.pdf(equal_area_uv(canonical)) * (1 / kFourPi);
+    }
     // Solid-angle pdf at image point uv; bit-identical to sample(u).pdf when uv = sample(u).uv.
     ENVMIS_HD float pdf_uv(Vec2 uv) const noexcept { return image_to_solid_angle(distribution.pdf(uv), uv.y); }
     // An image-space density at image row v, per steradian; on one float or eight lanes.
