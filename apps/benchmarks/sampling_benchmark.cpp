@@ -542,27 +542,27 @@ BENCHMARK(equal_area_over_equirect<SkyDetail::clouds>)
     ->ArgsProduct({{5792}, {8192}, {4096}, {0, 1}, {0, 1}})
     ->UseManualTime();
 // The sizes: rooitou_park_1k's square (724^2, about 1024 x 512) and the 8k sky's
-// (5792^2, about 8192 x 4096).
+// (5792^2, about 8192 x 4096); envmis on the square itself or on the equirect map.
+template <envmis::Mapping kMapping>
+void over_pbrt_sizes(benchmark::internal::Benchmark* b) {
+    for (const auto& [side, w, h] : {std::tuple{724, 1024, 512}, {5792, 8192, 4096}}) {
+        const bool square = kMapping == envmis::Mapping::equal_area;
+        b->ArgsProduct({{side}, {square ? side : w}, {square ? side : h}, {0, 1}});
+    }
+    b->UseManualTime();
+}
 BENCHMARK(over_pbrt<envmis::Mapping::equal_area, true>)
     ->Name("pdf/equal-area-over-pbrt")
-    ->ArgsProduct({{724}, {724}, {724}, {0, 1}})
-    ->ArgsProduct({{5792}, {5792}, {5792}, {0, 1}})
-    ->UseManualTime();
+    ->Apply(over_pbrt_sizes<envmis::Mapping::equal_area>);
 BENCHMARK(over_pbrt<envmis::Mapping::equirect, true>)
     ->Name("pdf/equirect-over-pbrt")
-    ->ArgsProduct({{724}, {1024}, {512}, {0, 1}})
-    ->ArgsProduct({{5792}, {8192}, {4096}, {0, 1}})
-    ->UseManualTime();
+    ->Apply(over_pbrt_sizes<envmis::Mapping::equirect>);
 BENCHMARK(over_pbrt<envmis::Mapping::equal_area, false>)
     ->Name("sample/equal-area-over-pbrt")
-    ->ArgsProduct({{724}, {724}, {724}, {0, 1}})
-    ->ArgsProduct({{5792}, {5792}, {5792}, {0, 1}})
-    ->UseManualTime();
+    ->Apply(over_pbrt_sizes<envmis::Mapping::equal_area>);
 BENCHMARK(over_pbrt<envmis::Mapping::equirect, false>)
     ->Name("sample/equirect-over-pbrt")
-    ->ArgsProduct({{724}, {1024}, {512}, {0, 1}})
-    ->ArgsProduct({{5792}, {8192}, {4096}, {0, 1}})
-    ->UseManualTime();
+    ->Apply(over_pbrt_sizes<envmis::Mapping::equirect>);
 BENCHMARK(lookup_over_line_reads)
     ->Name("lookup/many-over-line-reads")
     ->ArgsProduct({{1024, 8192}, {0, 1}})
