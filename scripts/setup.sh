@@ -10,6 +10,7 @@ packages=(
   cmake g++ pkg-config
   libopenimageio-dev libopencolorio-dev libopenexr-dev libeigen3-dev
   libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev
+  libembree-dev libtinyobjloader-dev
   clang libclang-rt-14-dev clang-format
   python3-dev python3-numpy python3-pytest python3-matplotlib pybind11-dev parallel
 )

@@ -109,6 +109,8 @@ add_test(NAME examples.compare.binned-equal-time
 set_tests_properties(examples.compare.binned-equal-samples examples.compare.binned-equal-time PROPERTIES
   FIXTURES_REQUIRED envmis_examples_renders TIMEOUT 120)
 
+include(${CMAKE_CURRENT_SOURCE_DIR}/examples/pathtrace.cmake)
+
 get_directory_property(envmis_examples_tests TESTS)
 list(FILTER envmis_examples_tests INCLUDE REGEX "^examples\\.")
 set_tests_properties(${envmis_examples_tests} PROPERTIES LABELS examples)

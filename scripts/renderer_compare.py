@@ -1,0 +1,192 @@
+#!/usr/bin/python3
+"""What envmis gives a path tracer at equal samples and at equal time.
+
+For each map and scene: the map is converted to pbrt-v4's equal-area square (so that
+every technique, the pbrt-v4-style reference sampler included, samples the same
+texels), three tables are built from it (plain, compensated, normal-aware with 121 bins),
+a high-spp reference is rendered with the plain table, then every technique renders the
+scene with several seeds at equal samples and at equal time (the time the compensated
+table took for those samples, the budget each technique gets). The relative MSE against
+the reference (envmis_example_pathtrace --reference) is averaged over seeds; the table
+gives it with the ratio of the global compensated table's (and the pbrt-v4-style
+sampler's) to the normal-aware table's: above 1, bins have the lower error.
+
+Usage (after building envmis and the examples against an install; docs/results-renderer.md):
+  /usr/bin/python3 scripts/renderer_compare.py --envmis build/apps/envmis \
+      --renderer build-examples/envmis_example_pathtrace --work /tmp/rc \
+      --json docs/results-renderer.json --markdown docs/results-renderer.md
+"""
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+TECHNIQUES = {  # name: (table, --env)
+    "plain": ("plain", "global"),
+    "compensated": ("compensated", "global"),
+    "pbrt": ("compensated", "pbrt"),
+    "bins": ("bins", "bins"),
+}
+REPO = Path(__file__).resolve().parent.parent
+
+
+def run(command, quiet=True):
+    result = subprocess.run([str(c) for c in command], capture_output=quiet, text=True)
+    if result.returncode != 0:
+        sys.exit(f"renderer_compare: failed ({result.returncode}): {' '.join(map(str, command))}\n"
+                 f"{result.stderr if quiet else ''}")
+    return result
+
+
+def tables(envmis, work, map_path):
+    """The equal-area square of the map and its three tables (made once, kept in work/)."""
+    stem = Path(map_path).stem
+    square = work / f"{stem}.square.exr"
+    if not square.exists():
+        run([envmis, "convert", map_path, "-o", square])
+    options = {"plain": ["--no-compensate"], "compensated": [], "bins": ["--bins", "121"]}
+    made = {}
+    for name, extra in options.items():
+        table = work / f"{stem}.{name}.envmis"
+        if not table.exists():
+            run([envmis, "precompute", square, "-o", table, "--mapping", "equal-area", *extra])
+        made[name] = table
+    return made
+
+
+def render(args, table, env, scene, out, seed, spp=None, seconds=None, reference=None):
+    command = [args.renderer, table, "-o", out, "--scene", scene, "--env", env, "--size", args.size,
+               "--seed", seed, "--bounces", args.bounces, "--threads", args.threads]
+    command += ["--spp", spp] if spp else []
+    command += ["--time", f"{seconds:.4f}"] if seconds else []
+    command += ["--reference", reference] if reference else []
+    command += ["--profile"] if args.profile else []
+    run(command)
+    return json.loads(Path(out).with_suffix(".json").read_text())
+
+
+def compare_case(args, made, scene, stem, work):
+    """One scene under one map: reference, then each technique at equal spp and equal time."""
+    reference = work / f"{stem}.{scene}.reference.exr"
+    if not reference.exists():
+        render(args, made["plain"], "global", scene, reference, 1000, spp=args.reference_spp)
+    case = {"scene": scene, "map": stem, "techniques": {}}
+    runs = {}
+    for name, (table, env) in TECHNIQUES.items():
+        runs[name] = [render(args, made[table], env, scene, work / f"{stem}.{scene}.{name}.spp.{s}.exr", s,
+                             spp=args.spp, reference=reference) for s in range(1, args.seeds + 1)]
+    budget = statistics.median(r["seconds"] for r in runs["compensated"])
+    for name, (table, env) in TECHNIQUES.items():
+        timed = [render(args, made[table], env, scene, work / f"{stem}.{scene}.{name}.time.{s}.exr", s,
+                        seconds=budget, reference=reference) for s in range(1, args.seeds + 1)]
+        equal_spp = runs[name]
+        case["techniques"][name] = {
+            "equal_spp_relative_mse": statistics.mean(r["relative_mse"] for r in equal_spp),
+            "equal_spp_seconds": statistics.median(r["seconds"] for r in equal_spp),
+            "equal_time_relative_mse": statistics.mean(r["relative_mse"] for r in timed),
+            "equal_time_passes": statistics.median(r["passes"] for r in timed),
+            "rays_per_second_per_thread": statistics.median(r["rays_per_second_per_thread"] for r in equal_spp),
+            "sampler_share": statistics.median(r.get("sampler_share", 0) for r in equal_spp),
+            "per_seed": {"equal_spp": [r["relative_mse"] for r in equal_spp],
+                         "equal_time": [r["relative_mse"] for r in timed]},
+        }
+    case["budget_seconds"] = budget
+    case["triangles"] = runs["plain"][0]["triangles"]
+    case["cpu"] = runs["plain"][0]["cpu"]
+    return case
+
+
+def ratio(case, over, mode):
+    t = case["techniques"]
+    return t[over][f"{mode}_relative_mse"] / t["bins"][f"{mode}_relative_mse"]
+
+
+def markdown(results, args, command):
+    cases = results["cases"]
+    lines = [
+        "# envmis in a path tracer: error at equal samples and at equal time",
+        "",
+        "Generated by `scripts/renderer_compare.py` (do not edit by hand). Command:",
+        "",
+        f"    {command}",
+        "",
+        f"CPU: {cases[0]['cpu']}, {args.threads} threads. Images {args.size}, {args.bounces} bounces "
+        f"(next-event estimation on the map at each, balance heuristic against the material's sample), "
+        f"{args.spp} spp at equal samples, {args.seeds} seeds; equal time: the compensated table's time at "
+        f"{args.spp} spp for every technique; reference {args.reference_spp} spp (plain table, another seed). "
+        "Relative MSE: mean over pixels of (Y - Y_ref)^2 / (Y_ref^2 + 0.01), averaged over seeds. "
+        "Maps converted to the equal-area square (pbrt-v4's), so every technique samples the same texels.",
+        "",
+        "Ratios are the other technique's relative MSE over the normal-aware table's (`bins`, 121 bins): "
+        "above 1, bins have the lower error.",
+        "",
+        "| scene | map | comp/bins, equal spp | comp/bins, equal time | pbrt/bins, equal time | "
+        "plain/bins, equal time | relMSE bins (time) | passes bins / comp / pbrt | sampler share bins / comp | "
+        "Mrays/s/thread |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for c in cases:
+        t = c["techniques"]
+        lines.append(
+            f"| {c['scene']} | {c['map']} | {ratio(c, 'compensated', 'equal_spp'):.2f} | "
+            f"{ratio(c, 'compensated', 'equal_time'):.2f} | {ratio(c, 'pbrt', 'equal_time'):.2f} | "
+            f"{ratio(c, 'plain', 'equal_time'):.2f} | {t['bins']['equal_time_relative_mse']:.4g} | "
+            f"{t['bins']['equal_time_passes']:g} / {t['compensated']['equal_time_passes']:g} / "
+            f"{t['pbrt']['equal_time_passes']:g} | "
+            f"{t['bins']['sampler_share']:.0%} / {t['compensated']['sampler_share']:.0%} | "
+            f"{t['compensated']['rays_per_second_per_thread'] / 1e6:.2f} |")
+    lines += ["", "Relative MSE per technique (mean over seeds), equal samples / equal time:", "",
+              "| scene | map | " + " | ".join(TECHNIQUES) + " |", "|---|---|" + "---|" * len(TECHNIQUES)]
+    for c in cases:
+        t = c["techniques"]
+        cells = [f"{t[n]['equal_spp_relative_mse']:.4g} / {t[n]['equal_time_relative_mse']:.4g}" for n in TECHNIQUES]
+        lines.append(f"| {c['scene']} | {c['map']} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--envmis", required=True, help="the envmis command")
+    p.add_argument("--renderer", required=True, help="envmis_example_pathtrace")
+    p.add_argument("--work", required=True, help="folder for tables and images (reused: delete it to start over)")
+    p.add_argument("--maps", nargs="+", default=[str(REPO / "data/envmaps" / m)
+                                                  for m in ("rooitou_park_1k.hdr", "city.exr", "studio.exr")])
+    p.add_argument("--scenes", nargs="+", default=["objects", "materials", "interior", "mesh"])
+    p.add_argument("--size", default="256x192")
+    p.add_argument("--spp", type=int, default=16)
+    p.add_argument("--reference-spp", type=int, default=1024)
+    p.add_argument("--seeds", type=int, default=3)
+    p.add_argument("--bounces", type=int, default=4)
+    p.add_argument("--threads", type=int, default=os.cpu_count())
+    p.add_argument("--profile", action="store_true", help="measure the sampler's share of the time (rdtsc)")
+    p.add_argument("--json", help="write the results here")
+    p.add_argument("--markdown", help="write the tables here")
+    args = p.parse_args()
+    if args.spp < 1 or args.reference_spp < 2 or args.seeds < 1 or args.bounces < 1 or args.threads < 1:
+        p.error("--spp, --seeds, --bounces and --threads must be at least 1, --reference-spp at least 2")
+    work = Path(args.work)
+    work.mkdir(parents=True, exist_ok=True)
+    start = time.time()
+    results = {"cases": []}
+    for map_path in args.maps:
+        made = tables(args.envmis, work, map_path)
+        for scene in args.scenes:
+            case = compare_case(args, made, scene, Path(map_path).stem, work)
+            results["cases"].append(case)
+            print(f"{scene:10s} {case['map']:18s} comp/bins {ratio(case, 'compensated', 'equal_spp'):5.2f} (spp) "
+                  f"{ratio(case, 'compensated', 'equal_time'):5.2f} (time), pbrt/bins "
+                  f"{ratio(case, 'pbrt', 'equal_time'):5.2f} (time)  [{time.time() - start:.0f} s]", flush=True)
+    command = "/usr/bin/python3 scripts/renderer_compare.py " + " ".join(sys.argv[1:])
+    if args.json:
+        Path(args.json).write_text(json.dumps(results, indent=1) + "\n")
+    if args.markdown:
+        Path(args.markdown).write_text(markdown(results, args, command))
+
+
+if __name__ == "__main__":
+    main()

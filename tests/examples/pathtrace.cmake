@@ -1,0 +1,108 @@
+# Path tracer tests (included from examples.cmake): build apps/examples' path tracer
+# against the install, make equal-area tables of the sunny map (the pbrt-v4-style
+# sampler needs the square), render each scene with each environment technique and
+# check that every one converges to the reference (the plain table at many samples):
+# mean luminance within 4 standard errors (check_mean.py). Small images, a few seconds
+# in all on 2 cores. Needs Embree and tinyobjloader (Debian's libembree-dev and
+# libtinyobjloader-dev; scripts/setup.sh installs them) and Python for the check.
+find_package(embree 3 CONFIG QUIET)
+find_package(tinyobjloader CONFIG QUIET)
+if(NOT embree_FOUND OR NOT tinyobjloader_FOUND OR NOT Python3_Interpreter_FOUND)
+  message(STATUS "examples.pathtrace tests: skipped (need libembree-dev, libtinyobjloader-dev and Python)")
+  return()
+endif()
+
+set(envmis_pt_work ${envmis_examples_work}/pathtrace)
+# A build folder of its own: --build-and-test cleans the folder it builds in.
+set(envmis_pt_build ${envmis_examples_dir}/build-pathtrace)
+if(CMAKE_CONFIGURATION_TYPES)
+  set(envmis_pt_exe ${envmis_pt_build}/$<CONFIG>/envmis_example_pathtrace)
+else()
+  set(envmis_pt_exe ${envmis_pt_build}/envmis_example_pathtrace)
+endif()
+set(envmis_pt ${CMAKE_COMMAND} -E env
+  OCIO=${envmis_consumer_prefix}/${CMAKE_INSTALL_DATADIR}/envmis/ocio/config.ocio ${envmis_pt_exe})
+set(envmis_pt_check ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/examples/check_mean.py)
+
+add_test(NAME examples.pathtrace.build
+  COMMAND ${CMAKE_CTEST_COMMAND} --build-and-test ${PROJECT_SOURCE_DIR}/apps/examples ${envmis_pt_build}
+    --build-generator ${CMAKE_GENERATOR}
+    --build-makeprogram ${CMAKE_MAKE_PROGRAM}
+    --build-project envmis_examples
+    --build-target envmis_example_pathtrace
+    --build-options -DCMAKE_PREFIX_PATH=${envmis_consumer_prefix} -DCMAKE_BUILD_TYPE=$<CONFIG>
+      -DCMAKE_CXX_COMPILER=${CMAKE_CXX_COMPILER} -DCMAKE_COMPILE_WARNING_AS_ERROR=ON)
+set_tests_properties(examples.pathtrace.build PROPERTIES
+  FIXTURES_REQUIRED envmis_installed FIXTURES_SETUP envmis_pt_built TIMEOUT 600)
+
+add_test(NAME examples.pathtrace.work COMMAND ${CMAKE_COMMAND} -E make_directory ${envmis_pt_work})
+add_test(NAME examples.pathtrace.square
+  COMMAND envmis convert ${envmis_examples_map} -o ${envmis_pt_work}/square.exr --size 128)
+set_tests_properties(examples.pathtrace.work PROPERTIES FIXTURES_SETUP envmis_pt_work)
+set_tests_properties(examples.pathtrace.square PROPERTIES
+  FIXTURES_REQUIRED envmis_pt_work FIXTURES_SETUP envmis_pt_square TIMEOUT 120)
+foreach(table plain:--no-compensate compensated bins:--bins:121)
+  string(REPLACE ":" ";" parts ${table})
+  list(POP_FRONT parts name)
+  add_test(NAME examples.pathtrace.table.${name}
+    COMMAND envmis precompute ${envmis_pt_work}/square.exr -o ${envmis_pt_work}/${name}.envmis
+      --mapping equal-area ${parts})
+  set_tests_properties(examples.pathtrace.table.${name} PROPERTIES
+    FIXTURES_REQUIRED envmis_pt_square FIXTURES_SETUP envmis_pt_tables TIMEOUT 120)
+endforeach()
+
+# Per scene: a reference (plain table, 4096 passes, seed 1000) and 256 passes of each
+# technique (seed 1); 48x36 pixels, 3 bounces.
+set(envmis_pt_args --size 48x36 --bounces 3)
+foreach(scene objects materials interior mesh)
+  add_test(NAME examples.pathtrace.${scene}.reference
+    COMMAND ${envmis_pt} ${envmis_pt_work}/plain.envmis -o ${envmis_pt_work}/${scene}-reference.exr
+      --scene ${scene} --spp 4096 --seed 1000 ${envmis_pt_args})
+  set_tests_properties(examples.pathtrace.${scene}.reference PROPERTIES
+    FIXTURES_REQUIRED "envmis_pt_built;envmis_pt_tables" FIXTURES_SETUP envmis_pt_${scene} TIMEOUT 300)
+  foreach(technique plain:plain:global compensated:compensated:global bins:bins:bins pbrt:compensated:pbrt)
+    string(REPLACE ":" ";" parts ${technique})
+    list(GET parts 0 name)
+    list(GET parts 1 table)
+    list(GET parts 2 env)
+    add_test(NAME examples.pathtrace.${scene}.${name}
+      COMMAND ${envmis_pt} ${envmis_pt_work}/${table}.envmis -o ${envmis_pt_work}/${scene}-${name}.exr
+        --scene ${scene} --env ${env} --spp 256 --seed 1 ${envmis_pt_args}
+        --reference ${envmis_pt_work}/${scene}-reference.exr)
+    add_test(NAME examples.pathtrace.${scene}.${name}.converges
+      COMMAND ${envmis_pt_check} ${envmis_pt_work}/${scene}-reference.json ${envmis_pt_work}/${scene}-${name}.json)
+    set_tests_properties(examples.pathtrace.${scene}.${name} PROPERTIES
+      FIXTURES_REQUIRED "envmis_pt_${scene}" FIXTURES_SETUP envmis_pt_${scene}_${name} TIMEOUT 300)
+    set_tests_properties(examples.pathtrace.${scene}.${name}.converges PROPERTIES
+      FIXTURES_REQUIRED envmis_pt_${scene}_${name} TIMEOUT 60)
+  endforeach()
+endforeach()
+
+# A time budget ends the render after the first pass that reaches it.
+add_test(NAME examples.pathtrace.time-budget
+  COMMAND ${envmis_pt} ${envmis_pt_work}/compensated.envmis -o ${envmis_pt_work}/timed.exr --time 0.2
+    ${envmis_pt_args})
+set_tests_properties(examples.pathtrace.time-budget PROPERTIES
+  FIXTURES_REQUIRED "envmis_pt_built;envmis_pt_tables" PASS_REGULAR_EXPRESSION "48x36, [0-9]+ spp, 0\\.[2-9]" TIMEOUT 60)
+
+# Refusals name the problem and the fix.
+add_test(NAME examples.pathtrace.refuses-pbrt-on-equirect
+  COMMAND ${envmis_pt} ${envmis_examples_work}/compensated.envmis -o ${envmis_pt_work}/refused.exr --env pbrt)
+add_test(NAME examples.pathtrace.refuses-bins-without-bins
+  COMMAND ${envmis_pt} ${envmis_pt_work}/compensated.envmis -o ${envmis_pt_work}/refused.exr --env bins)
+add_test(NAME examples.pathtrace.refuses-unknown-scene
+  COMMAND ${envmis_pt} ${envmis_pt_work}/compensated.envmis -o ${envmis_pt_work}/refused.exr --scene kitchen)
+add_test(NAME examples.pathtrace.refuses-a-bad-obj
+  COMMAND ${envmis_pt} ${envmis_pt_work}/compensated.envmis -o ${envmis_pt_work}/refused.exr --scene mesh
+    --obj ${envmis_examples_map})
+set_tests_properties(examples.pathtrace.refuses-pbrt-on-equirect PROPERTIES
+  PASS_REGULAR_EXPRESSION "pbrt-v4's equal-area square.*--mapping equal-area")
+set_tests_properties(examples.pathtrace.refuses-bins-without-bins PROPERTIES
+  PASS_REGULAR_EXPRESSION "has no bins.*--bins 121")
+set_tests_properties(examples.pathtrace.refuses-unknown-scene PROPERTIES
+  PASS_REGULAR_EXPRESSION "--scene 'kitchen': expected one of objects, materials, interior, mesh")
+set_tests_properties(examples.pathtrace.refuses-a-bad-obj PROPERTIES
+  PASS_REGULAR_EXPRESSION "not a readable OBJ file|no faces")
+set_tests_properties(examples.pathtrace.refuses-pbrt-on-equirect examples.pathtrace.refuses-bins-without-bins
+  examples.pathtrace.refuses-unknown-scene examples.pathtrace.refuses-a-bad-obj PROPERTIES
+  FIXTURES_REQUIRED "envmis_pt_built;envmis_pt_tables;envmis_examples_tables" TIMEOUT 60)
