@@ -32,6 +32,7 @@ TECHNIQUES = {  # name: (table, --env)
     "pbrt": ("compensated", "pbrt"),
     "bins": ("bins", "bins"),
 }
+FLOOR_LIGHT_SAMPLES = 32
 REPO = Path(__file__).resolve().parent.parent
 
 
@@ -59,31 +60,36 @@ def tables(envmis, work, map_path):
     return made
 
 
-def render(args, table, env, scene, out, seed, spp=None, seconds=None, reference=None):
+def render(args, table, env, scene, out, seed, bounces, spp=None, seconds=None, reference=None, light_samples=1,
+           profile=False):
     command = [args.renderer, table, "-o", out, "--scene", scene, "--env", env, "--size", args.size,
-               "--seed", seed, "--bounces", args.bounces, "--threads", args.threads]
+               "--seed", seed, "--bounces", bounces, "--threads", args.threads, "--light-samples", light_samples]
     command += ["--spp", spp] if spp else []
     command += ["--time", f"{seconds:.4f}"] if seconds else []
     command += ["--reference", reference] if reference else []
-    command += ["--profile"] if args.profile else []
+    command += ["--profile"] if profile else []
     run(command)
     return json.loads(Path(out).with_suffix(".json").read_text())
 
 
-def compare_case(args, made, scene, stem, work):
-    """One scene under one map: reference, then each technique at equal spp and equal time."""
-    reference = work / f"{stem}.{scene}.reference.exr"
+def compare_case(args, made, scene, stem, work, bounces):
+    """One scene under one map: reference, then each technique at equal spp and equal time
+    (the sampler's share profiled in a run of its own, as profiling costs time), and the
+    floor: the plain (complete) table with FLOOR_LIGHT_SAMPLES environment samples a vertex."""
+    prefix = work / f"{stem}.{scene}.b{bounces}"
+    reference = Path(f"{prefix}.reference.exr")
     if not reference.exists():
-        render(args, made["plain"], "global", scene, reference, 1000, spp=args.reference_spp)
+        render(args, made["plain"], "global", scene, reference, 1000, bounces, spp=args.reference_spp)
     case = {"scene": scene, "map": stem, "techniques": {}}
-    runs = {}
-    for name, (table, env) in TECHNIQUES.items():
-        runs[name] = [render(args, made[table], env, scene, work / f"{stem}.{scene}.{name}.spp.{s}.exr", s,
-                             spp=args.spp, reference=reference) for s in range(1, args.seeds + 1)]
+    seeds = range(1, args.seeds + 1)
+    runs = {name: [render(args, made[table], env, scene, f"{prefix}.{name}.spp.{s}.exr", s, bounces, spp=args.spp,
+                          reference=reference) for s in seeds] for name, (table, env) in TECHNIQUES.items()}
     budget = statistics.median(r["seconds"] for r in runs["compensated"])
     for name, (table, env) in TECHNIQUES.items():
-        timed = [render(args, made[table], env, scene, work / f"{stem}.{scene}.{name}.time.{s}.exr", s,
-                        seconds=budget, reference=reference) for s in range(1, args.seeds + 1)]
+        timed = [render(args, made[table], env, scene, f"{prefix}.{name}.time.{s}.exr", s, bounces, seconds=budget,
+                        reference=reference) for s in seeds]
+        profiled = render(args, made[table], env, scene, f"{prefix}.{name}.profile.exr", 1, bounces, spp=args.spp,
+                          profile=True)
         equal_spp = runs[name]
         case["techniques"][name] = {
             "equal_spp_relative_mse": statistics.mean(r["relative_mse"] for r in equal_spp),
@@ -91,10 +97,13 @@ def compare_case(args, made, scene, stem, work):
             "equal_time_relative_mse": statistics.mean(r["relative_mse"] for r in timed),
             "equal_time_passes": statistics.median(r["passes"] for r in timed),
             "rays_per_second_per_thread": statistics.median(r["rays_per_second_per_thread"] for r in equal_spp),
-            "sampler_share": statistics.median(r.get("sampler_share", 0) for r in equal_spp),
+            "sampler_share": profiled["sampler_share"],
             "per_seed": {"equal_spp": [r["relative_mse"] for r in equal_spp],
                          "equal_time": [r["relative_mse"] for r in timed]},
         }
+    floor = [render(args, made["plain"], "global", scene, f"{prefix}.floor.{s}.exr", s, bounces, spp=args.spp,
+                    reference=reference, light_samples=FLOOR_LIGHT_SAMPLES) for s in seeds]
+    case["floor_relative_mse"] = statistics.mean(r["relative_mse"] for r in floor)
     case["budget_seconds"] = budget
     case["triangles"] = runs["plain"][0]["triangles"]
     case["cpu"] = runs["plain"][0]["cpu"]
@@ -106,8 +115,36 @@ def ratio(case, over, mode):
     return t[over][f"{mode}_relative_mse"] / t["bins"][f"{mode}_relative_mse"]
 
 
+def table_lines(cases):
+    lines = [
+        "| scene | map | comp/bins, equal spp | comp/bins, equal time | pbrt/bins, equal time | "
+        "plain/bins, equal time | floor/comp | bins relMSE (time) | passes bins / comp / pbrt | "
+        "sampler share bins / comp / pbrt | Mrays/s/thread |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for c in cases:
+        t = c["techniques"]
+        lines.append(
+            f"| {c['scene']} | {c['map']} | {ratio(c, 'compensated', 'equal_spp'):.2f} | "
+            f"{ratio(c, 'compensated', 'equal_time'):.2f} | {ratio(c, 'pbrt', 'equal_time'):.2f} | "
+            f"{ratio(c, 'plain', 'equal_time'):.2f} | "
+            f"{c['floor_relative_mse'] / t['compensated']['equal_spp_relative_mse']:.2f} | "
+            f"{t['bins']['equal_time_relative_mse']:.4g} | "
+            f"{t['bins']['equal_time_passes']:g} / {t['compensated']['equal_time_passes']:g} / "
+            f"{t['pbrt']['equal_time_passes']:g} | "
+            f"{t['bins']['sampler_share']:.0%} / {t['compensated']['sampler_share']:.0%} / "
+            f"{t['pbrt']['sampler_share']:.0%} | {t['compensated']['rays_per_second_per_thread'] / 1e6:.2f} |")
+    lines += ["", "Relative MSE per technique (mean over seeds), equal samples / equal time:", "",
+              "| scene | map | " + " | ".join(TECHNIQUES) + " |", "|---|---|" + "---|" * len(TECHNIQUES)]
+    for c in cases:
+        t = c["techniques"]
+        cells = [f"{t[n]['equal_spp_relative_mse']:.4g} / {t[n]['equal_time_relative_mse']:.4g}" for n in TECHNIQUES]
+        lines.append(f"| {c['scene']} | {c['map']} | " + " | ".join(cells) + " |")
+    return lines
+
+
 def markdown(results, args, command):
-    cases = results["cases"]
+    cpu = results["runs"][0]["cases"][0]["cpu"]
     lines = [
         "# envmis in a path tracer: error at equal samples and at equal time",
         "",
@@ -115,37 +152,24 @@ def markdown(results, args, command):
         "",
         f"    {command}",
         "",
-        f"CPU: {cases[0]['cpu']}, {args.threads} threads. Images {args.size}, {args.bounces} bounces "
-        f"(next-event estimation on the map at each, balance heuristic against the material's sample), "
-        f"{args.spp} spp at equal samples, {args.seeds} seeds; equal time: the compensated table's time at "
-        f"{args.spp} spp for every technique; reference {args.reference_spp} spp (plain table, another seed). "
-        "Relative MSE: mean over pixels of (Y - Y_ref)^2 / (Y_ref^2 + 0.01), averaged over seeds. "
-        "Maps converted to the equal-area square (pbrt-v4's), so every technique samples the same texels.",
+        f"CPU: {cpu}, {args.threads} threads. Images {args.size}; at every vertex one environment sample "
+        f"(next-event estimation, shadow ray) and one material sample, balance heuristic; {args.spp} spp at "
+        f"equal samples, {args.seeds} seeds; equal time: the time the compensated table took for {args.spp} spp, "
+        f"for every technique; reference {args.reference_spp} spp (plain table, another seed). Relative MSE: "
+        "mean over pixels of (Y - Y_ref)^2 / (Y_ref^2 + 0.01), averaged over seeds. Maps converted to the "
+        "equal-area square (pbrt-v4's), so every technique samples the same texels. Scenes: "
+        "apps/examples/pathtrace/scene.h.",
         "",
-        "Ratios are the other technique's relative MSE over the normal-aware table's (`bins`, 121 bins): "
-        "above 1, bins have the lower error.",
-        "",
-        "| scene | map | comp/bins, equal spp | comp/bins, equal time | pbrt/bins, equal time | "
-        "plain/bins, equal time | relMSE bins (time) | passes bins / comp / pbrt | sampler share bins / comp | "
-        "Mrays/s/thread |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "Columns: the other technique's relative MSE over the normal-aware table's (`bins`, 121 bins): above 1, "
+        f"bins have the lower error. `floor/comp`: the plain table with {FLOOR_LIGHT_SAMPLES} environment "
+        "samples a vertex over the compensated table with one, at equal samples: the error left when direct light from the map is "
+        "nearly noise-free, so 1 / floor is the most any environment sampler can gain at equal samples. "
+        "Sampler share: the threads' time in the environment's calls (choosing the bin, sampling, looking up; "
+        "timed with the CPU's cycle counter in a run of its own).",
     ]
-    for c in cases:
-        t = c["techniques"]
-        lines.append(
-            f"| {c['scene']} | {c['map']} | {ratio(c, 'compensated', 'equal_spp'):.2f} | "
-            f"{ratio(c, 'compensated', 'equal_time'):.2f} | {ratio(c, 'pbrt', 'equal_time'):.2f} | "
-            f"{ratio(c, 'plain', 'equal_time'):.2f} | {t['bins']['equal_time_relative_mse']:.4g} | "
-            f"{t['bins']['equal_time_passes']:g} / {t['compensated']['equal_time_passes']:g} / "
-            f"{t['pbrt']['equal_time_passes']:g} | "
-            f"{t['bins']['sampler_share']:.0%} / {t['compensated']['sampler_share']:.0%} | "
-            f"{t['compensated']['rays_per_second_per_thread'] / 1e6:.2f} |")
-    lines += ["", "Relative MSE per technique (mean over seeds), equal samples / equal time:", "",
-              "| scene | map | " + " | ".join(TECHNIQUES) + " |", "|---|---|" + "---|" * len(TECHNIQUES)]
-    for c in cases:
-        t = c["techniques"]
-        cells = [f"{t[n]['equal_spp_relative_mse']:.4g} / {t[n]['equal_time_relative_mse']:.4g}" for n in TECHNIQUES]
-        lines.append(f"| {c['scene']} | {c['map']} | " + " | ".join(cells) + " |")
+    for run in results["runs"]:
+        title = "Direct lighting only (1 bounce)" if run["bounces"] == 1 else f"Path tracing, {run['bounces']} bounces"
+        lines += ["", f"## {title}", ""] + table_lines(run["cases"])
     return "\n".join(lines) + "\n"
 
 
@@ -161,26 +185,27 @@ def main():
     p.add_argument("--spp", type=int, default=16)
     p.add_argument("--reference-spp", type=int, default=1024)
     p.add_argument("--seeds", type=int, default=3)
-    p.add_argument("--bounces", type=int, default=4)
+    p.add_argument("--bounces", type=int, nargs="+", default=[4, 1], help="one table for each")
     p.add_argument("--threads", type=int, default=os.cpu_count())
-    p.add_argument("--profile", action="store_true", help="measure the sampler's share of the time (rdtsc)")
     p.add_argument("--json", help="write the results here")
     p.add_argument("--markdown", help="write the tables here")
     args = p.parse_args()
-    if args.spp < 1 or args.reference_spp < 2 or args.seeds < 1 or args.bounces < 1 or args.threads < 1:
+    if args.spp < 1 or args.reference_spp < 2 or args.seeds < 1 or min(args.bounces) < 1 or args.threads < 1:
         p.error("--spp, --seeds, --bounces and --threads must be at least 1, --reference-spp at least 2")
     work = Path(args.work)
     work.mkdir(parents=True, exist_ok=True)
     start = time.time()
-    results = {"cases": []}
+    results = {"runs": [{"bounces": b, "cases": []} for b in args.bounces]}
     for map_path in args.maps:
         made = tables(args.envmis, work, map_path)
-        for scene in args.scenes:
-            case = compare_case(args, made, scene, Path(map_path).stem, work)
-            results["cases"].append(case)
-            print(f"{scene:10s} {case['map']:18s} comp/bins {ratio(case, 'compensated', 'equal_spp'):5.2f} (spp) "
-                  f"{ratio(case, 'compensated', 'equal_time'):5.2f} (time), pbrt/bins "
-                  f"{ratio(case, 'pbrt', 'equal_time'):5.2f} (time)  [{time.time() - start:.0f} s]", flush=True)
+        for run_ in results["runs"]:
+            for scene in args.scenes:
+                case = compare_case(args, made, scene, Path(map_path).stem, work, run_["bounces"])
+                run_["cases"].append(case)
+                print(f"{run_['bounces']} bounces {scene:10s} {case['map']:16s} comp/bins "
+                      f"{ratio(case, 'compensated', 'equal_spp'):5.2f} (spp) "
+                      f"{ratio(case, 'compensated', 'equal_time'):5.2f} (time), pbrt/bins "
+                      f"{ratio(case, 'pbrt', 'equal_time'):5.2f} (time)  [{time.time() - start:.0f} s]", flush=True)
     command = "/usr/bin/python3 scripts/renderer_compare.py " + " ".join(sys.argv[1:])
     if args.json:
         Path(args.json).write_text(json.dumps(results, indent=1) + "\n")

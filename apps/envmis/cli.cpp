@@ -48,7 +48,9 @@ void add_map_flags(CLI::App& app, BuildRequest& request) {
     app.add_option("--colorspace", request.colorspace, "Input colour space (default: from the file's metadata)");
     app.add_option("--working-space", request.working_space, "Linear working colour space, e.g. lin_rec709 or ACEScg")
         ->capture_default_str();
-    app.add_option("--axes", request.axes, "World frame of directions: z-up, y-up or a signed permutation like x,z,-y")
+    app.add_option("--axes", request.axes,
+                   "World frame of directions: z-up, y-up, a renderer's (pbrt-v4, mitsuba3, blender) or a signed "
+                   "permutation like x,z,-y")
         ->capture_default_str();
 }
 

@@ -162,7 +162,7 @@ path: an image that OpenImageIO reads (EXR, .hdr, .pfm, TIFF...), converted with
 compensate: compensate the density for MIS (False: luminance times solid angle).
 alpha: compensation strength, a number >= 0, or the str "auto" (choose_alpha: the
    candidate with the lowest exact variance of balance MIS); any other str is refused. Default: 1, or with bins auto per bin and lobe class.
-axes: the world frame of directions: "z-up", "y-up" or a signed permutation like "x,z,-y".
+axes: the world frame of directions: "z-up", "y-up", a renderer's ("pbrt-v4", "mitsuba3", "blender") or a signed permutation like "x,z,-y".
 mapping: "equirect" (latitude-longitude) or "equal-area" (octahedral, a square image).
 bins: K = g^2 (g 1 to 64) gives a BinnedEnvMap as `precompute --bins K` builds it;
    cell_columns its cell grid's columns (0: width / 32), bin_cost what a compensated bin's

@@ -2,7 +2,8 @@
 # against the install, make equal-area tables of the sunny map (the pbrt-v4-style
 # sampler needs the square), render each scene with each environment technique and
 # check that every one converges to the reference (the plain table at many samples):
-# mean luminance within 4 standard errors (check_mean.py). Small images, a few seconds
+# mean luminance within 4 standard errors (check_mean.py); likewise with the sky turned
+# at render time (--rotate); an OBJ mesh; time budgets; refusals. Small images, a few seconds
 # in all on 2 cores. Needs Embree and tinyobjloader (Debian's libembree-dev and
 # libtinyobjloader-dev; scripts/setup.sh installs them) and Python for the check.
 find_package(embree 3 CONFIG QUIET)
@@ -78,12 +79,47 @@ foreach(scene objects materials interior mesh)
   endforeach()
 endforeach()
 
+# The sky turned at render time (--rotate 90, rotated.h): every technique converges to
+# the turned reference, which differs from the unturned one.
+add_test(NAME examples.pathtrace.rotated.reference
+  COMMAND ${envmis_pt} ${envmis_pt_work}/plain.envmis -o ${envmis_pt_work}/rotated-reference.exr
+    --scene objects --spp 4096 --seed 1000 --rotate 90 ${envmis_pt_args})
+add_test(NAME examples.pathtrace.rotated.differs
+  COMMAND ${envmis_pt_check} ${envmis_pt_work}/objects-reference.json ${envmis_pt_work}/rotated-reference.json --differ)
+set_tests_properties(examples.pathtrace.rotated.reference PROPERTIES
+  FIXTURES_REQUIRED "envmis_pt_built;envmis_pt_tables" FIXTURES_SETUP envmis_pt_rotated TIMEOUT 300)
+set_tests_properties(examples.pathtrace.rotated.differs PROPERTIES
+  FIXTURES_REQUIRED "envmis_pt_rotated;envmis_pt_objects" TIMEOUT 60)
+foreach(technique compensated:compensated:global bins:bins:bins pbrt:compensated:pbrt)
+  string(REPLACE ":" ";" parts ${technique})
+  list(GET parts 0 name)
+  list(GET parts 1 table)
+  list(GET parts 2 env)
+  add_test(NAME examples.pathtrace.rotated.${name}
+    COMMAND ${envmis_pt} ${envmis_pt_work}/${table}.envmis -o ${envmis_pt_work}/rotated-${name}.exr
+      --scene objects --env ${env} --spp 256 --seed 1 --rotate 90 ${envmis_pt_args})
+  add_test(NAME examples.pathtrace.rotated.${name}.converges
+    COMMAND ${envmis_pt_check} ${envmis_pt_work}/rotated-reference.json ${envmis_pt_work}/rotated-${name}.json)
+  set_tests_properties(examples.pathtrace.rotated.${name} PROPERTIES
+    FIXTURES_REQUIRED envmis_pt_rotated FIXTURES_SETUP envmis_pt_rotated_${name} TIMEOUT 300)
+  set_tests_properties(examples.pathtrace.rotated.${name}.converges PROPERTIES
+    FIXTURES_REQUIRED envmis_pt_rotated_${name} TIMEOUT 60)
+endforeach()
+
 # A time budget ends the render after the first pass that reaches it.
 add_test(NAME examples.pathtrace.time-budget
   COMMAND ${envmis_pt} ${envmis_pt_work}/compensated.envmis -o ${envmis_pt_work}/timed.exr --time 0.2
     ${envmis_pt_args})
 set_tests_properties(examples.pathtrace.time-budget PROPERTIES
   FIXTURES_REQUIRED "envmis_pt_built;envmis_pt_tables" PASS_REGULAR_EXPRESSION "48x36, [0-9]+ spp, 0\\.[2-9]" TIMEOUT 60)
+
+# A mesh read from an OBJ file replaces the knot: the ground's 2 triangles and its 4.
+add_test(NAME examples.pathtrace.obj
+  COMMAND ${envmis_pt} ${envmis_pt_work}/compensated.envmis -o ${envmis_pt_work}/obj.exr --scene mesh
+    --obj ${CMAKE_CURRENT_SOURCE_DIR}/examples/data/tetrahedron.obj --spp 4 ${envmis_pt_args})
+set_tests_properties(examples.pathtrace.obj PROPERTIES
+  FIXTURES_REQUIRED "envmis_pt_built;envmis_pt_tables" PASS_REGULAR_EXPRESSION "mesh \\(6 triangles\\)"
+  TIMEOUT 60)
 
 # Refusals name the problem and the fix.
 add_test(NAME examples.pathtrace.refuses-pbrt-on-equirect

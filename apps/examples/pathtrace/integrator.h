@@ -1,8 +1,8 @@
 // Path tracing under an environment map: what a renderer does with envmis at every bounce.
 //
 // At each surface vertex the light from the map is estimated twice and the two combined
-// by the balance heuristic (one-sample-each MIS): next-event estimation draws a direction
-// from the environment's density and traces a shadow ray; the path continues in a
+// by the balance heuristic: next-event estimation draws a direction (or several:
+// PathOptions::light_samples) from the environment's density and traces a shadow ray; the path continues in a
 // direction drawn from the material, and where that ray escapes to the sky its radiance
 // is weighted against the density the environment technique had at that vertex. Russian
 // roulette ends paths after a few bounces, by their throughput.
@@ -23,6 +23,7 @@
 #include "envmis/math/random.h"
 #include "envmis/sampling/binned.h"
 #include "envmis/sampling/envmap.h"
+#include "envmis/sampling/rotated.h"
 #include "envmis/study/shading/frame.h"
 #include "pbrt_style.h"
 #include "scene.h"
@@ -34,18 +35,26 @@ inline Rgb operator*(Rgb a, Rgb b) { return {a.r * b.r, a.g * b.g, a.b * b.b}; }
 inline Rgb operator*(Rgb a, float s) { return {a.r * s, a.g * s, a.b * s}; }
 
 // The density one vertex samples: sample(u) and lookup(direction) (radiance and pdf), as
-// EnvMapView and BinView have them.
+// EnvMapView and BinView have them, turned by the renderer's rotation of the sky
+// (rotated.h; the identity unless --rotate).
 struct GlobalEnvironment {
-    envmis::EnvMapView map;
-    const envmis::EnvMapView& at(Vec3 /*normal*/, Vec3 /*to_viewer*/, uint32_t /*lobe*/, float /*choice*/) const {
+    envmis::Rotated<envmis::EnvMapView> map;
+    const envmis::Rotated<envmis::EnvMapView>& at(Vec3 /*normal*/, Vec3 /*to_viewer*/, uint32_t /*lobe*/,
+                                                  float /*choice*/, uint32_t /*vertex*/) const {
         return map;
     }
     Rgb eval(Vec3 direction) const noexcept { return map.eval(direction); }
 };
 
+// Bins at the first `depth` vertices of a path; beyond, the table's plain map (a bin
+// marked plain: binned.h), whose samples cost less where a path's throughput has
+// already shrunk what they can gain.
 struct BinnedEnvironment {
-    envmis::BinnedEnvMapView bins;
-    envmis::BinView at(Vec3 normal, Vec3 to_viewer, uint32_t lobe, float choice) const {
+    envmis::RotatedBinned bins;
+    uint32_t depth = UINT32_MAX;
+    envmis::Rotated<envmis::BinView> at(Vec3 normal, Vec3 to_viewer, uint32_t lobe, float choice,
+                                        uint32_t vertex) const {
+        if (vertex >= depth) return {{bins.map, {}, true}, bins.rotation};
         return bins.bin(envmis::lobe_axis(lobe, normal, to_viewer), lobe, choice);
     }
     Rgb eval(Vec3 direction) const noexcept { return bins.eval(direction); }
@@ -56,20 +65,31 @@ struct BinnedEnvironment {
 struct PbrtEnvironment {
     const envmis::reference::PbrtStyleEnvMap* sampler = nullptr;
     envmis::EnvMapView map;  // the plain equal-area map whose radiance the sampler holds
+    envmis::Rotation rotation;
     struct Density {
         const PbrtEnvironment* env;
-        envmis::EnvSample sample(Vec2 u) const noexcept { return env->sampler->sample(u); }
+        envmis::EnvSample sample(Vec2 u) const noexcept {
+            envmis::EnvSample s = env->sampler->sample(u);
+            s.direction = env->rotation.to_world(s.direction);
+            return s;
+        }
         envmis::EnvMapView::Lookup lookup(Vec3 direction) const noexcept {
-            return {env->map.eval(direction), env->sampler->pdf(direction)};
+            const Vec3 local = env->rotation.to_local(direction);
+            return {env->map.eval(local), env->sampler->pdf(local)};
         }
     };
-    Density at(Vec3, Vec3, uint32_t, float) const { return {this}; }
-    Rgb eval(Vec3 direction) const noexcept { return map.eval(direction); }
+    Density at(Vec3, Vec3, uint32_t, float, uint32_t) const { return {this}; }
+    Rgb eval(Vec3 direction) const noexcept { return map.eval(rotation.to_local(direction)); }
 };
 
 struct PathOptions {
     uint32_t max_bounces = 4;     // surface vertices lit along a path
     uint32_t roulette_after = 2;  // vertices before Russian roulette starts
+    // Environment samples at each vertex (one material sample): n light samples and the
+    // material's combined by the balance heuristic with counts (n p_env + p_bsdf). Many
+    // make direct lighting nearly noise-free: what is left is the floor no environment
+    // sampler can lower.
+    uint32_t light_samples = 1;
 };
 
 // What one thread traced: rays (camera, continuation and shadow) and, where profiled,
@@ -97,20 +117,23 @@ Rgb trace_path(const Environment& env, const RayScene& scene, const SceneDescrip
         const Vec3 to_viewer = direction * -1.0f, wo = frame.to_local(to_viewer);
         if (wo.z <= 0) break;  // a shading normal turned away from the viewer
         const uint64_t t0 = Profile ? ticks() : 0;
-        const auto density = env.at(hit->shading_normal, to_viewer, lobes[hit->material], rng.uniform());
-        const envmis::EnvSample light = density.sample(rng.uniform2());
+        const auto density = env.at(hit->shading_normal, to_viewer, lobes[hit->material], rng.uniform(), vertex);
         if constexpr (Profile) counters.sampler_ticks += ticks() - t0;
-        ++counters.samples;
         // Both samples count only on the geometric normal's side, so rays leave from just
         // above the surface there.
         const Vec3 lifted = hit->point + hit->geometric_normal * scene.epsilon();
-        if (light.pdf > 0 && envmis::dot(light.direction, hit->geometric_normal) > 0) {
+        const auto n = static_cast<float>(options.light_samples);
+        for (uint32_t k = 0; k < options.light_samples; ++k) {
+            const uint64_t t1 = Profile ? ticks() : 0;
+            const envmis::EnvSample light = density.sample(rng.uniform2());
+            if constexpr (Profile) counters.sampler_ticks += ticks() - t1;
+            ++counters.samples;
+            if (!(light.pdf > 0) || envmis::dot(light.direction, hit->geometric_normal) <= 0) continue;
             const envmis::BsdfValues<float> f = material.values(wo, frame.to_local(light.direction));
-            if (f.r > 0 || f.g > 0 || f.b > 0) {
-                ++counters.rays;
-                if (!scene.occluded(lifted, light.direction))
-                    radiance = radiance + throughput * light.radiance * Rgb{f.r, f.g, f.b} * (1 / (light.pdf + f.pdf));
-            }
+            if (!(f.r > 0 || f.g > 0 || f.b > 0)) continue;
+            ++counters.rays;
+            if (!scene.occluded(lifted, light.direction))  // balance heuristic over n + 1 samples
+                radiance = radiance + throughput * light.radiance * Rgb{f.r, f.g, f.b} * (1 / (n * light.pdf + f.pdf));
         }
         const envmis::BsdfSample s = material.sample(wo, rng.uniform2(), rng.uniform());
         if (!(s.pdf > 0)) break;
@@ -124,7 +147,7 @@ Rgb trace_path(const Environment& env, const RayScene& scene, const SceneDescrip
             const envmis::EnvMapView::Lookup sky = density.lookup(next);
             if constexpr (Profile) counters.sampler_ticks += ticks() - t1;
             ++counters.lookups;
-            radiance = radiance + throughput * sky.radiance * (s.pdf / (s.pdf + sky.pdf));
+            radiance = radiance + throughput * sky.radiance * (s.pdf / (s.pdf + n * sky.pdf));
             break;
         }
         if (vertex + 1 >= options.max_bounces) break;

@@ -5,15 +5,18 @@
 //
 // Usage:
 //   envmis_example_pathtrace TABLE -o OUT.exr [--scene NAME] [--obj FILE] [--env global|bins|pbrt]
-//                            [--size WxH] [--spp N] [--time SECONDS] [--bounces N] [--seed S]
-//                            [--threads T] [--reference REF.exr] [--profile] [--progress]
+//                            [--size WxH] [--spp N] [--time SECONDS] [--bounces N] [--light-samples N]
+//                            [--bins-depth N] [--rotate DEGREES] [--seed S] [--threads T]
+//                            [--reference REF.exr] [--profile] [--progress]
 // The image is rendered in passes of one sample per pixel until N passes or, with --time,
 // until that many seconds have passed (equal-time comparisons); it depends on the seed and
 // the pass count only, not on the threads. Writes OUT.exr (linear), OUT.png (tone-mapped)
 // and OUT.json: what was rendered, passes, seconds, rays per second per thread, the image's
 // mean luminance with its standard error over passes, and with --profile the share of the
 // threads' time spent in the environment's sample and lookup calls; with --reference, the
-// relative MSE against that image (relative_mse).
+// relative MSE against that image (relative_mse). --rotate turns the sky about the map's up
+// axis at render time (envmis/sampling/rotated.h), every technique alike; --bins-depth N
+// samples the bins at the first N vertices of a path only, the plain map beyond.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -59,7 +62,9 @@ struct Options {
     std::optional<std::filesystem::path> obj;
     EnvKind env = EnvKind::global;
     uint32_t width = 320, height = 240, spp = 16, threads = std::max(1u, std::thread::hardware_concurrency());
-    double seconds = 0;  // 0: no time budget
+    double seconds = 0;                // 0: no time budget
+    float rotate_degrees = 0;          // the sky turned about the map's up axis
+    uint32_t bins_depth = UINT32_MAX;  // vertices of a path that sample bins (--env bins)
     std::optional<std::filesystem::path> reference;
     uint64_t seed = 1;
     PathOptions path;
@@ -92,71 +97,105 @@ struct RenderResult {
     double mean_luminance = 0, standard_error = 0;  // over passes
 };
 
-// Passes of one sample per pixel, rows shared among threads. `trace(camera_direction, rng,
-// counters)` returns a sample's radiance; each (pass, pixel) has its own random stream.
-template <class Trace>
-RenderResult render_passes(const Options& o, const PinholeCamera& camera, Trace&& trace) {
-    const size_t pixels = size_t{o.width} * o.height;
-    std::vector<double> sum(3 * pixels);
+// The image's accumulators across passes, and what each thread traced and how long it
+// was busy.
+struct Accumulator {
+    std::vector<double> sum;  // RGB per pixel
     std::vector<double> pass_means;
-    std::vector<Counters> counters(o.threads);
-    std::vector<double> busy(o.threads);
-    const auto start = std::chrono::steady_clock::now();
-    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-    for (uint32_t pass = 0; pass < o.spp && !(o.seconds > 0 && pass > 0 && elapsed() >= o.seconds); ++pass) {
-        std::atomic<uint32_t> next_row{0};
-        std::vector<double> row_luminance(o.height);
-        auto work = [&](uint32_t thread) {
-            const auto t0 = std::chrono::steady_clock::now();
-            for (uint32_t y; (y = next_row.fetch_add(1)) < o.height;) {
-                double luminance = 0;
-                for (uint32_t x = 0; x < o.width; ++x) {
+    std::vector<Counters> counters;
+    std::vector<double> busy;
+};
+
+inline constexpr uint32_t kTile = 16;
+
+// One pass of one sample per pixel, 16x16 tiles shared among threads; returns the pass's
+// mean luminance. `trace(camera_direction, rng, counters)` returns a sample's radiance;
+// each (pass, pixel) has its own random stream, so the image does not depend on threads.
+template <class Trace>
+double render_pass(const Options& o, const PinholeCamera& camera, Trace& trace, uint32_t pass, Accumulator& a) {
+    const uint32_t tiles_x = (o.width + kTile - 1) / kTile, tiles = tiles_x * ((o.height + kTile - 1) / kTile);
+    std::atomic<uint32_t> next{0};
+    std::vector<double> tile_luminance(tiles);
+    auto work = [&](uint32_t thread) {
+        const auto t0 = std::chrono::steady_clock::now();
+        for (uint32_t t; (t = next.fetch_add(1)) < tiles;) {
+            const uint32_t x0 = t % tiles_x * kTile, y0 = t / tiles_x * kTile;
+            double luminance = 0;
+            for (uint32_t y = y0; y < std::min(y0 + kTile, o.height); ++y)
+                for (uint32_t x = x0; x < std::min(x0 + kTile, o.width); ++x) {
                     const size_t pixel = size_t{y} * o.width + x;
                     envmis::Pcg32 rng(o.seed, (uint64_t{pass} << 32) | pixel);
                     const Vec2 jitter = rng.uniform2();
                     const Vec3 d = camera.direction((static_cast<float>(x) + jitter.x) / static_cast<float>(o.width),
                                                     (static_cast<float>(y) + jitter.y) / static_cast<float>(o.height));
-                    const Rgb c = trace(d, rng, counters[thread]);
-                    sum[3 * pixel] += c.r, sum[3 * pixel + 1] += c.g, sum[3 * pixel + 2] += c.b;
+                    const Rgb c = trace(d, rng, a.counters[thread]);
+                    a.sum[3 * pixel] += c.r, a.sum[3 * pixel + 1] += c.g, a.sum[3 * pixel + 2] += c.b;
                     luminance += envmis::luminance(c, {});
                 }
-                row_luminance[y] = luminance;
-            }
-            busy[thread] += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        };
-        {
-            std::vector<std::jthread> pool;
-            for (uint32_t t = 1; t < o.threads; ++t) pool.emplace_back(work, t);
-            work(0);
+            tile_luminance[t] = luminance;
         }
-        double total = 0;
-        for (double l : row_luminance) total += l;
-        pass_means.push_back(total / static_cast<double>(pixels));
-        if (o.progress)
-            std::fprintf(stderr, "\r%s: pass %u%s, %.1f s   ", o.output.filename().string().c_str(), pass + 1,
-                         o.seconds > 0 ? "" : (" of " + std::to_string(o.spp)).c_str(), elapsed());
+        a.busy[thread] += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    };
+    {
+        std::vector<std::jthread> pool;
+        for (uint32_t t = 1; t < o.threads; ++t) pool.emplace_back(work, t);
+        work(0);
     }
-    if (o.progress) std::fputc('\n', stderr);
+    double total = 0;
+    for (double l : tile_luminance) total += l;
+    return total / (static_cast<double>(o.width) * o.height);
+}
 
+// A progress bar on stderr: passes done of --spp, or time spent of --time.
+void show_progress(const Options& o, uint32_t passes, double seconds) {
+    const double done = o.seconds > 0 ? std::min(1.0, seconds / o.seconds) : static_cast<double>(passes) / o.spp;
+    const int width = 30, filled = static_cast<int>(done * width);
+    std::fprintf(stderr, "\r%s [%s%s] %3.0f%%  %u spp  %.1f s ", o.output.filename().string().c_str(),
+                 std::string(static_cast<size_t>(filled), '#').c_str(),
+                 std::string(static_cast<size_t>(width - filled), '.').c_str(), 100 * done, passes, seconds);
+}
+
+// The image and figures from a finished accumulator.
+RenderResult finish(const Options& o, const Accumulator& a, double seconds) {
     RenderResult r;
-    r.seconds = elapsed();
-    r.passes = static_cast<uint32_t>(pass_means.size());
-    r.image = {o.width, o.height, envmis::RgbPixels(pixels)};
-    for (size_t i = 0; i < pixels; ++i)
-        r.image.pixels[i] = Rgb{static_cast<float>(sum[3 * i]), static_cast<float>(sum[3 * i + 1]),
-                                static_cast<float>(sum[3 * i + 2])} *
-                            (1.0f / static_cast<float>(r.passes));
-    for (const Counters& c : counters) {
+    r.seconds = seconds;
+    r.passes = static_cast<uint32_t>(a.pass_means.size());
+    r.image = {o.width, o.height, envmis::RgbPixels(size_t{o.width} * o.height)};
+    const float scale = 1.0f / static_cast<float>(r.passes);
+    for (size_t i = 0; i < r.image.pixels.size(); ++i)
+        r.image.pixels[i] = Rgb{static_cast<float>(a.sum[3 * i]), static_cast<float>(a.sum[3 * i + 1]),
+                                static_cast<float>(a.sum[3 * i + 2])} *
+                            scale;
+    for (const Counters& c : a.counters) {
         r.counters.rays += c.rays, r.counters.samples += c.samples, r.counters.lookups += c.lookups;
         r.counters.sampler_ticks += c.sampler_ticks;
     }
-    for (double b : busy) r.thread_seconds += b;
+    for (double b : a.busy) r.thread_seconds += b;
     double m = 0, m2 = 0;
-    for (double p : pass_means) m += p, m2 += p * p;
-    const double n = static_cast<double>(pass_means.size());
+    for (double p : a.pass_means) m += p, m2 += p * p;
+    const auto n = static_cast<double>(r.passes);
     r.mean_luminance = m / n;
     r.standard_error = n > 1 ? std::sqrt(std::max(0.0, (m2 - m * m / n) / (n - 1)) / n) : 0;
     return r;
+}
+
+// Passes until --spp of them or, with --time, until the first that ends past the budget.
+template <class Trace>
+RenderResult render_passes(const Options& o, const PinholeCamera& camera, Trace&& trace) {
+    Accumulator a{std::vector<double>(3 * size_t{o.width} * o.height),
+                  {},
+                  std::vector<Counters>(o.threads),
+                  std::vector<double>(o.threads)};
+    const auto start = std::chrono::steady_clock::now();
+    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+    double shown = -1;
+    for (uint32_t pass = 0; pass < o.spp && !(o.seconds > 0 && pass > 0 && elapsed() >= o.seconds); ++pass) {
+        a.pass_means.push_back(render_pass(o, camera, trace, pass, a));
+        if (o.progress && (elapsed() - shown >= 0.2 || pass + 1 == o.spp))
+            show_progress(o, pass + 1, shown = elapsed());
+    }
+    if (o.progress) std::fputc('\n', stderr);
+    return finish(o, a, elapsed());
 }
 
 template <class Environment>
@@ -281,9 +320,12 @@ std::string summary_json(const Options& o, const Loaded& l, const SceneDescripti
     j << "{\n  \"scene\": " << json_string(scene.name) << ",\n  \"triangles\": " << scene.triangles()
       << ",\n  \"table\": " << json_string(o.table.string()) << ",\n  \"technique\": " << json_string(l.technique)
       << ",\n  \"width\": " << o.width << ",\n  \"height\": " << o.height << ",\n  \"passes\": " << r.passes
-      << ",\n  \"seed\": " << o.seed << ",\n  \"bounces\": " << o.path.max_bounces << ",\n  \"threads\": " << o.threads
-      << ",\n  \"seconds\": " << r.seconds << ",\n  \"thread_seconds\": " << r.thread_seconds
-      << ",\n  \"rays\": " << r.counters.rays << ",\n  \"rays_per_second_per_thread\": " << rays_per_second
+      << ",\n  \"seed\": " << o.seed << ",\n  \"bounces\": " << o.path.max_bounces
+      << ",\n  \"bins_depth\": " << std::min<uint32_t>(o.bins_depth, 64)
+      << ",\n  \"light_samples\": " << o.path.light_samples << ",\n  \"rotate_degrees\": " << o.rotate_degrees
+      << ",\n  \"threads\": " << o.threads << ",\n  \"seconds\": " << r.seconds
+      << ",\n  \"thread_seconds\": " << r.thread_seconds << ",\n  \"rays\": " << r.counters.rays
+      << ",\n  \"rays_per_second_per_thread\": " << rays_per_second
       << ",\n  \"environment_samples\": " << r.counters.samples
       << ",\n  \"environment_lookups\": " << r.counters.lookups;
     if (o.profile) {
@@ -319,13 +361,17 @@ int run(const Options& o) {
         for (size_t m = 0; m < lobes.size(); ++m)
             lobes[m] = loaded->binned->lobe_class(scene.materials[m].phong_exponent());
 
+    const envmis::Rotation rotation =
+        envmis::Rotation::about_up(map.options().axes, o.rotate_degrees * envmis::kPiF / 180);
     RenderResult r;
-    if (loaded->binned)
-        r = render(BinnedEnvironment{loaded->binned->view()}, scene, rays, lobes, o);
-    else if (loaded->pbrt)
-        r = render(PbrtEnvironment{&*loaded->pbrt, map.view()}, scene, rays, lobes, o);
-    else
-        r = render(GlobalEnvironment{map.view()}, scene, rays, lobes, o);
+    if (loaded->binned) {
+        const envmis::BinnedEnvMapView view = loaded->binned->view();
+        r = render(BinnedEnvironment{{&view, rotation}, o.bins_depth}, scene, rays, lobes, o);
+    } else if (loaded->pbrt) {
+        r = render(PbrtEnvironment{&*loaded->pbrt, map.view(), rotation}, scene, rays, lobes, o);
+    } else {
+        r = render(GlobalEnvironment{{map.view(), rotation}}, scene, rays, lobes, o);
+    }
 
     std::filesystem::path png = o.output, json = o.output;
     png.replace_extension(".png");
@@ -351,8 +397,8 @@ struct UsageError : std::runtime_error {
 const char* const kUsage =
     "usage: envmis_example_pathtrace TABLE -o OUT.exr [--scene objects|materials|interior|mesh] [--obj FILE.obj]\n"
     "                                [--env global|bins|pbrt] [--size WxH] [--spp N] [--time SECONDS]\n"
-    "                                [--bounces N] [--seed S] [--threads T] [--reference REF.exr]\n"
-    "                                [--profile] [--progress]\n";
+    "                                [--bounces N] [--light-samples N] [--bins-depth N] [--rotate DEGREES]\n"
+    "                                [--seed S] [--threads T] [--reference REF.exr] [--profile] [--progress]\n";
 
 uint64_t parse_number(const std::string& flag, const std::string& text, uint64_t lo, uint64_t hi) {
     size_t used = 0;
@@ -417,10 +463,20 @@ Options parse(int argc, char** argv) {
             o.seconds = parse_seconds(value());
         } else if (arg == "--bounces") {
             o.path.max_bounces = static_cast<uint32_t>(parse_number(arg, value(), 1, 64));
+        } else if (arg == "--light-samples") {
+            o.path.light_samples = static_cast<uint32_t>(parse_number(arg, value(), 1, 1024));
         } else if (arg == "--seed") {
             o.seed = parse_number(arg, value(), 0, UINT64_MAX);
         } else if (arg == "--threads") {
             o.threads = static_cast<uint32_t>(parse_number(arg, value(), 1, 1024));
+        } else if (arg == "--bins-depth") {
+            o.bins_depth = static_cast<uint32_t>(parse_number(arg, value(), 1, 64));
+        } else if (arg == "--rotate") {
+            const std::string text = value();
+            char* end = nullptr;
+            o.rotate_degrees = std::strtof(text.c_str(), &end);
+            if (text.empty() || *end != 0 || !(std::abs(o.rotate_degrees) <= 360))
+                throw UsageError("--rotate '" + text + "': expected degrees from -360 to 360");
         } else if (arg == "--reference") {
             o.reference = value();
         } else if (arg == "--profile") {

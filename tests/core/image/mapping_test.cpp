@@ -120,6 +120,56 @@ TEST(Axes, ParseAndPrint) {
         EXPECT_THROW(Axes::parse(bad), std::invalid_argument) << bad;
 }
 
+// Each renderer's own formula for the image point of a direction in its world frame
+// (with an identity light transform), written here from its sources; v from the top row.
+struct Convention {
+    const char* preset;
+    Vec2 (*uv)(double x, double y, double z);
+};
+double wrap(double u) { return u - std::floor(u); }
+const Convention kConventions[] = {
+    // pbrt-v4 (imgtool makeequiarea, EqualAreaSquareToSphere's frame): phi = atan2(y, x), z up.
+    {"pbrt-v4",
+     [](double x, double y, double z) {
+         return Vec2{static_cast<float>(wrap(std::atan2(y, x) / (2 * kPi))), static_cast<float>(std::acos(z) / kPi)};
+     }},
+    // Mitsuba 3 (envmap emitter): u = atan2(x, -z) / 2 pi, v = acos(y) / pi, y up.
+    {"mitsuba3",
+     [](double x, double y, double z) {
+         return Vec2{static_cast<float>(wrap(std::atan2(x, -z) / (2 * kPi))), static_cast<float>(std::acos(y) / kPi)};
+     }},
+    // Blender Cycles (environment texture): u = 1/2 - atan2(y, x) / 2 pi, v = 1 - acos(z) / pi
+    // counted from the bottom row, so acos(z) / pi from the top.
+    {"blender",
+     [](double x, double y, double z) {
+         return Vec2{static_cast<float>(wrap(0.5 - std::atan2(y, x) / (2 * kPi))),
+                     static_cast<float>(std::acos(z) / kPi)};
+     }},
+};
+
+TEST(Axes, RendererPresetsPutEachDirectionOnTheTexelTheRendererReads) {
+    const uint32_t w = 64, h = 32;
+    test::Rng rng(41);
+    for (const Convention& c : kConventions) {
+        const Axes axes = Axes::parse(c.preset);
+        int agree = 0;
+        const int n = 2000;
+        for (int i = 0; i < n; ++i) {
+            const Vec3 d = normalize(Vec3{rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f});
+            const Vec2 ours = equirect_uv(to_canonical(axes, d)), theirs = c.uv(d.x, d.y, d.z);
+            const auto texel = [&](Vec2 uv) {
+                return std::pair{std::min(w - 1, static_cast<uint32_t>(uv.x * w)),
+                                 std::min(h - 1, static_cast<uint32_t>(uv.y * h))};
+            };
+            agree += texel(ours) == texel(theirs);
+        }
+        EXPECT_GT(agree, n * 99 / 100) << c.preset;  // float rounding at texel borders only
+    }
+    EXPECT_EQ(Axes::parse("mitsuba3").to_string(), "y,z,-x");
+    EXPECT_EQ(Axes::parse("blender").to_string(), "-x,y,z");
+    EXPECT_EQ(Axes::parse("pbrt-v4"), Axes{});
+}
+
 TEST(Axes, ToCanonicalInvertsToWorld) {
     const Vec3 v{0.1f, -0.7f, 0.3f};
     for (const char* a : {"x,y,z", "x,z,-y", "-z,y,x", "y,-x,-z"}) {

@@ -15,8 +15,10 @@ bool Axes::valid() const noexcept {
 }
 
 Axes Axes::parse(std::string_view text) {
-    if (text == "z-up") return Axes{{1, 2, 3}};
+    if (text == "z-up" || text == "pbrt-v4") return Axes{{1, 2, 3}};
     if (text == "y-up") return Axes{{1, 3, -2}};
+    if (text == "mitsuba3") return Axes{{2, 3, -1}};
+    if (text == "blender") return Axes{{-1, 2, 3}};
     Axes axes;
     int i = 0;
     size_t pos = 0;
@@ -31,8 +33,9 @@ Axes Axes::parse(std::string_view text) {
         pos = comma + 1;
     }
     if (!ok || i != 3 || !axes.valid())
-        throw std::invalid_argument("axes '" + std::string(text) +
-                                    "': expected z-up, y-up or a signed permutation such as x,z,-y");
+        throw std::invalid_argument(
+            "axes '" + std::string(text) +
+            "': expected z-up, y-up, pbrt-v4, mitsuba3, blender or a signed permutation such as x,z,-y");
     return axes;
 }
 

@@ -33,10 +33,22 @@ namespace envmis {
 
 // A signed permutation of the axes: world component i = sign(code[i]) * canonical
 // component |code[i]| - 1. {1, 2, 3} is the identity (z up); {1, 3, -2} is y up.
+//
+// Renderers' conventions for a latitude-longitude image (the same image, read as each
+// renderer reads it, with an identity light or world transform), as presets:
+//   pbrt-v4   x,y,z    pbrt-v4's own square mapping and its equirect conversion (imgtool
+//                      makeequiarea): u = atan2(y, x) / 2 pi, v = acos(z) / pi, z up
+//   mitsuba3  y,z,-x   Mitsuba 3's envmap emitter: u = atan2(x, -z) / 2 pi, v = acos(y) / pi, y up
+//   blender   -x,y,z   Cycles' environment texture: u = 1/2 - atan2(y, x) / 2 pi, top row +z
+// (v from the image's top row). The last two mirror the first: a panorama's u grows as
+// one turns right in Mitsuba and Blender, left in pbrt-v4 (whose scenes often hold
+// `Scale -1 1 1` for this). tests/core/image/mapping_test.cpp checks each against the
+// renderer's formula.
 struct ENVMIS_CORE_API Axes {
     int8_t code[3] = {1, 2, 3};
 
-    // Parses "x,y,z", "x,z,-y", ... or the presets "z-up" and "y-up".
+    // Parses "x,y,z", "x,z,-y", ... or the presets "z-up", "y-up", "pbrt-v4",
+    // "mitsuba3" and "blender".
     // Throws std::invalid_argument naming the text if it is not a signed permutation.
     static Axes parse(std::string_view text);
     std::string to_string() const;
