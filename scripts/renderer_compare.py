@@ -26,11 +26,13 @@ import sys
 import time
 from pathlib import Path
 
-TECHNIQUES = {  # name: (table, --env)
-    "plain": ("plain", "global"),
-    "compensated": ("compensated", "global"),
-    "pbrt": ("compensated", "pbrt"),
-    "bins": ("bins", "bins"),
+TECHNIQUES = {  # name: (table, --env, more options: tables named by kind in braces)
+    "plain": ("plain", "global", []),
+    "compensated": ("compensated", "global", []),
+    "pbrt": ("compensated", "pbrt", []),
+    "bins": ("bins", "bins", []),
+    # Bins at the camera's hit only, the compensated table at every later vertex.
+    "bins-first": ("bins", "bins", ["--bins-depth", "1", "--beyond", "{compensated}"]),
 }
 FLOOR_LIGHT_SAMPLES = 32
 REPO = Path(__file__).resolve().parent.parent
@@ -61,9 +63,10 @@ def tables(envmis, work, map_path):
 
 
 def render(args, table, env, scene, out, seed, bounces, spp=None, seconds=None, reference=None, light_samples=1,
-           profile=False):
+           profile=False, more=()):
     command = [args.renderer, table, "-o", out, "--scene", scene, "--env", env, "--size", args.size,
-               "--seed", seed, "--bounces", bounces, "--threads", args.threads, "--light-samples", light_samples]
+               "--seed", seed, "--bounces", bounces, "--threads", args.threads, "--light-samples", light_samples,
+               *more]
     command += ["--spp", spp] if spp else []
     command += ["--time", f"{seconds:.4f}"] if seconds else []
     command += ["--reference", reference] if reference else []
@@ -82,14 +85,17 @@ def compare_case(args, made, scene, stem, work, bounces):
         render(args, made["plain"], "global", scene, reference, 1000, bounces, spp=args.reference_spp)
     case = {"scene": scene, "map": stem, "techniques": {}}
     seeds = range(1, args.seeds + 1)
+    more = {name: [m.format(**{k: str(v) for k, v in made.items()}) for m in extra]
+            for name, (_, _, extra) in TECHNIQUES.items()}
     runs = {name: [render(args, made[table], env, scene, f"{prefix}.{name}.spp.{s}.exr", s, bounces, spp=args.spp,
-                          reference=reference) for s in seeds] for name, (table, env) in TECHNIQUES.items()}
+                          reference=reference, more=more[name]) for s in seeds]
+            for name, (table, env, _) in TECHNIQUES.items()}
     budget = statistics.median(r["seconds"] for r in runs["compensated"])
-    for name, (table, env) in TECHNIQUES.items():
+    for name, (table, env, _) in TECHNIQUES.items():
         timed = [render(args, made[table], env, scene, f"{prefix}.{name}.time.{s}.exr", s, bounces, seconds=budget,
-                        reference=reference) for s in seeds]
+                        reference=reference, more=more[name]) for s in seeds]
         profiled = render(args, made[table], env, scene, f"{prefix}.{name}.profile.exr", 1, bounces, spp=args.spp,
-                          profile=True)
+                          profile=True, more=more[name])
         equal_spp = runs[name]
         case["techniques"][name] = {
             "equal_spp_relative_mse": statistics.mean(r["relative_mse"] for r in equal_spp),
@@ -110,26 +116,34 @@ def compare_case(args, made, scene, stem, work, bounces):
     return case
 
 
-def ratio(case, over, mode):
+def ratio(case, over, mode, of="bins"):
+    """relMSE of `over` over `of`'s: at equal spp, at equal time (each given the budget), or
+    by cost ("cost": relMSE x seconds at equal spp, the equal-time ratio without the
+    budget's whole-pass rounding)."""
     t = case["techniques"]
-    return t[over][f"{mode}_relative_mse"] / t["bins"][f"{mode}_relative_mse"]
+    if mode == "cost":
+        return (t[over]["equal_spp_relative_mse"] * t[over]["equal_spp_seconds"]) / (
+            t[of]["equal_spp_relative_mse"] * t[of]["equal_spp_seconds"])
+    return t[over][f"{mode}_relative_mse"] / t[of][f"{mode}_relative_mse"]
 
 
 def table_lines(cases):
     lines = [
-        "| scene | map | comp/bins, equal spp | comp/bins, equal time | pbrt/bins, equal time | "
-        "plain/bins, equal time | floor/comp | bins relMSE (time) | passes bins / comp / pbrt | "
-        "sampler share bins / comp / pbrt | Mrays/s/thread |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "| scene | map | comp/bins: equal spp · equal time · by cost | pbrt/bins: equal time · by cost | "
+        "plain/bins, equal time | comp/bins-first: equal time · by cost | floor/comp | "
+        "passes bins / comp / pbrt | sampler share bins / comp / pbrt | Mrays/s/thread |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for c in cases:
         t = c["techniques"]
         lines.append(
-            f"| {c['scene']} | {c['map']} | {ratio(c, 'compensated', 'equal_spp'):.2f} | "
-            f"{ratio(c, 'compensated', 'equal_time'):.2f} | {ratio(c, 'pbrt', 'equal_time'):.2f} | "
+            f"| {c['scene']} | {c['map']} | {ratio(c, 'compensated', 'equal_spp'):.2f} · "
+            f"{ratio(c, 'compensated', 'equal_time'):.2f} · {ratio(c, 'compensated', 'cost'):.2f} | "
+            f"{ratio(c, 'pbrt', 'equal_time'):.2f} · {ratio(c, 'pbrt', 'cost'):.2f} | "
             f"{ratio(c, 'plain', 'equal_time'):.2f} | "
+            f"{ratio(c, 'compensated', 'equal_time', 'bins-first'):.2f} · "
+            f"{ratio(c, 'compensated', 'cost', 'bins-first'):.2f} | "
             f"{c['floor_relative_mse'] / t['compensated']['equal_spp_relative_mse']:.2f} | "
-            f"{t['bins']['equal_time_relative_mse']:.4g} | "
             f"{t['bins']['equal_time_passes']:g} / {t['compensated']['equal_time_passes']:g} / "
             f"{t['pbrt']['equal_time_passes']:g} | "
             f"{t['bins']['sampler_share']:.0%} / {t['compensated']['sampler_share']:.0%} / "
@@ -160,8 +174,11 @@ def markdown(results, args, command):
         "equal-area square (pbrt-v4's), so every technique samples the same texels. Scenes: "
         "apps/examples/pathtrace/scene.h.",
         "",
-        "Columns: the other technique's relative MSE over the normal-aware table's (`bins`, 121 bins): above 1, "
-        f"bins have the lower error. `floor/comp`: the plain table with {FLOOR_LIGHT_SAMPLES} environment "
+        "Columns: the other technique's relative MSE over the normal-aware table's (`bins`, 121 bins, at every "
+        "vertex; `bins-first`: at the camera's hit only, the compensated table beyond): above 1, "
+        "bins have the lower error. At equal time each technique renders for the budget (whole passes); "
+        "`by cost` is the equal-time ratio from the equal-spp renders, relMSE x seconds, free of the "
+        f"passes' rounding. Equal-time figures carry the timing noise of a shared machine. `floor/comp`: the plain table with {FLOOR_LIGHT_SAMPLES} environment "
         "samples a vertex over the compensated table with one, at equal samples: the error left when direct light from the map is "
         "nearly noise-free, so 1 / floor is the most any environment sampler can gain at equal samples. "
         "Sampler share: the threads' time in the environment's calls (choosing the bin, sampling, looking up; "
@@ -173,27 +190,40 @@ def markdown(results, args, command):
     return "\n".join(lines) + "\n"
 
 
-def main():
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--envmis", required=True, help="the envmis command")
-    p.add_argument("--renderer", required=True, help="envmis_example_pathtrace")
-    p.add_argument("--work", required=True, help="folder for tables and images (reused: delete it to start over)")
-    p.add_argument("--maps", nargs="+", default=[str(REPO / "data/envmaps" / m)
-                                                  for m in ("rooitou_park_1k.hdr", "city.exr", "studio.exr")])
-    p.add_argument("--scenes", nargs="+", default=["objects", "materials", "interior", "mesh"])
-    p.add_argument("--size", default="256x192")
-    p.add_argument("--spp", type=int, default=16)
-    p.add_argument("--reference-spp", type=int, default=1024)
-    p.add_argument("--seeds", type=int, default=3)
-    p.add_argument("--bounces", type=int, nargs="+", default=[4, 1], help="one table for each")
-    p.add_argument("--threads", type=int, default=os.cpu_count())
-    p.add_argument("--json", help="write the results here")
-    p.add_argument("--markdown", help="write the tables here")
-    args = p.parse_args()
-    if args.spp < 1 or args.reference_spp < 2 or args.seeds < 1 or min(args.bounces) < 1 or args.threads < 1:
-        p.error("--spp, --seeds, --bounces and --threads must be at least 1, --reference-spp at least 2")
-    work = Path(args.work)
-    work.mkdir(parents=True, exist_ok=True)
+def picture(results, args, path):
+    """The README's comparison: one scene and map at equal time (seed 1), each technique
+    beside the reference, labelled with its passes and relative MSE (matplotlib, from the
+    renders' tone-mapped PNGs)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    scene, map_stem = args.picture_case.split(":")
+    run_ = next(r for r in results["runs"] if r["bounces"] == args.bounces[0])
+    case = next((c for c in run_["cases"] if c["scene"] == scene and c["map"] == map_stem), None)
+    if case is None:
+        sys.exit(f"renderer_compare: no case {args.picture_case} in the results")
+    prefix = Path(args.work) / f"{map_stem}.{scene}.b{run_['bounces']}"
+    panels = [("reference", f"{prefix}.reference.png", f"{args.reference_spp} spp, plain table")]
+    names = {"compensated": "global compensated", "pbrt": "pbrt-v4-style", "bins": "normal-aware (bins)"}
+    for name, label in names.items():
+        t = case["techniques"][name]
+        json_path = Path(f"{prefix}.{name}.time.1.json")
+        passes = json.loads(json_path.read_text())["passes"] if json_path.exists() else t["equal_time_passes"]
+        panels.append((label, f"{prefix}.{name}.time.1.png",
+                       f"{passes} spp, relMSE {t['equal_time_relative_mse']:.4f} (mean of {args.seeds} seeds)"))
+    fig, axes = plt.subplots(1, len(panels), figsize=(3.2 * len(panels), 3.1), dpi=100, layout="constrained")
+    for ax, (title, png, detail) in zip(axes, panels):
+        ax.imshow(plt.imread(png), interpolation="nearest")
+        ax.set_title(f"{title}\n{detail}", fontsize=9)
+        ax.set_axis_off()
+    fig.suptitle(f"{scene} under {map_stem}, {run_['bounces']} bounces, equal time "
+                 f"({case['budget_seconds']:.2f} s each, {case['cpu'].split(' (')[0]})", fontsize=10)
+    # JPEG: noise, which is what the picture shows, makes PNGs large.
+    fig.savefig(path, **({"pil_kwargs": {"quality": 90}} if str(path).endswith((".jpg", ".jpeg")) else {}))
+    plt.close(fig)
+
+
+def render_all(args, work):
     start = time.time()
     results = {"runs": [{"bounces": b, "cases": []} for b in args.bounces]}
     for map_path in args.maps:
@@ -204,13 +234,54 @@ def main():
                 run_["cases"].append(case)
                 print(f"{run_['bounces']} bounces {scene:10s} {case['map']:16s} comp/bins "
                       f"{ratio(case, 'compensated', 'equal_spp'):5.2f} (spp) "
-                      f"{ratio(case, 'compensated', 'equal_time'):5.2f} (time), pbrt/bins "
+                      f"{ratio(case, 'compensated', 'equal_time'):5.2f} (time) "
+                      f"{ratio(case, 'compensated', 'cost'):5.2f} (cost), pbrt/bins "
                       f"{ratio(case, 'pbrt', 'equal_time'):5.2f} (time)  [{time.time() - start:.0f} s]", flush=True)
+    return results
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--envmis", required=True, help="the envmis command")
+    p.add_argument("--renderer", required=True, help="envmis_example_pathtrace")
+    p.add_argument("--work", required=True, help="folder for tables and images (reused: delete it to start over)")
+    p.add_argument("--maps", nargs="+", default=[str(REPO / "data/envmaps" / m)
+                                                  for m in ("rooitou_park_1k.hdr", "city.exr", "studio.exr")])
+    p.add_argument("--scenes", nargs="+", default=["objects", "materials", "interior", "mesh"])
+    p.add_argument("--size", default="160x120")
+    p.add_argument("--spp", type=int, default=16)
+    p.add_argument("--reference-spp", type=int, default=1024)
+    p.add_argument("--seeds", type=int, default=5)
+    p.add_argument("--bounces", type=int, nargs="+", default=[4, 1], help="one table for each")
+    p.add_argument("--threads", type=int, default=os.cpu_count())
+    p.add_argument("--json", help="write the results here")
+    p.add_argument("--markdown", help="write the tables here")
+    p.add_argument("--picture", help="write a labelled equal-time comparison of --picture-case here (.jpg, .png)")
+    p.add_argument("--picture-case", default="objects:studio", help="SCENE:MAP (the map's file stem)")
+    p.add_argument("--from-json", help="skip rendering: the tables and picture from an earlier run's --json "
+                                       "(its images still in --work)")
+    args = p.parse_args()
+    if args.spp < 1 or args.reference_spp < 2 or args.seeds < 1 or min(args.bounces) < 1 or args.threads < 1:
+        p.error("--spp, --seeds, --bounces and --threads must be at least 1, --reference-spp at least 2")
+    work = Path(args.work)
+    work.mkdir(parents=True, exist_ok=True)
     command = "/usr/bin/python3 scripts/renderer_compare.py " + " ".join(sys.argv[1:])
+    settings = {k: getattr(args, k) for k in ("size", "spp", "reference_spp", "seeds", "threads")}
+    if args.from_json:
+        results = json.loads(Path(args.from_json).read_text())
+        results.setdefault("settings", dict(settings, command=command))
+    else:
+        results = render_all(args, work)
+        results["settings"] = dict(settings, command=command)
+    for k, v in results["settings"].items():
+        setattr(args, k, v)
+    args.bounces = [r["bounces"] for r in results["runs"]]
     if args.json:
         Path(args.json).write_text(json.dumps(results, indent=1) + "\n")
     if args.markdown:
-        Path(args.markdown).write_text(markdown(results, args, command))
+        Path(args.markdown).write_text(markdown(results, args, args.command))
+    if args.picture:
+        picture(results, args, args.picture)
 
 
 if __name__ == "__main__":

@@ -51,6 +51,7 @@
 #include "envmis/study/shading/bsdf.h"
 #include "envmis/study/shading/frame.h"
 #include "envmis/table/table.h"
+#include "example_support.h"
 
 namespace {
 
@@ -136,21 +137,6 @@ struct Environment {
     const envmis::BinnedEnvMapView* binned = nullptr;
 };
 
-// A pinhole camera; (x, y) in [0,1)^2 across the image, y down.
-struct Camera {
-    Vec3 position, forward, right, up;  // right and up scaled to the image's half extent
-
-    Camera(Vec3 from, Vec3 at, float vertical_fov_degrees, float aspect) : position(from) {
-        forward = envmis::normalize(at - from);
-        const float half = std::tan(0.5f * vertical_fov_degrees * envmis::kPiF / 180);
-        right = envmis::normalize(envmis::cross(forward, {0, 0, 1})) * (half * aspect);
-        up = envmis::cross(envmis::normalize(right), forward) * half;
-    }
-    Ray ray(float x, float y) const {
-        return {position, envmis::normalize(forward + right * (2 * x - 1) + up * (1 - 2 * y))};
-    }
-};
-
 // ---------------------------------------------------------------------------------------
 // Direct lighting: the part a renderer copies.
 
@@ -220,8 +206,8 @@ struct Options {
 };
 
 envmis::RgbImage render(const Environment& env, const Scene& scene, const Options& o) {
-    const Camera camera({0, -7.5f, 2.2f}, {0, 0, 0.55f}, 30,
-                        static_cast<float>(o.width) / static_cast<float>(o.height));
+    const examples::PinholeCamera camera({0, -7.5f, 2.2f}, {0, 0, 0.55f}, 30,
+                                         static_cast<float>(o.width) / static_cast<float>(o.height));
     envmis::RgbImage image{o.width, o.height, envmis::RgbPixels(size_t{o.width} * o.height)};
     std::atomic<uint32_t> next_row{0};
     auto work = [&] {
@@ -232,8 +218,9 @@ envmis::RgbImage render(const Environment& env, const Scene& scene, const Option
                 Rgb sum;
                 for (uint32_t i = 0; i < o.spp; ++i) {
                     const Vec2 jitter = rng.uniform2();
-                    const Ray ray = camera.ray((static_cast<float>(x) + jitter.x) / static_cast<float>(o.width),
-                                               (static_cast<float>(y) + jitter.y) / static_cast<float>(o.height));
+                    const Ray ray{camera.position,
+                                  camera.direction((static_cast<float>(x) + jitter.x) / static_cast<float>(o.width),
+                                                   (static_cast<float>(y) + jitter.y) / static_cast<float>(o.height))};
                     sum = sum + trace(env, scene, ray, o.technique, rng);
                 }
                 image.pixels[pixel] = sum * (1.0f / static_cast<float>(o.spp));
@@ -324,31 +311,11 @@ int run_render(const Options& o) {
 // ---------------------------------------------------------------------------------------
 // --compare: relative MSE of renders against a reference.
 
-envmis::RgbImage read_exr(const std::filesystem::path& path) {
-    // Read as written: no colour conversion (the working space to itself).
-    return envmis::io::load_image(path, {"lin_rec709", "lin_rec709"}).image;
-}
-
-// Mean over pixels of (Y - Y_ref)^2 / (Y_ref^2 + 0.01), Y the luminance: the usual
-// relative MSE, whose 0.01 keeps nearly black pixels from dominating. It assumes a
-// display-like scale (this scene under rooitou_park_1k.hdr has mean luminance 0.33).
-double relative_mse(const envmis::RgbImage& image, const envmis::RgbImage& reference, const std::string& name) {
-    if (image.width != reference.width || image.height != reference.height)
-        throw std::runtime_error(name + ": size differs from the reference's");
-    double sum = 0;
-    for (size_t i = 0; i < image.pixels.size(); ++i) {
-        const double ref = envmis::luminance(reference.pixels[i], {});
-        const double d = envmis::luminance(image.pixels[i], {}) - ref;
-        sum += d * d / (ref * ref + 0.01);
-    }
-    return sum / static_cast<double>(image.pixels.size());
-}
-
 int run_compare(const std::vector<std::string>& files, double expect_ratio) {
-    const envmis::RgbImage reference = read_exr(files[0]);
+    const envmis::RgbImage reference = examples::read_exr(files[0]);
     std::vector<double> errors;
     for (size_t i = 1; i < files.size(); ++i) {
-        errors.push_back(relative_mse(read_exr(files[i]), reference, files[i]));
+        errors.push_back(examples::relative_mse(examples::read_exr(files[i]), reference, files[i]));
         std::printf("relMSE %c  %-10.4g %s\n", i == 1 ? 'A' : 'B', errors.back(), files[i].c_str());
     }
     if (errors.size() < 2) return 0;
@@ -364,29 +331,13 @@ int run_compare(const std::vector<std::string>& files, double expect_ratio) {
 
 // ---------------------------------------------------------------------------------------
 
-// A command-line mistake: reported with the usage text, exit status 2.
-struct UsageError : std::runtime_error {
-    using std::runtime_error::runtime_error;
-};
+using examples::parse_number;
+using examples::UsageError;
 
 const char* const kUsage =
     "usage: envmis_example_render TABLE -o OUT.exr [--size WxH] [--spp N] [--seed S] [--threads T]\n"
     "                             [--technique mis|env|bsdf] [--bins]\n"
     "       envmis_example_render --compare REF A [B] [--expect-ratio R]\n";
-
-uint64_t parse_number(std::string_view flag, const std::string& text, uint64_t lo, uint64_t hi) {
-    size_t used = 0;
-    uint64_t value = 0;
-    try {
-        value = std::stoull(text, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used != text.size() || text.empty() || text[0] == '-' || value < lo || value > hi)
-        throw UsageError(std::string(flag) + " '" + text + "': expected an integer from " + std::to_string(lo) +
-                         " to " + std::to_string(hi));
-    return value;
-}
 
 }  // namespace
 
@@ -453,7 +404,7 @@ int main(int argc, char** argv) {
         if (positional.size() != 1 || o.output.extension() != ".exr") throw UsageError("expected TABLE and -o OUT.exr");
         o.table = positional[0];
         return run_render(o);
-    } catch (const UsageError& e) {
+    } catch (const examples::UsageError& e) {
         std::fprintf(stderr, "envmis_example_render: %s\n%s", e.what(), kUsage);
         return 2;
     } catch (const std::exception& e) {

@@ -79,6 +79,17 @@ foreach(scene objects materials interior mesh)
   endforeach()
 endforeach()
 
+# Bins at the camera's hit only, the compensated table of the same image beyond.
+add_test(NAME examples.pathtrace.objects.bins-first
+  COMMAND ${envmis_pt} ${envmis_pt_work}/bins.envmis -o ${envmis_pt_work}/objects-bins-first.exr --scene objects
+    --env bins --bins-depth 1 --beyond ${envmis_pt_work}/compensated.envmis --spp 256 --seed 1 ${envmis_pt_args})
+add_test(NAME examples.pathtrace.objects.bins-first.converges
+  COMMAND ${envmis_pt_check} ${envmis_pt_work}/objects-reference.json ${envmis_pt_work}/objects-bins-first.json)
+set_tests_properties(examples.pathtrace.objects.bins-first PROPERTIES
+  FIXTURES_REQUIRED envmis_pt_objects FIXTURES_SETUP envmis_pt_bins_first TIMEOUT 300)
+set_tests_properties(examples.pathtrace.objects.bins-first.converges PROPERTIES
+  FIXTURES_REQUIRED envmis_pt_bins_first TIMEOUT 60)
+
 # The sky turned at render time (--rotate 90, rotated.h): every technique converges to
 # the turned reference, which differs from the unturned one.
 add_test(NAME examples.pathtrace.rotated.reference
@@ -126,6 +137,9 @@ add_test(NAME examples.pathtrace.refuses-pbrt-on-equirect
   COMMAND ${envmis_pt} ${envmis_examples_work}/compensated.envmis -o ${envmis_pt_work}/refused.exr --env pbrt)
 add_test(NAME examples.pathtrace.refuses-bins-without-bins
   COMMAND ${envmis_pt} ${envmis_pt_work}/compensated.envmis -o ${envmis_pt_work}/refused.exr --env bins)
+add_test(NAME examples.pathtrace.refuses-beyond-of-another-image
+  COMMAND ${envmis_pt} ${envmis_pt_work}/bins.envmis -o ${envmis_pt_work}/refused.exr --env bins --bins-depth 1
+    --beyond ${envmis_examples_work}/compensated.envmis)
 add_test(NAME examples.pathtrace.refuses-unknown-scene
   COMMAND ${envmis_pt} ${envmis_pt_work}/compensated.envmis -o ${envmis_pt_work}/refused.exr --scene kitchen)
 add_test(NAME examples.pathtrace.refuses-a-bad-obj
@@ -135,10 +149,12 @@ set_tests_properties(examples.pathtrace.refuses-pbrt-on-equirect PROPERTIES
   PASS_REGULAR_EXPRESSION "pbrt-v4's equal-area square.*--mapping equal-area")
 set_tests_properties(examples.pathtrace.refuses-bins-without-bins PROPERTIES
   PASS_REGULAR_EXPRESSION "has no bins.*--bins 121")
+set_tests_properties(examples.pathtrace.refuses-beyond-of-another-image PROPERTIES
+  PASS_REGULAR_EXPRESSION "--beyond needs a table of the same image")
 set_tests_properties(examples.pathtrace.refuses-unknown-scene PROPERTIES
   PASS_REGULAR_EXPRESSION "--scene 'kitchen': expected one of objects, materials, interior, mesh")
 set_tests_properties(examples.pathtrace.refuses-a-bad-obj PROPERTIES
   PASS_REGULAR_EXPRESSION "not a readable OBJ file|no faces")
 set_tests_properties(examples.pathtrace.refuses-pbrt-on-equirect examples.pathtrace.refuses-bins-without-bins
-  examples.pathtrace.refuses-unknown-scene examples.pathtrace.refuses-a-bad-obj PROPERTIES
+  examples.pathtrace.refuses-beyond-of-another-image examples.pathtrace.refuses-unknown-scene examples.pathtrace.refuses-a-bad-obj PROPERTIES
   FIXTURES_REQUIRED "envmis_pt_built;envmis_pt_tables;envmis_examples_tables" TIMEOUT 60)

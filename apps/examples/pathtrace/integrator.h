@@ -46,16 +46,28 @@ struct GlobalEnvironment {
     Rgb eval(Vec3 direction) const noexcept { return map.eval(direction); }
 };
 
-// Bins at the first `depth` vertices of a path; beyond, the table's plain map (a bin
-// marked plain: binned.h), whose samples cost less where a path's throughput has
-// already shrunk what they can gain.
+// Bins at the first `depth` vertices of a path; beyond, a global density over the same
+// texels (`beyond`: a compensated table of the same image, or the binned table's own
+// plain map), which costs less where a path's throughput has already shrunk what the
+// bins can gain, and whose tables stay in cache where random normals would scatter the
+// bins' loads. Each vertex samples and weighs with one density, so each is unbiased.
 struct BinnedEnvironment {
     envmis::RotatedBinned bins;
+    envmis::Rotated<envmis::EnvMapView> beyond;
     uint32_t depth = UINT32_MAX;
-    envmis::Rotated<envmis::BinView> at(Vec3 normal, Vec3 to_viewer, uint32_t lobe, float choice,
-                                        uint32_t vertex) const {
-        if (vertex >= depth) return {{bins.map, {}, true}, bins.rotation};
-        return bins.bin(envmis::lobe_axis(lobe, normal, to_viewer), lobe, choice);
+
+    struct Density {
+        bool binned;
+        envmis::Rotated<envmis::BinView> bin;
+        const envmis::Rotated<envmis::EnvMapView>* global;
+        envmis::EnvSample sample(Vec2 u) const noexcept { return binned ? bin.sample(u) : global->sample(u); }
+        envmis::EnvMapView::Lookup lookup(Vec3 direction) const noexcept {
+            return binned ? bin.lookup(direction) : global->lookup(direction);
+        }
+    };
+    Density at(Vec3 normal, Vec3 to_viewer, uint32_t lobe, float choice, uint32_t vertex) const {
+        if (vertex >= depth) return {false, {}, &beyond};
+        return {true, bins.bin(envmis::lobe_axis(lobe, normal, to_viewer), lobe, choice), &beyond};
     }
     Rgb eval(Vec3 direction) const noexcept { return bins.eval(direction); }
 };

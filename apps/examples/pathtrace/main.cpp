@@ -6,7 +6,7 @@
 // Usage:
 //   envmis_example_pathtrace TABLE -o OUT.exr [--scene NAME] [--obj FILE] [--env global|bins|pbrt]
 //                            [--size WxH] [--spp N] [--time SECONDS] [--bounces N] [--light-samples N]
-//                            [--bins-depth N] [--rotate DEGREES] [--seed S] [--threads T]
+//                            [--bins-depth N [--beyond GLOBAL]] [--rotate DEGREES] [--seed S] [--threads T]
 //                            [--reference REF.exr] [--profile] [--progress]
 // The image is rendered in passes of one sample per pixel until N passes or, with --time,
 // until that many seconds have passed (equal-time comparisons); it depends on the seed and
@@ -16,7 +16,8 @@
 // threads' time spent in the environment's sample and lookup calls; with --reference, the
 // relative MSE against that image (relative_mse). --rotate turns the sky about the map's up
 // axis at render time (envmis/sampling/rotated.h), every technique alike; --bins-depth N
-// samples the bins at the first N vertices of a path only, the plain map beyond.
+// samples the bins at the first N vertices of a path only and beyond them the binned
+// table's plain map or, with --beyond, a global table of the same image (compensated).
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -40,6 +41,7 @@
 #include "envmis/io/image_io.h"
 #include "envmis/pictures/picture.h"
 #include "envmis/table/table.h"
+#include "example_support.h"
 #include "integrator.h"
 
 namespace pathtrace {
@@ -62,9 +64,10 @@ struct Options {
     std::optional<std::filesystem::path> obj;
     EnvKind env = EnvKind::global;
     uint32_t width = 320, height = 240, spp = 16, threads = std::max(1u, std::thread::hardware_concurrency());
-    double seconds = 0;                // 0: no time budget
-    float rotate_degrees = 0;          // the sky turned about the map's up axis
-    uint32_t bins_depth = UINT32_MAX;  // vertices of a path that sample bins (--env bins)
+    double seconds = 0;                           // 0: no time budget
+    float rotate_degrees = 0;                     // the sky turned about the map's up axis
+    uint32_t bins_depth = UINT32_MAX;             // vertices of a path that sample bins (--env bins)
+    std::optional<std::filesystem::path> beyond;  // the global table sampled past bins_depth
     std::optional<std::filesystem::path> reference;
     uint64_t seed = 1;
     PathOptions path;
@@ -73,21 +76,6 @@ struct Options {
 
 // ---------------------------------------------------------------------------------------
 // The image, in passes
-
-struct PinholeCamera {
-    Vec3 position, forward, right, up;  // right and up scaled to the image's half extent
-
-    PinholeCamera(const Camera& c, float aspect) : position(c.from) {
-        forward = envmis::normalize(c.at - c.from);
-        const float half = std::tan(0.5f * c.vertical_fov_degrees * envmis::kPiF / 180);
-        right = envmis::normalize(envmis::cross(forward, {0, 0, 1})) * (half * aspect);
-        up = envmis::cross(envmis::normalize(right), forward) * half;
-    }
-    // (x, y) in [0,1)^2 across the image, y down.
-    Vec3 direction(float x, float y) const {
-        return envmis::normalize(forward + right * (2 * x - 1) + up * (1 - 2 * y));
-    }
-};
 
 struct RenderResult {
     envmis::RgbImage image;
@@ -112,7 +100,8 @@ inline constexpr uint32_t kTile = 16;
 // mean luminance. `trace(camera_direction, rng, counters)` returns a sample's radiance;
 // each (pass, pixel) has its own random stream, so the image does not depend on threads.
 template <class Trace>
-double render_pass(const Options& o, const PinholeCamera& camera, Trace& trace, uint32_t pass, Accumulator& a) {
+double render_pass(const Options& o, const examples::PinholeCamera& camera, Trace& trace, uint32_t pass,
+                   Accumulator& a) {
     const uint32_t tiles_x = (o.width + kTile - 1) / kTile, tiles = tiles_x * ((o.height + kTile - 1) / kTile);
     std::atomic<uint32_t> next{0};
     std::vector<double> tile_luminance(tiles);
@@ -181,7 +170,7 @@ RenderResult finish(const Options& o, const Accumulator& a, double seconds) {
 
 // Passes until --spp of them or, with --time, until the first that ends past the budget.
 template <class Trace>
-RenderResult render_passes(const Options& o, const PinholeCamera& camera, Trace&& trace) {
+RenderResult render_passes(const Options& o, const examples::PinholeCamera& camera, Trace&& trace) {
     Accumulator a{std::vector<double>(3 * size_t{o.width} * o.height),
                   {},
                   std::vector<Counters>(o.threads),
@@ -201,7 +190,8 @@ RenderResult render_passes(const Options& o, const PinholeCamera& camera, Trace&
 template <class Environment>
 RenderResult render(const Environment& env, const SceneDescription& scene, const RayScene& rays,
                     const std::vector<uint32_t>& lobes, const Options& o) {
-    const PinholeCamera camera(scene.camera, static_cast<float>(o.width) / static_cast<float>(o.height));
+    const examples::PinholeCamera camera(scene.camera.from, scene.camera.at, scene.camera.vertical_fov_degrees,
+                                         static_cast<float>(o.width) / static_cast<float>(o.height));
     auto trace = [&]<bool Profile>(Vec3 d, envmis::Pcg32& rng, Counters& c) {
         return trace_path<Profile>(env, rays, scene, lobes, camera.position, d, o.path, rng, c);
     };
@@ -220,6 +210,7 @@ RenderResult render(const Environment& env, const SceneDescription& scene, const
 struct Loaded {
     envmis::Table table;
     std::optional<envmis::BinnedEnvMap> binned;
+    std::optional<envmis::Table> beyond;     // --beyond: the global table past --bins-depth
     std::optional<envmis::RgbImage> square;  // the pbrt sampler's copy of the radiance
     std::optional<envmis::reference::PbrtStyleEnvMap> pbrt;
     std::string technique;  // plain, compensated, bins, pbrt
@@ -227,28 +218,44 @@ struct Loaded {
     const envmis::EnvMap& map() const { return binned ? binned->plain() : table.map; }
 };
 
-std::unique_ptr<Loaded> load(const Options& o) {
-    auto l = std::make_unique<Loaded>(Loaded{envmis::read_table(o.table), {}, {}, {}, {}});
-    const envmis::EnvMap& map = l->table.map;
-    l->technique = map.compensated() ? "compensated" : "plain";
-    if (o.env == EnvKind::bins) {
-        if (!l->table.bins)
-            throw std::runtime_error(o.table.string() +
-                                     ": the table has no bins; --env bins needs one built with `envmis precompute "
-                                     "MAP -o T.envmis --bins 121`");
-        l->binned = envmis::binned_map(std::move(l->table));
-        l->technique = "bins";
-    } else if (o.env == EnvKind::pbrt) {
-        if (map.options().mapping != envmis::Mapping::equal_area)
-            throw std::runtime_error(o.table.string() +
-                                     ": --env pbrt samples pbrt-v4's equal-area square; build the table with "
-                                     "`envmis precompute MAP -o T.envmis --mapping equal-area`");
-        const envmis::RgbImageView radiance = map.radiance();
-        l->square = envmis::RgbImage{radiance.width, radiance.height,
-                                     envmis::RgbPixels(radiance.pixels.begin(), radiance.pixels.end())};
-        l->pbrt.emplace(*l->square, map.options());
-        l->technique = "pbrt";
+// The normal-aware table and, with --beyond, the global table that must hold the same
+// texels (same source image, size, mapping and axes).
+void load_bins(const Options& o, Loaded& l) {
+    if (!l.table.bins)
+        throw std::runtime_error(o.table.string() +
+                                 ": the table has no bins; --env bins needs one built with `envmis precompute "
+                                 "MAP -o T.envmis --bins 121`");
+    if (o.beyond) {
+        l.beyond = envmis::read_table(*o.beyond);
+        const envmis::EnvMap &a = l.table.map, &b = l.beyond->map;
+        if (l.beyond->source.content_hash != l.table.source.content_hash || a.width() != b.width() ||
+            a.height() != b.height() || a.options().mapping != b.options().mapping ||
+            a.options().axes != b.options().axes)
+            throw std::runtime_error(o.beyond->string() + ": --beyond needs a table of the same image as " +
+                                     o.table.string() + " (source, size, mapping and axes)");
     }
+    l.binned = envmis::binned_map(std::move(l.table));
+    l.technique = "bins";
+}
+
+void load_pbrt(const Options& o, Loaded& l) {
+    const envmis::EnvMap& map = l.table.map;
+    if (map.options().mapping != envmis::Mapping::equal_area)
+        throw std::runtime_error(o.table.string() +
+                                 ": --env pbrt samples pbrt-v4's equal-area square; build the table with "
+                                 "`envmis precompute MAP -o T.envmis --mapping equal-area`");
+    const envmis::RgbImageView radiance = map.radiance();
+    l.square = envmis::RgbImage{radiance.width, radiance.height,
+                                envmis::RgbPixels(radiance.pixels.begin(), radiance.pixels.end())};
+    l.pbrt.emplace(*l.square, map.options());
+    l.technique = "pbrt";
+}
+
+std::unique_ptr<Loaded> load(const Options& o) {
+    auto l = std::make_unique<Loaded>(Loaded{envmis::read_table(o.table), {}, {}, {}, {}, {}});
+    l->technique = l->table.map.compensated() ? "compensated" : "plain";
+    if (o.env == EnvKind::bins) load_bins(o, *l);
+    if (o.env == EnvKind::pbrt) load_pbrt(o, *l);
     return l;
 }
 
@@ -282,24 +289,6 @@ std::string cpu_name() {
         if (line.rfind("model name", 0) == 0) name = value(line);
     }
     return name.empty() ? "unknown" : name + " (" + vendor + " family " + family + " model " + model + ")";
-}
-
-// Mean over pixels of (Y - Y_ref)^2 / (Y_ref^2 + 0.01), Y the luminance: the usual
-// relative MSE, whose 0.01 keeps nearly black pixels from dominating.
-double relative_mse(const envmis::RgbImage& image, const std::filesystem::path& reference_path) {
-    // Read as written: no colour conversion (the working space to itself).
-    const envmis::RgbImage reference = envmis::io::load_image(reference_path, {"lin_rec709", "lin_rec709"}).image;
-    if (image.width != reference.width || image.height != reference.height)
-        throw std::runtime_error(reference_path.string() + ": the reference is " + std::to_string(reference.width) +
-                                 "x" + std::to_string(reference.height) + ", the image " + std::to_string(image.width) +
-                                 "x" + std::to_string(image.height));
-    double sum = 0;
-    for (size_t i = 0; i < image.pixels.size(); ++i) {
-        const double ref = envmis::luminance(reference.pixels[i], {});
-        const double d = envmis::luminance(image.pixels[i], {}) - ref;
-        sum += d * d / (ref * ref + 0.01);
-    }
-    return sum / static_cast<double>(image.pixels.size());
 }
 
 // Writes `text` to `path` through a temporary file in the same folder, renamed.
@@ -339,8 +328,8 @@ std::string summary_json(const Options& o, const Loaded& l, const SceneDescripti
         j << ",\n  \"sampler_share\": " << static_cast<double>(r.counters.sampler_ticks) / rate / r.thread_seconds;
     }
     if (o.reference)
-        j << ",\n  \"reference\": " << json_string(o.reference->string())
-          << ",\n  \"relative_mse\": " << relative_mse(r.image, *o.reference);
+        j << ",\n  \"reference\": " << json_string(o.reference->string()) << ",\n  \"relative_mse\": "
+          << examples::relative_mse(r.image, examples::read_exr(*o.reference), o.output.string());
     j << ",\n  \"mean_luminance\": " << r.mean_luminance << ",\n  \"standard_error\": " << r.standard_error
       << ",\n  \"cpu\": " << json_string(cpu_name()) << "\n}\n";
     return j.str();
@@ -366,7 +355,8 @@ int run(const Options& o) {
     RenderResult r;
     if (loaded->binned) {
         const envmis::BinnedEnvMapView view = loaded->binned->view();
-        r = render(BinnedEnvironment{{&view, rotation}, o.bins_depth}, scene, rays, lobes, o);
+        const envmis::EnvMapView beyond = loaded->beyond ? loaded->beyond->map.view() : map.view();
+        r = render(BinnedEnvironment{{&view, rotation}, {beyond, rotation}, o.bins_depth}, scene, rays, lobes, o);
     } else if (loaded->pbrt) {
         r = render(PbrtEnvironment{&*loaded->pbrt, map.view(), rotation}, scene, rays, lobes, o);
     } else {
@@ -390,29 +380,15 @@ int run(const Options& o) {
 // ---------------------------------------------------------------------------------------
 // Command line
 
-struct UsageError : std::runtime_error {
-    using std::runtime_error::runtime_error;
-};
+using examples::parse_number;
+using examples::UsageError;
 
 const char* const kUsage =
     "usage: envmis_example_pathtrace TABLE -o OUT.exr [--scene objects|materials|interior|mesh] [--obj FILE.obj]\n"
     "                                [--env global|bins|pbrt] [--size WxH] [--spp N] [--time SECONDS]\n"
-    "                                [--bounces N] [--light-samples N] [--bins-depth N] [--rotate DEGREES]\n"
-    "                                [--seed S] [--threads T] [--reference REF.exr] [--profile] [--progress]\n";
-
-uint64_t parse_number(const std::string& flag, const std::string& text, uint64_t lo, uint64_t hi) {
-    size_t used = 0;
-    uint64_t value = 0;
-    try {
-        value = std::stoull(text, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used != text.size() || text.empty() || text[0] == '-' || value < lo || value > hi)
-        throw UsageError(flag + " '" + text + "': expected an integer from " + std::to_string(lo) + " to " +
-                         std::to_string(hi));
-    return value;
-}
+    "                                [--bounces N] [--light-samples N] [--bins-depth N [--beyond GLOBAL]]\n"
+    "                                [--rotate DEGREES] [--seed S] [--threads T] [--reference REF.exr]\n"
+    "                                [--profile] [--progress]\n";
 
 double parse_seconds(const std::string& text) {
     char* end = nullptr;
@@ -471,6 +447,8 @@ Options parse(int argc, char** argv) {
             o.threads = static_cast<uint32_t>(parse_number(arg, value(), 1, 1024));
         } else if (arg == "--bins-depth") {
             o.bins_depth = static_cast<uint32_t>(parse_number(arg, value(), 1, 64));
+        } else if (arg == "--beyond") {
+            o.beyond = value();
         } else if (arg == "--rotate") {
             const std::string text = value();
             char* end = nullptr;
@@ -494,6 +472,8 @@ Options parse(int argc, char** argv) {
     }
     if (positional.size() != 1 || o.output.extension() != ".exr") throw UsageError("expected TABLE and -o OUT.exr");
     if (o.obj && o.scene != "mesh") throw UsageError("--obj replaces the mesh scene's knot: add --scene mesh");
+    if ((o.beyond || o.bins_depth != UINT32_MAX) && o.env != EnvKind::bins)
+        throw UsageError("--bins-depth and --beyond choose where bins are sampled: add --env bins");
     if (o.seconds > 0 && !spp_given) o.spp = 1u << 24;  // the time decides
     o.table = positional[0];
     return o;
@@ -505,7 +485,7 @@ Options parse(int argc, char** argv) {
 int main(int argc, char** argv) {
     try {
         return pathtrace::run(pathtrace::parse(argc, argv));
-    } catch (const pathtrace::UsageError& e) {
+    } catch (const examples::UsageError& e) {
         std::fprintf(stderr, "envmis_example_pathtrace: %s\n%s", e.what(), pathtrace::kUsage);
         return 2;
     } catch (const std::exception& e) {
