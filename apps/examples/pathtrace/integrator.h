@@ -2,17 +2,18 @@
 //
 // At each surface vertex the light from the map is estimated twice and the two combined
 // by the balance heuristic: next-event estimation draws a direction (or several:
-// PathOptions::light_samples) from the environment's density and traces a shadow ray; the path continues in a
-// direction drawn from the material, and where that ray escapes to the sky its radiance
-// is weighted against the density the environment technique had at that vertex. Russian
-// roulette ends paths after a few bounces, by their throughput.
+// PathOptions::light_samples) from the environment's density and traces a shadow ray;
+// the path continues in a direction drawn from the material, and where that ray escapes
+// to the sky its radiance is weighted against the density the environment technique had
+// at that vertex. Russian roulette ends paths after a few bounces, by their throughput.
 //
 // The environment techniques compared (Environment below, one type each, so the loop is
 // compiled once per technique with no virtual calls):
 //   plain, compensated  one global envmis density (EnvMapView), as a table holds it
 //   bins                the normal-aware table: at each vertex the bin that the
 //                       material's lobe class and axis pick (lobe_axis) with one uniform;
-//                       the same bin gives the BSDF sample's MIS weight
+//                       the same bin gives the BSDF sample's MIS weight; optionally at
+//                       the first vertices only, a global table beyond
 //   pbrt                a sampler following pbrt-v4's ImageInfiniteLight (equal-area map,
 //                       compensated, float CDFs), what a pbrt user renders with today
 #pragma once
@@ -48,9 +49,9 @@ struct GlobalEnvironment {
 
 // Bins at the first `depth` vertices of a path; beyond, a global density over the same
 // texels (`beyond`: a compensated table of the same image, or the binned table's own
-// plain map), which costs less where a path's throughput has already shrunk what the
-// bins can gain, and whose tables stay in cache where random normals would scatter the
-// bins' loads. Each vertex samples and weighs with one density, so each is unbiased.
+// plain map): a renderer's choice to spend the bins' cost where a path's throughput is
+// whole (what it buys: docs/performance.md, 'In a path tracer'). Each vertex samples
+// and weighs with one density, so each vertex's estimate is unbiased.
 struct BinnedEnvironment {
     envmis::RotatedBinned bins;
     envmis::Rotated<envmis::EnvMapView> beyond;
@@ -111,7 +112,8 @@ struct Counters {
     uint64_t sampler_ticks = 0;
 };
 
-// A cheap timer for the sampler's share of frame time; a no-op unless profiling.
+// The CPU's cycle counter (steady_clock elsewhere), read around the environment's calls
+// only when profiling (--profile): the sampler's share of the threads' time.
 uint64_t ticks() noexcept;
 
 // Starts at `origin` + t `direction` (a camera ray) and returns the radiance along it.

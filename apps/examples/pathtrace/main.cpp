@@ -15,7 +15,8 @@
 // mean luminance with its standard error over passes, and with --profile the share of the
 // threads' time spent in the environment's sample and lookup calls; with --reference, the
 // relative MSE against that image (relative_mse). --rotate turns the sky about the map's up
-// axis at render time (envmis/sampling/rotated.h), every technique alike; --bins-depth N
+// axis at render time (envmis/sampling/rotated.h), every technique alike; --light-samples N
+// draws N environment samples a vertex (balance heuristic with counts); --bins-depth N
 // samples the bins at the first N vertices of a path only and beyond them the binned
 // table's plain map or, with --beyond, a global table of the same image (compensated).
 #include <algorithm>
@@ -24,7 +25,6 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <iterator>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -36,7 +36,6 @@
 #if defined(__x86_64__) || defined(__i386__)
 #include <x86intrin.h>
 #endif
-#include <unistd.h>
 
 #include "envmis/io/image_io.h"
 #include "envmis/pictures/picture.h"
