@@ -17,6 +17,7 @@
 #include "cli.h"
 #include "envmis/build/atomic_file.h"
 #include "envmis/build/env_map.h"
+#include "envmis/cpu.h"
 #include "envmis/io/image_io.h"
 #include "envmis/report/inputs.h"
 #include "envmis/report/results.h"
@@ -107,8 +108,8 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
         ->check(in_range(uint32_t{0}, kMaxStudySamples));
     sub.add_option("--seed", args.seed, "Random seed")->capture_default_str()->check(any_seed());
     sub.add_option("--threads", args.threads,
-                   "Worker threads, 1 to 1024, at most 4 per hardware thread (more are reduced to that, with a "
-                   "note; default: all cores); results do not depend on it")
+                   "Worker threads, 1 to 1024, at most 4 per usable core (more are reduced to that, with a "
+                   "note; default: the cores the CPU affinity and cgroup quota allow); results do not depend on it")
         ->check(in_range(uint32_t{1}, kMaxStudyThreads));
     CLI::Option* normal = sub.add_option("--normal", args.normal, "One shading point with this normal x,y,z")
                               ->check(direction_validator());
@@ -186,7 +187,7 @@ std::pair<EnvMap, float> load_plain(const CompareArgs& args, std::string& map_na
     return {std::move(loaded.map), fixed_alpha};
 }
 
-// --threads (0: every hardware thread), with a note where it is reduced.
+// --threads (0: every usable core), with a note where it is reduced.
 uint32_t threads_of(const CompareArgs& args) {
     std::string note;
     const uint32_t threads = worker_threads(args.threads, &note);
@@ -588,7 +589,7 @@ void run_library_compare(const CompareArgs& args) {
     CompareArgs shared = args;
     shared.show_progress = false;
     if (!(args.threads_flag && args.threads_flag->count() > 0))
-        shared.threads = std::max(1u, hardware_cores() / std::min<uint32_t>(args.jobs, uint32_t(items.size())));
+        shared.threads = std::max(1u, usable_cores() / std::min<uint32_t>(args.jobs, uint32_t(items.size())));
     const std::string options = options_text(args);
     const auto matches = [&](const std::filesystem::path& output, uint64_t hash) {
         return results_up_to_date(output, hash, options);

@@ -17,6 +17,7 @@
 
 #include "cli.h"
 #include "envmis/build/atomic_file.h"
+#include "envmis/cpu.h"
 #include "envmis/io/image_io.h"
 #include "envmis/table/table.h"
 
@@ -98,10 +99,8 @@ std::vector<LibraryItem> plan_outputs(const std::vector<fs::path>& inputs, const
     return items;
 }
 
-uint32_t hardware_cores() { return std::max(1u, std::thread::hardware_concurrency()); }
-
 CLI::Option* add_jobs_flag(CLI::App& app, uint32_t& jobs) {
-    jobs = hardware_cores();
+    jobs = usable_cores();
     return app
         .add_option("--jobs", jobs,
                     "With several inputs or a folder: maps run at once, 1 to 1024 (default: the core count)")

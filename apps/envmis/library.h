@@ -32,8 +32,6 @@ struct LibraryItem {
 std::vector<LibraryItem> plan_outputs(const std::vector<std::filesystem::path>& inputs,
                                       const std::filesystem::path& dir, const std::string& extension);
 
-// The hardware threads (at least 1).
-uint32_t hardware_cores();
 inline constexpr uint32_t kMaxJobs = 1024;
 // --jobs N: maps run at once, 1 to kMaxJobs (default: the core count).
 CLI::Option* add_jobs_flag(CLI::App& app, uint32_t& jobs);

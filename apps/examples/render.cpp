@@ -199,7 +199,7 @@ Rgb trace(const Environment& env, const Scene& scene, const Ray& ray, Technique 
 
 struct Options {
     std::filesystem::path table, output;
-    uint32_t width = 480, height = 320, spp = 16, threads = std::max(1u, std::thread::hardware_concurrency());
+    uint32_t width = 480, height = 320, spp = 16, threads = envmis::usable_cores();
     uint64_t seed = 1;
     Technique technique = Technique::mis;
     bool bins = false;

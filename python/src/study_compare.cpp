@@ -164,7 +164,7 @@ spp: estimates per point, BSDF and technique, 1 to 2^32-1.
 points: K normals spread evenly over the sphere (1 to 10^6), each viewed head-on;
   or normals: float32 (N, 3) unit vectors, world frame, with views (N, 3) (towards
   the viewer; default the normal).
-seed: 0 to 2^64-1. threads: workers (0: every hardware thread).
+seed: 0 to 2^64-1. threads: workers (0: every usable core: the CPU affinity and cgroup quota).
 alpha: the compensation strength, >= 0; 'auto' chooses it per BSDF (envmis.choose_alpha
   over these BSDFs and points); None: the map's own if compensated, else 0 for a map
   read from a table (map.from_table) and 1 for one built from an image, as the command's

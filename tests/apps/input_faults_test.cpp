@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "cli_run.h"
+#include "envmis/cpu.h"
 
 namespace {
 
@@ -189,14 +190,27 @@ TEST_F(InputFaults, BenchRefusesASkyAboveTheTexelLimitNamingTheFlag) {
     expect_one_line_error(r, "--size 65536x65536", "above the limit of 2147483648");
 }
 
-TEST_F(InputFaults, CompareUsesAtMostFourThreadsPerHardwareThreadWithANote) {
-    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+// A process bound to one CPU (taskset, a batch system's binding) runs one worker by
+// default, and its JSON says so.
+TEST_F(InputFaults, CompareBoundToOneCpuRecordsOneThread) {
+    if (std::system("command -v taskset > /dev/null 2>&1") != 0) GTEST_SKIP() << "no taskset";
+    write_exr(file("map.exr"), constant(16, 8, 1.0f));
+    const std::string command = "cd " + quoted(dir_.string()) + " && taskset -c 0 " + quoted(ENVMIS_CLI) +
+                                " compare map.exr --points 1 --spp 4 --bsdf lambert --json out.json";
+    const Result r = envmis::test::run_shell(command, dir_ / "..stdout", dir_ / "..stderr");
+    ASSERT_EQ(r.exit_code, 0) << r;
+    EXPECT_TRUE(std::regex_search(envmis::test::read_file(file("out.json")), std::regex("\"threads\": 1[,\n ]")))
+        << envmis::test::read_file(file("out.json"));
+}
+
+TEST_F(InputFaults, CompareUsesAtMostFourThreadsPerUsableCoreWithANote) {
+    const unsigned cores = envmis::usable_cores();
     if (4 * cores >= 1024) GTEST_SKIP() << cores << " hardware threads: --threads 1024 is within the limit";
     write_exr(file("map.exr"), constant(16, 8, 1.0f));
     const Result r = envmis({"compare", "map.exr", "--points", "1", "--spp", "4", "--bsdf", "lambert", "--threads",
                              "1024", "--json", "out.json"});
     ASSERT_EQ(r.exit_code, 0) << r;
-    EXPECT_TRUE(contains(r.err, "note: --threads 1024: more than 4 per hardware thread \\(" + std::to_string(cores) +
+    EXPECT_TRUE(contains(r.err, "note: --threads 1024: more than 4 per usable core \\(" + std::to_string(cores) +
                                     "\\); using " + std::to_string(4 * cores) + "\n"))
         << r;
 }

@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <thread>
+#if defined(__linux__)
+#include <sched.h>
+#endif
 
 #include "forced_path.h"
 
@@ -81,6 +85,40 @@ TEST(Cpu, NamesTheCpuAndThePaths) {
     EXPECT_GT(cpu_info().family, 0u);
 #endif
 }
+
+TEST(Cpu, ACgroupQuotaGivesItsCoresRoundedUpAndNoLimitGivesNone) {
+    EXPECT_EQ(cores_of_cpu_quota("200000 100000"), 2u);  // cgroup v2 cpu.max
+    EXPECT_EQ(cores_of_cpu_quota("150000 100000"), 2u);
+    EXPECT_EQ(cores_of_cpu_quota("50000 100000"), 1u);
+    EXPECT_EQ(cores_of_cpu_quota("max 100000"), 0u);
+    EXPECT_EQ(cores_of_cpu_quota("-1 100000"), 0u);  // cgroup v1 without a limit
+    EXPECT_EQ(cores_of_cpu_quota(""), 0u);
+    EXPECT_EQ(cores_of_cpu_quota(" 100000"), 0u);
+    EXPECT_EQ(cores_of_cpu_quota("100000 0"), 0u);
+    EXPECT_EQ(cores_of_cpu_quota("1e30 1"), 65536u);
+}
+
+#if defined(__linux__)
+// A thread bound to one CPU (as `taskset -c 0` binds a process) may use one core.
+TEST(Cpu, UsableCoresFollowTheAffinityMask) {
+    cpu_set_t all;
+    ASSERT_EQ(sched_getaffinity(0, sizeof all, &all), 0);
+    EXPECT_LE(usable_cores(), static_cast<uint32_t>(CPU_COUNT(&all)));
+    EXPECT_GE(usable_cores(), 1u);
+    uint32_t bound = 0;
+    std::thread([&] {
+        cpu_set_t one;
+        CPU_ZERO(&one);
+        for (int c = 0; c < CPU_SETSIZE; ++c)
+            if (CPU_ISSET(c, &all)) {
+                CPU_SET(c, &one);
+                break;
+            }
+        if (sched_setaffinity(0, sizeof one, &one) == 0) bound = usable_cores();
+    }).join();
+    EXPECT_EQ(bound, 1u);
+}
+#endif
 
 }  // namespace
 }  // namespace envmis

@@ -62,7 +62,7 @@ struct Options {
     std::string scene = "objects";
     std::optional<std::filesystem::path> obj;
     EnvKind env = EnvKind::global;
-    uint32_t width = 320, height = 240, spp = 16, threads = std::max(1u, std::thread::hardware_concurrency());
+    uint32_t width = 320, height = 240, spp = 16, threads = envmis::usable_cores();
     double seconds = 0;                           // 0: no time budget
     float rotate_degrees = 0;                     // the sky turned about the map's up axis
     uint32_t bins_depth = UINT32_MAX;             // vertices of a path that sample bins (--env bins)

@@ -1,4 +1,5 @@
-// Internal: splits an index range over the machine's cores with plain std::thread,
+// Internal: splits an index range over the cores this process may use (usable_cores:
+// affinity, cgroup quota) with plain std::thread,
 // so that envmis::core needs no threading library. Each index is processed by exactly
 // one call, so results never depend on the number of threads.
 #pragma once
@@ -10,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "envmis/cpu.h"
 #include "envmis/interrupt.h"
 
 namespace envmis::detail {
@@ -26,7 +28,7 @@ template <class Fn>
 void parallel_for(uint32_t n, uint32_t chunk, StopFlag stop, Fn&& fn) {
     chunk = std::max(1u, chunk);
     const uint32_t chunks = n / chunk + (n % chunk != 0);
-    const uint32_t threads = std::min(std::max(1u, std::thread::hardware_concurrency()), chunks);
+    const uint32_t threads = std::min(usable_cores(), chunks);
     if (threads <= 1 && !stop) {
         fn(0u, n);
         return;

@@ -3,6 +3,7 @@
 // exact figures of --exact.
 #include "envmis/study/comparison/setup.h"
 #include "envmis/build/env_map.h"
+#include "envmis/cpu.h"
 
 #include <gtest/gtest.h>
 
@@ -58,15 +59,15 @@ TEST(CompareSetup, BinsAreASquareCountAndOnlyWhereABinnedTechniqueRuns) {
     EXPECT_THROW(bins_per_side(5, plain), std::invalid_argument);
 }
 
-TEST(CompareSetup, WorkersAreAtMostFourPerHardwareThreadAndANoteSaysSo) {
-    const uint32_t cores = std::max(1u, std::thread::hardware_concurrency());
+TEST(CompareSetup, WorkersAreAtMostFourPerUsableCoreAndANoteSaysSo) {
+    const uint32_t cores = usable_cores();
     std::string note;
     EXPECT_EQ(worker_threads(0, &note), cores);
     EXPECT_EQ(worker_threads(1, &note), 1u);
     EXPECT_TRUE(note.empty());
     EXPECT_EQ(worker_threads(kMaxStudyThreads, &note), std::min(kMaxStudyThreads, kThreadsPerCore * cores));
     if (kThreadsPerCore * cores < kMaxStudyThreads) {
-        EXPECT_NE(note.find("threads 1024: more than 4 per hardware thread"), std::string::npos) << note;
+        EXPECT_NE(note.find("threads 1024: more than 4 per usable core"), std::string::npos) << note;
     }
 }
 

@@ -33,6 +33,16 @@ ENVMIS_CORE_API const CpuInfo& cpu_info() noexcept;
 // "<brand> (<vendor> family and model in hex, AVX2, AVX-512)": for benchmark output.
 ENVMIS_CORE_API std::string cpu_name();
 
+// How many threads this process can run at once: the CPUs its affinity mask allows
+// (taskset, a batch system's binding) and no more than its cgroup's CPU quota (a
+// container's or a Slurm job's limit, rounded up), at least 1. Read on each call (a
+// process may be moved); the default thread count of every envmis command and library.
+ENVMIS_CORE_API uint32_t usable_cores() noexcept;
+// The same from a cgroup's limit as written in cpu.max (v2: "QUOTA PERIOD" or "max
+// PERIOD") or v1's cfs_quota_us and cfs_period_us joined by a space: quota / period
+// rounded up, or 0 for no limit (or text it cannot read).
+ENVMIS_CORE_API uint32_t cores_of_cpu_quota(std::string_view cpu_max) noexcept;
+
 // The path of each kernel family; `forced` is ENVMIS_SIMD's value (empty when unset),
 // `unavailable` true when it names a path this CPU or build lacks, which then runs
 // scalar instead (a test of that path must skip, not pass).

@@ -1,9 +1,17 @@
-// cpuid, xgetbv and the rules of envmis/cpu.h.
+// cpuid, xgetbv and the rules of envmis/cpu.h; the usable cores (affinity, cgroup quota).
 #include "envmis/cpu.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <string>
+#include <thread>
+#if defined(__linux__)
+#include <sched.h>
+#endif
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <cpuid.h>
@@ -132,6 +140,42 @@ std::string batch_paths_summary() {
                     " sample_many=" + std::string(to_string(p.sample)) + " lanes=" + std::string(to_string(p.lanes));
     if (!p.forced.empty()) s += " (ENVMIS_SIMD=" + p.forced + (p.unavailable ? ": unavailable, scalar)" : ")");
     return s;
+}
+
+uint32_t cores_of_cpu_quota(std::string_view cpu_max) noexcept {
+    const std::string text(cpu_max);
+    double quota = 0, period = 0;
+    if (std::sscanf(text.c_str(), "%lf %lf", &quota, &period) != 2 || !(quota > 0) || !(period > 0)) return 0;
+    const double cores = std::ceil(quota / period);
+    return cores < 1 ? 1 : cores > 65536 ? 65536 : static_cast<uint32_t>(cores);
+}
+
+namespace {
+// The first line of a small file, or "" where it cannot be read.
+std::string first_line(const char* path) {
+    std::ifstream in(path);
+    std::string line;
+    std::getline(in, line);
+    return line;
+}
+}  // namespace
+
+uint32_t usable_cores() noexcept {
+    uint32_t cores = std::max(1u, std::thread::hardware_concurrency());
+#if defined(__linux__)
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0)
+        cores = static_cast<uint32_t>(CPU_COUNT(&set));
+    try {
+        uint32_t quota = cores_of_cpu_quota(first_line("/sys/fs/cgroup/cpu.max"));
+        if (quota == 0)
+            quota = cores_of_cpu_quota(first_line("/sys/fs/cgroup/cpu/cpu.cfs_quota_us") + " " +
+                                       first_line("/sys/fs/cgroup/cpu/cpu.cfs_period_us"));
+        if (quota > 0) cores = std::min(cores, quota);
+    } catch (...) {  // allocation failure reading the files: the affinity's count stands
+    }
+#endif
+    return cores;
 }
 
 }  // namespace envmis

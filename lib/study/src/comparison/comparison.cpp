@@ -9,6 +9,7 @@
 
 #include "envmis/build/bins.h"
 #include "envmis/build/env_map.h"
+#include "envmis/cpu.h"
 #include "envmis/study/shading/frame.h"
 #include "envmis/study/statistics/statistics.h"
 
@@ -199,7 +200,7 @@ Comparison compare_one(const EnvMap& plain, const EnvMap& compensated, const Bin
     for (const Technique& t : options.techniques)
         estimators.push_back(study_estimator(plain, compensated, binned, t, options.allocation));
     const size_t nb = options.bsdfs.size(), nt = options.techniques.size();
-    const uint32_t threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+    const uint32_t threads = options.threads ? options.threads : usable_cores();
     const LumaCoefficients luma = plain.options().luma;
 
     // cells[(p * nb + b) * nt + t]; references[p * nb + b].

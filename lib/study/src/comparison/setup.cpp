@@ -1,6 +1,7 @@
 #include "envmis/study/comparison/setup.h"
 #include "envmis/build/bins.h"
 #include "envmis/build/env_map.h"
+#include "envmis/cpu.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,13 +12,12 @@
 namespace envmis {
 
 uint32_t worker_threads(uint32_t asked, std::string* note) {
-    const uint32_t cores = std::max(1u, std::thread::hardware_concurrency());
+    const uint32_t cores = usable_cores();
     if (asked == 0) return cores;
     if (asked <= kThreadsPerCore * cores) return asked;
     if (note)
         *note = "threads " + std::to_string(asked) + ": more than " + std::to_string(kThreadsPerCore) +
-                " per hardware thread (" + std::to_string(cores) + "); using " +
-                std::to_string(kThreadsPerCore * cores);
+                " per usable core (" + std::to_string(cores) + "); using " + std::to_string(kThreadsPerCore * cores);
     return kThreadsPerCore * cores;
 }
 

@@ -24,7 +24,7 @@ namespace envmis {
 inline constexpr uint32_t kMaxStudySamples = 65536;  // per estimate, of each kind
 inline constexpr uint32_t kMaxStudyPoints = 1000000;
 inline constexpr uint32_t kMaxStudyThreads = 1024;
-inline constexpr uint32_t kThreadsPerCore = 4;  // more workers than this per hardware thread only contend
+inline constexpr uint32_t kThreadsPerCore = 4;  // more workers than this per usable core only contend
 inline constexpr uint32_t kDefaultStudyBins = 121;
 
 // What a study is asked for; options.threads as worker_threads resolves the count asked.
@@ -37,8 +37,8 @@ struct CompareRequest {
     float bin_cost = BinnedOptions{}.cost;
 };
 
-// Workers for `asked` threads: 0 is every hardware thread; more than kThreadsPerCore per
-// hardware thread are reduced to that, and `note` (when given) says so in a sentence
+// Workers for `asked` threads: 0 is every usable core (usable_cores: CPU affinity, cgroup
+// quota); more than kThreadsPerCore per usable core are reduced to that, and `note` (when given) says so in a sentence
 // naming both counts; otherwise it is left empty.
 uint32_t worker_threads(uint32_t asked, std::string* note = nullptr);
 
