@@ -43,6 +43,7 @@
 #include <thread>
 #include <vector>
 
+#include "envmis/cpu.h"
 #include "envmis/io/image_io.h"
 #include "envmis/math/random.h"
 #include "envmis/pictures/picture.h"

@@ -37,6 +37,7 @@
 #include <x86intrin.h>
 #endif
 
+#include "envmis/cpu.h"
 #include "envmis/io/image_io.h"
 #include "envmis/pictures/picture.h"
 #include "envmis/table/table.h"
