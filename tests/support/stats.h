@@ -6,6 +6,7 @@
 // family of tests has a 1e-4 chance of a false alarm on a correct build.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -96,6 +97,17 @@ inline ChiSquare chi_square(std::span<const double> expected, std::span<const do
     r.dof = static_cast<int>(pools.size()) - 1;
     r.p_value = r.dof > 0 ? gamma_q(r.dof / 2.0, r.statistic / 2.0) : 1.0;
     return r;
+}
+
+// The equirect texel (of w x h) a canonical direction (z up) falls in, from the
+// documented convention (mapping.h), in double.
+inline size_t equirect_texel_of(Vec3 d, uint32_t w, uint32_t h) {
+    const double theta = std::acos(std::clamp<double>(d.z, -1, 1));
+    double phi = std::atan2(double{d.y}, double{d.x});
+    if (phi < 0) phi += 2 * kPi;
+    const auto x = std::min<uint32_t>(w - 1, static_cast<uint32_t>(phi / (2 * kPi) * w));
+    const auto y = std::min<uint32_t>(h - 1, static_cast<uint32_t>(theta / kPi * h));
+    return size_t{y} * w + x;
 }
 
 // Midpoint rule over the sphere on an nt x np grid in (theta, phi), z up: the integral

@@ -45,16 +45,6 @@ std::vector<double> reference_mass(const RgbImage& m, bool compensate, double al
     return mass;
 }
 
-// Texel a world direction falls in, for the default z-up axes.
-size_t texel_of(Vec3 d, uint32_t w, uint32_t h) {
-    const double theta = std::acos(std::clamp<double>(d.z, -1, 1));
-    double phi = std::atan2(double{d.y}, double{d.x});
-    if (phi < 0) phi += 2 * kPi;
-    const auto x = std::min<uint32_t>(w - 1, static_cast<uint32_t>(phi / (2 * kPi) * w));
-    const auto y = std::min<uint32_t>(h - 1, static_cast<uint32_t>(theta / kPi * h));
-    return size_t{y} * w + x;
-}
-
 void expect_directions_follow(const EnvMap& map, const std::vector<double>& mass, uint64_t seed) {
     const size_t n = std::max<size_t>(100000, 30 * mass.size());
     const double total = std::accumulate(mass.begin(), mass.end(), 0.0);
@@ -62,7 +52,7 @@ void expect_directions_follow(const EnvMap& map, const std::vector<double>& mass
     for (size_t i = 0; i < mass.size(); ++i) expected[i] = n * mass[i] / total;
     Rng rng(seed);
     for (size_t i = 0; i < n; ++i)
-        observed[texel_of(map.sample(rng.uniform2()).direction, map.width(), map.height())] += 1;
+        observed[test::equirect_texel_of(map.sample(rng.uniform2()).direction, map.width(), map.height())] += 1;
     const auto chi = test::chi_square(expected, observed);
     EXPECT_GT(chi.p_value, kLevel) << map.width() << "x" << map.height() << ": " << chi.describe();
 }

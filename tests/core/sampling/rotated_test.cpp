@@ -47,16 +47,6 @@ struct Turn {
 const Vec3 kAxis{0.3f, -0.5f, 0.8f};
 const float kAngle = 1.1f;
 
-// Equirect texel of a canonical direction (z up), from the documented convention.
-size_t texel_of(Vec3 d, uint32_t w, uint32_t h) {
-    const double theta = std::acos(std::clamp<double>(d.z, -1, 1));
-    double phi = std::atan2(double{d.y}, double{d.x});
-    if (phi < 0) phi += 2 * kPi;
-    const auto x = std::min<uint32_t>(w - 1, static_cast<uint32_t>(phi / (2 * kPi) * w));
-    const auto y = std::min<uint32_t>(h - 1, static_cast<uint32_t>(theta / kPi * h));
-    return size_t{y} * w + x;
-}
-
 EnvMap sky(bool compensate) {
     EnvMapOptions o;
     o.compensation.enabled = compensate;
@@ -112,7 +102,7 @@ TEST(Rotated, DirectionsFollowTheDensityTurned) {
         Rng rng(31 + compensate);
         size_t over_edge = 0;
         for (size_t i = 0; i < n; ++i) {
-            const size_t t = texel_of(turn.to_local(turned.sample(rng.uniform2()).direction), w, h);
+            const size_t t = test::equirect_texel_of(turn.to_local(turned.sample(rng.uniform2()).direction), w, h);
             if (expected[t] == 0)
                 ++over_edge;
             else
@@ -205,7 +195,7 @@ TEST(RotatedBinned, BinsFollowTheTurnedNormalAndSamplesTheirDensity) {
         for (size_t i = 0; i < p.size(); ++i) expected[i] = p[i] * n;
         for (size_t i = 0; i < n; ++i) {
             const EnvSample s = bin.sample(rng.uniform2());
-            observed[texel_of(turn.to_local(s.direction), plain.width(), plain.height())] += 1;
+            observed[test::equirect_texel_of(turn.to_local(s.direction), plain.width(), plain.height())] += 1;
         }
         const auto chi = test::chi_square(expected, observed);
         EXPECT_GT(chi.p_value, test::kBinnedLevel) << chi.describe();
