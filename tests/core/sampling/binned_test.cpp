@@ -384,6 +384,33 @@ TEST(Binned, PicksFollowTheBilinearWeightsWhichChangeWithoutSteps) {
     EXPECT_EQ(fold.bin[1], (g - 1 - 2) * g + g - 1);
 }
 
+TEST(Binned, APickFromTheNormalAloneIsThePickFromItsBlendWithTheWeightsFrequencies) {
+    // Random normals everywhere (both hemispheres, the poles, the fold) and normals one
+    // grid step outside the map's edges; for each, choices on an even grid of [0,1).
+    Rng rng(12);
+    const int choices = 1000;
+    for (uint32_t g : {1u, 2u, 11u, 21u}) {
+        for (int i = 0; i < 3000; ++i) {
+            const Vec3 n = i < 8 ? Vec3{i & 1 ? 0.0f : 1.0f, i & 2 ? 1.0f : -0.0f, i & 4 ? -1.0f : 1.0f}
+                                 : octahedral_normal(rng.uniform(), rng.uniform());
+            const BinBlend blend = normal_blend(n, g);
+            float hits[4] = {};
+            for (int k = 0; k < choices; ++k) {
+                const float choice = (k + 0.5f) / choices;
+                const uint32_t bin = pick_bin(n, g, choice);
+                ASSERT_EQ(bin, pick_bin(blend, choice)) << "g " << g << " normal " << i << " choice " << choice;
+                ASSERT_LT(bin, g * g);
+                const uint32_t corner = pick_corner(blend.wa, blend.wb, choice);
+                ASSERT_GT(blend.weight[corner], 0.0f);
+                hits[corner] += 1.0f / choices;
+            }
+            for (int c = 0; c < 4; ++c)
+                ASSERT_NEAR(hits[c], blend.weight[c], 2.0f / choices)
+                    << "g " << g << " normal " << i << " corner " << c;
+        }
+    }
+}
+
 TEST(Binned, RejectsCompensatedMapsAndInvalidOptionsAndLayouts) {
     EXPECT_THROW(build_bins(build_env_map(test::sun_sky_map(16, 8))), std::invalid_argument);
     const EnvMap plain = plain_map(test::sun_sky_map(16, 8));

@@ -97,12 +97,13 @@ namespace envmis {
 ENVMIS_HD inline Vec2 octahedral_point(Vec3 n) noexcept {
     const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
     if (!(l1 > 0 && l1 <= 0x1.fffffep127f)) return {0, 0};
-    float u = n.x / l1, v = n.y / l1;
-    if (n.z < 0) {
-        const float fu = (1 - std::abs(v)) * (u < 0 ? -1.0f : 1.0f), fv = (1 - std::abs(u)) * (v < 0 ? -1.0f : 1.0f);
-        u = fu, v = fv;
-    }
-    return {0.5f * (u + 1), 0.5f * (v + 1)};
+    const float u = n.x / l1, v = n.y / l1;
+    // The lower hemisphere folded over the square's edges, by bits: the three signs of a
+    // random normal are coin flips that jumps would mispredict.
+    const float fu = from_bits(to_bits(1 - std::abs(v)) ^ (static_cast<uint32_t>(u < 0) << 31));
+    const float fv = from_bits(to_bits(1 - std::abs(u)) ^ (static_cast<uint32_t>(v < 0) << 31));
+    const bool lower = n.z < 0;
+    return {0.5f * (select_bits(lower, fu, u) + 1), 0.5f * (select_bits(lower, fv, v) + 1)};
 }
 
 // Octahedral grid of normals: the bin (of g x g) of a unit vector in the canonical
@@ -133,29 +134,57 @@ ENVMIS_HD inline uint32_t wrapped_bin(int i, int j, uint32_t g) noexcept {
 // bilinear), so that a normal within (1 - kBlendWidth) / 2 of the spacing from a centre
 // takes that bin alone, the one fitted to it.
 inline constexpr float kBlendWidth = 0.5f;
-struct BinBlend {
-    uint32_t bin[4];
-    float weight[4];
+ENVMIS_HD inline float blend_ramp(float t) noexcept {
+    const float r = (t - 0.5f) * (1 / kBlendWidth) + 0.5f, low = select_bits(r > 0, r, 0.0f);
+    return select_bits(low < 1, low, 1.0f);
+}
+// The square of bin centres around a normal: its lower-left centre (i, j), one step
+// outside the grid at most, and the weights wa, wb of the right and upper columns.
+struct BlendSquare {
+    int i, j;
+    float wa, wb;
 };
-ENVMIS_HD inline float blend_ramp(float t) noexcept { return clamp((t - 0.5f) * (1 / kBlendWidth) + 0.5f, 0.0f, 1.0f); }
-ENVMIS_HD inline BinBlend normal_blend(Vec3 n, uint32_t g) noexcept {
+ENVMIS_HD inline BlendSquare blend_square(Vec3 n, uint32_t g) noexcept {
     const Vec2 p = octahedral_point(n);
     const float a = p.x * static_cast<float>(g) - 0.5f, b = p.y * static_cast<float>(g) - 0.5f;
-    const float fa = std::floor(a), fb = std::floor(b), wa = blend_ramp(a - fa), wb = blend_ramp(b - fb);
-    const int i = static_cast<int>(fa), j = static_cast<int>(fb);
-    return {{wrapped_bin(i, j, g), wrapped_bin(i + 1, j, g), wrapped_bin(i, j + 1, g), wrapped_bin(i + 1, j + 1, g)},
-            {(1 - wa) * (1 - wb), wa * (1 - wb), (1 - wa) * wb, wa * wb}};
+    // floor for a, b >= -0.5, without a libm call (x86-64 has no rounding instruction
+    // before SSE4.1); where a + 1 rounds up to an integer, t = a - i is a hair below 0
+    // and its ramp 0: the same bin, with the same weight 1.
+    const int i = static_cast<int>(a + 1) - 1, j = static_cast<int>(b + 1) - 1;
+    return {i, j, blend_ramp(a - static_cast<float>(i)), blend_ramp(b - static_cast<float>(j))};
 }
-// The bin a uniform `choice` in [0,1) picks: the first whose running sum of weights
-// exceeds it (a bin of weight 0 never).
+struct BinBlend {
+    uint32_t bin[4];  // (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1), wrapped
+    float weight[4];  // (1 - wa)(1 - wb), wa (1 - wb), (1 - wa) wb, wa wb
+    float wa = 0, wb = 0;
+};
+ENVMIS_HD inline BinBlend normal_blend(Vec3 n, uint32_t g) noexcept {
+    const BlendSquare q = blend_square(n, g);
+    return {{wrapped_bin(q.i, q.j, g), wrapped_bin(q.i + 1, q.j, g), wrapped_bin(q.i, q.j + 1, g),
+             wrapped_bin(q.i + 1, q.j + 1, g)},
+            {(1 - q.wa) * (1 - q.wb), q.wa * (1 - q.wb), (1 - q.wa) * q.wb, q.wa * q.wb},
+            q.wa,
+            q.wb};
+}
+// The corner of the square a uniform `choice` in [0,1) picks (bit 0: right, bit 1: up),
+// with the weights' probabilities: the upper row where choice >= 1 - wb, then the right
+// column where choice passes (1 - wa) of its row's stretch. A corner of weight 0 never.
+ENVMIS_HD inline uint32_t pick_corner(float wa, float wb, float choice) noexcept {
+    // & of the comparisons, not &&: a && on a coin flip compiles to a jump.
+    const float rest = 1 - wb;
+    const uint32_t up = static_cast<uint32_t>(choice >= rest) & static_cast<uint32_t>(wb > 0);
+    const float split = select_bits(up != 0, rest + (1 - wa) * wb, (1 - wa) * rest);
+    const uint32_t right = static_cast<uint32_t>(choice >= split) & static_cast<uint32_t>(wa > 0);
+    return right | up << 1;
+}
 ENVMIS_HD inline uint32_t pick_bin(const BinBlend& blend, float choice) noexcept {
-    uint32_t bin = blend.bin[0];
-    float sum = blend.weight[0];
-    for (int k = 1; k < 4; ++k) {
-        bin = choice >= sum && blend.weight[k] > 0 ? blend.bin[k] : bin;
-        sum += blend.weight[k];
-    }
-    return bin;
+    return blend.bin[pick_corner(blend.wa, blend.wb, choice)];
+}
+// The same bin as pick_bin(normal_blend(n, g), choice), computing only that one.
+ENVMIS_HD inline uint32_t pick_bin(Vec3 n, uint32_t g, float choice) noexcept {
+    const BlendSquare q = blend_square(n, g);
+    const uint32_t corner = pick_corner(q.wa, q.wb, choice);
+    return wrapped_bin(q.i + static_cast<int>(corner & 1), q.j + static_cast<int>(corner >> 1), g);
 }
 
 // Canonical unit normal at point (s, t) in [0,1]^2 of the octahedral map of normals.
@@ -317,7 +346,7 @@ struct BinnedEnvMapView {
     // (normal_blend). A renderer draws `choice` once per shading point and keeps the
     // returned view for its light samples and its BSDF samples' MIS weights alike.
     ENVMIS_HD BinView bin(Vec3 axis, uint32_t lobe, float choice) const noexcept {
-        return bin(blend(axis, lobe), choice);
+        return bin_at(class_bin(lobe, pick_bin(to_canonical(plain.axes, axis), side(lobe), choice)));
     }
     // The same in two steps, for a shading point that draws several choices: the bins
     // around `axis` (their indices among all, class_bin) with their weights, and the
@@ -489,13 +518,14 @@ ENVMIS_HD inline BinView::Texel BinView::find_texel(const Cell& c, const Row& r)
     const uint32_t a = row.start[x0], b = x1 < row.n ? row.start[x1] : kCdfUnits;
     const double units = a + static_cast<double>(c.hit.offset) * (b - a);
     const auto t = min(static_cast<uint32_t>(units), b - 1);
-    uint32_t lo = x0, hi = x1 - 1;
-    while (lo < hi) {  // last texel of the segment whose start is <= t
-        const uint32_t mid = (lo + hi + 1) / 2;
-        if (row.start[mid] <= t)
-            lo = mid;
-        else
-            hi = mid - 1;
+    // The last texel of the segment whose start is <= t (row.start[x0] = a <= t), by
+    // halving with a select: the steps depend on the segment's width alone, so the loop's
+    // jumps are predicted, where a search's on u would miss half the time.
+    uint32_t lo = x0;
+    for (uint32_t len = x1 - x0; len > 1;) {
+        const uint32_t half = len / 2;
+        lo = row.start[lo + half] <= t ? lo + half : lo;
+        len -= half;
     }
     const float ox = min(static_cast<float>((units - row.start[lo]) / row.width(lo)), kOneMinusEpsilon);
     ENVMIS_PREFETCH(m.plain.radiance + static_cast<size_t>(r.y) * row.n + lo);
