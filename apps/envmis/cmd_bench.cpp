@@ -367,6 +367,9 @@ struct BinnedResult {
     double ratio[2][4] = {};                 // binned over plain, over compensated
     double lookup_ns[3] = {};                // per sampler: a single lookup (pdf and radiance)
     double batch_speedup[3][3] = {};         // per sampler: single sample, pdf, lookup / batch
+    // A single pdf call in a bin picked beforehand (a renderer picks once per shading
+    // point and weighs its BSDF samples in that bin), and its time over the plain pdf's.
+    double pdf_in_bin_ns = 0, pdf_in_bin_ratio = 0;
 };
 
 // ns per call of the three samplers, back to back in each repeat; lobe class 0.
@@ -381,7 +384,9 @@ void time_binned_calls(const EnvMapView (&today)[2], const BinnedEnvMapView& bin
     for (size_t i = 0; i < points.us.size(); ++i)
         inputs.push_back({points.us[i], points.directions[i], points.normals[i], points.choices[i]});
     BatchInputs batch(points.us, points.directions, points.normals, points.choices);
-    std::vector<double> ns[3][4], ratio[2][4], lookup_ns[3], speedup[3][3];
+    std::vector<std::pair<uint32_t, Vec3>> picked;  // (class_bin, direction)
+    for (const Input& in : inputs) picked.emplace_back(pick_bin(binned.blend(in.normal, 0), in.choice), in.direction);
+    std::vector<double> ns[3][4], ratio[2][4], lookup_ns[3], speedup[3][3], pdf_in_bin, pdf_in_bin_ratio;
     for (int r = 0; r < repeats; ++r) {
         throw_if_interrupted();
         double t[3][4], lookup[3];
@@ -402,6 +407,9 @@ void time_binned_calls(const EnvMapView (&today)[2], const BinnedEnvMapView& bin
         lookup[2] = ns_per_call(inputs, [&](const Input& in) {
             return every_output(binned.lookup(in.normal, 0, in.choice, in.direction));
         });
+        pdf_in_bin.push_back(ns_per_call(
+            picked, [&](const std::pair<uint32_t, Vec3>& p) { return binned.bin_at(p.first).pdf(p.second); }));
+        pdf_in_bin_ratio.push_back(pdf_in_bin.back() / t[kPlain][1]);
         for (int c = 0; c < 4; ++c) {
             for (int k = 0; k < 3; ++k) ns[k][c].push_back(t[k][c]);
             for (int k = 0; k < 2; ++k) ratio[k][c].push_back(t[2][c] / t[k][c]);
@@ -417,6 +425,7 @@ void time_binned_calls(const EnvMapView (&today)[2], const BinnedEnvMapView& bin
         for (int k = 0; k < 3; ++k) result.ns[k][c] = median(ns[k][c]);
         for (int k = 0; k < 2; ++k) result.ratio[k][c] = median(ratio[k][c]);
     }
+    result.pdf_in_bin_ns = median(pdf_in_bin), result.pdf_in_bin_ratio = median(pdf_in_bin_ratio);
     for (int k = 0; k < 3; ++k) {
         result.lookup_ns[k] = median(lookup_ns[k]);
         for (int c = 0; c < 3; ++c) result.batch_speedup[k][c] = median(speedup[k][c]);
@@ -479,6 +488,7 @@ nlohmann::json binned_json(const BinnedResult& b) {
         for (int c = 0; c < 4; ++c) j[std::string("binned_over_") + kBinnedSamplers[k]][kCallNames[c]] = b.ratio[k][c];
     j["binned_over_compensated"]["build"] = binned_build_ratio(b);
     j["binned_over_compensated"]["memory"] = binned_memory_ratio(b);
+    j["pdf_in_picked_bin"] = {{"ns", b.pdf_in_bin_ns}, {"over_plain_pdf", b.pdf_in_bin_ratio}};
     return j;
 }
 
@@ -501,9 +511,10 @@ void print_binned_text(const BinnedResult& b) {
             std::printf(" build=%.2fx memory=%.2f%%", binned_build_ratio(b), 100 * binned_memory_ratio(b));
         std::printf("\n");
     }
+    std::printf("binned_pdf_in_picked_bin ns=%.1f over_plain_pdf=%.2fx\n", b.pdf_in_bin_ns, b.pdf_in_bin_ratio);
     std::printf(
         "(binned over today's: time or bytes, median of the ratios within each repeat; build: plain map "
-        "plus bins over the compensated map)\n");
+        "plus bins over the compensated map; pdf in picked bin: the bin picked beforehand, once per shading point)\n");
 }
 
 void print_bench_json(const BenchArgs& args, const BenchMap& map, const BenchResult& result,

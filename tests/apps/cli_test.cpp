@@ -362,6 +362,8 @@ TEST_F(Cli, BenchWithBinsAddsTheBinnedSamplerAgainstTodaysMaps) {
                                     "x batch_sample=" + number + "x batch_lookup=" + number + "x build=" + number +
                                     "x memory=" + number + "%\\n"))
         << r;
+    EXPECT_TRUE(contains(r.out, "\\nbinned_pdf_in_picked_bin ns=" + number + " over_plain_pdf=" + number + "x\\n"))
+        << r;
     const Result j =
         envmis({"bench", "--size", "256x128", "--repeats", "1", "--samples", "1000", "--bins", "4", "--json"});
     ASSERT_EQ(j.exit_code, 0) << j;
@@ -370,6 +372,8 @@ TEST_F(Cli, BenchWithBinsAddsTheBinnedSamplerAgainstTodaysMaps) {
     ASSERT_EQ(binned.at("samplers").size(), 3u);
     for (const char* field : {"sample", "pdf", "batch_sample", "batch_lookup", "build", "memory"})
         EXPECT_GT(binned.at("binned_over_compensated").at(field).get<double>(), 0) << field << j;
+    for (const char* field : {"ns", "over_plain_pdf"})
+        EXPECT_GT(binned.at("pdf_in_picked_bin").at(field).get<double>(), 0) << field << j;
     for (const auto& s : binned.at("samplers")) {
         EXPECT_GT(s.at("ns_per_lookup").get<double>(), 0) << j;
         for (const char* field : {"sample", "lookup_over_pdf", "lookup_over_lookup"})
