@@ -171,9 +171,11 @@ void add_bench_flags(CLI::App& sub, BenchArgs& args) {
                    "Mapping of the synthetic sky (equal-area: a square --size) or of an image; a table has its own")
         ->capture_default_str()
         ->check(CLI::IsMember({"equirect", "equal-area"}));
-    sub.add_option("--bins", args.bins,
-                   "Also measure the binned sampler with K bins (square number) against today's EnvMap, plain and "
-                   "compensated: build, memory, sample and pdf with a random normal per call (lobe class 0)")
+    sub.add_option(
+           "--bins", args.bins,
+           "Also measure the binned sampler with K bins (square number) against today's EnvMap, plain and "
+           "compensated: build, memory, sample and pdf with a random normal per call (lobe class 0), and the pdf in a "
+           "bin picked beforehand (once per shading point, as a renderer weighs its BSDF samples)")
         ->type_name("K")
         ->check(bins_validator());
     sub.add_option("--samples-per-normal", args.samples_per_normal,
