@@ -46,6 +46,7 @@ struct CompareArgs {
     double view_angle = 0;  // degrees between each --points normal and its view
     uint32_t bins = 0;      // --bins; 0: kDefaultStudyBins where a -bins technique runs
     float bin_cost = BinnedOptions{}.cost;
+    uint32_t cell_columns = 0;
     uint64_t seed = 1;
     bool exact = false;
     // Library mode: hash_text of the file given, the key results_up_to_date checks (for a
@@ -97,6 +98,7 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
         ->type_name("K")
         ->check(bins_validator());
     add_bin_cost_flag(sub, args.bin_cost);
+    add_cell_columns_flag(sub, args.cell_columns);
     sub.add_option("--spp", args.spp, "Estimates per shading point, BSDF and technique (1 to 2^32-1)")
         ->capture_default_str()
         ->check(in_range(uint32_t{1}, kMaxSpp));
@@ -224,6 +226,7 @@ CompareRequest compare_request(const CompareArgs& args, std::vector<Technique>& 
     request.bin_alpha = args.map.alpha;
     request.bins = args.bins;
     request.bin_cost = args.bin_cost;
+    request.cell_columns = args.cell_columns;
     return request;
 }
 

@@ -66,10 +66,7 @@ void add_precompute_flags(CLI::App& sub, PrecomputeArgs& args) {
                        "and lobe class, --alpha X fixes it for every bin, --no-compensate makes it 0")
             ->type_name("K")
             ->check(bins_validator());
-    sub.add_option("--cell-columns", args.cell_columns, "With --bins: columns of the bins' cell grid (0: width / 32)")
-        ->type_name("N")
-        ->check(in_range(uint32_t{0}, uint32_t{4096}))
-        ->needs(bins);
+    add_cell_columns_flag(sub, args.cell_columns)->needs(bins);
     add_bin_cost_flag(sub, args.bin_cost)->needs(bins);
     add_jobs_flag(sub, args.jobs);
     sub.add_flag("--force", args.force,

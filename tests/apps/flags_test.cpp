@@ -137,6 +137,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadFlag{"PrecomputeCellColumnsAbove4096",
                 {"precompute", kStudio, "-o", "out.envmis", "--bins", "64", "--cell-columns", "4097"},
                 "--cell-columns"},
+        BadFlag{"CompareCellColumnsAbove4096", {"compare", kStudio, "--cell-columns", "4097"}, "--cell-columns"},
         // --bin-cost 1 to 100, with --bins only.
         BadFlag{"PrecomputeBinCostBelow1",
                 {"precompute", kStudio, "-o", "out.envmis", "--bins", "64", "--bin-cost", "0.5"},

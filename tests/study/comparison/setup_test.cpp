@@ -101,7 +101,7 @@ TEST(CompareSetup, AFixedAlphaCompensatesEveryBsdfAndNoneChoosesPerBsdf) {
     EXPECT_EQ(chosen.alpha_of(Bsdf::lambert()), chosen.bsdf_alphas[0]);
 }
 
-TEST(CompareSetup, BinsAreBuiltForABinnedTechniqueWithTheirAlphaFixedOnlyWhenGiven) {
+TEST(CompareSetup, BinsAreBuiltForABinnedTechniqueWithTheirAlphaFixedOnlyWhenGivenAndTheCellGridAsked) {
     EXPECT_EQ(prepare_compare(sky(false), quick_request()).binned, nullptr);
     CompareRequest request = quick_request({"mis-balance", "mis-balance-bins"});
     request.bins = 9;
@@ -113,6 +113,9 @@ TEST(CompareSetup, BinsAreBuiltForABinnedTechniqueWithTheirAlphaFixedOnlyWhenGiv
     const CompareSetup fixed = prepare_compare(sky(false), request);
     EXPECT_FALSE(fixed.bins_auto);
     for (const BinChoice& c : fixed.binned->layout().choices) EXPECT_EQ(c.alpha, 0.5f);
+    EXPECT_EQ(automatic.binned->layout().cell_columns, 2u);  // width / 32
+    request.cell_columns = 8;
+    EXPECT_EQ(prepare_compare(sky(false), request).binned->layout().cell_columns, 8u);
 }
 
 TEST(CompareSetup, ExactRatiosCoverTheFixedWeightTechniquesAndBalanceIsOneOverItself) {

@@ -61,6 +61,7 @@ std::shared_ptr<const BinnedEnvMap> study_bins(const EnvMap& plain, uint32_t g, 
     options.auto_alpha = !request.bin_alpha;
     options.alpha = request.bin_alpha.value_or(options.alpha);
     options.cost = request.bin_cost;
+    options.cell_columns = request.cell_columns;
     return std::make_shared<const BinnedEnvMap>(build_bins(EnvMap(plain), options, stop));
 }
 

@@ -35,6 +35,7 @@ struct CompareRequest {
     std::optional<float> bin_alpha;  // every bin's; empty: each bin chooses its own (BinnedOptions::auto_alpha)
     uint32_t bins = 0;               // K = g*g normal bins; 0: kDefaultStudyBins where a -bins technique runs
     float bin_cost = BinnedOptions{}.cost;
+    uint32_t cell_columns = 0;  // of the bins' cell grid (BinnedOptions::cell_columns)
 };
 
 // Workers for `asked` threads: 0 is every usable core (usable_cores: CPU affinity, cgroup
