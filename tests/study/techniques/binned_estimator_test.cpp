@@ -163,7 +163,7 @@ TEST(BinnedEstimator, ABinsTechniqueNeedsABinnedMapAndOthersRefuseOne) {
     EXPECT_NO_THROW(DirectLightingEstimator(binned, Technique::parse("mis-optimal-bins"), {2, 1}));
 }
 
-TEST(BinnedEstimator, LobeClassFollowsTheBsdfsSharpness) {
+TEST(BinnedEstimator, LobeClassFollowsTheBsdfsSharpnessAndRoughGgxIsDiffuse) {
     EXPECT_EQ(Bsdf::lambert().phong_exponent(), 0.0f);
     EXPECT_EQ(Bsdf::phong(200).phong_exponent(), 200.0f);
     EXPECT_NEAR(Bsdf::ggx(0.1f).phong_exponent(), 49.5f, 1e-2f);
@@ -172,6 +172,10 @@ TEST(BinnedEstimator, LobeClassFollowsTheBsdfsSharpness) {
     EXPECT_EQ(binned.lobe_class(Bsdf::phong(20).phong_exponent()), 1u);
     EXPECT_EQ(binned.lobe_class(Bsdf::ggx(0.1f).phong_exponent()), 1u);
     EXPECT_EQ(binned.lobe_class(Bsdf::ggx(0.03f).phong_exponent()), 2u);
+    // Rough GGX from kGgxDiffuseRoughness up takes the diffuse class, whose bins follow the normal.
+    EXPECT_EQ(binned.lobe_class(Bsdf::ggx(0.14f).phong_exponent()), 1u);
+    EXPECT_EQ(binned.lobe_class(Bsdf::ggx(kGgxDiffuseRoughness).phong_exponent()), 0u);
+    EXPECT_EQ(binned.lobe_class(Bsdf::ggx(0.3f).phong_exponent()), 0u);
 }
 
 }  // namespace

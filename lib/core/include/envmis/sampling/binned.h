@@ -211,12 +211,18 @@ inline Vec3 folded_octahedral_normal(float s, float t) noexcept {
 // the nearest on the scale log(1 + e). Lambert has e = 0; GGX, see ggx_lobe_exponent.
 ENVMIS_CORE_API uint32_t lobe_class(std::span<const float> exponents, float phong_exponent) noexcept;
 
-// The Phong exponent whose lobe of reflected directions is as wide as GGX's with
-// roughness a: (2 / a^2 - 2) / 4. The usual 2 / a^2 - 2 matches the distribution of
-// microfacet normals; reflection doubles angles, so the lobe of directions is four
-// times wider in exponent. Measured: GGX 0.1 in the Phong-20 class has its worst point
-// at 0.85x of plain balance MIS on rooitou_park, against 0.67x in the Phong-200 class.
-inline float ggx_lobe_exponent(float a) noexcept { return a > 0 ? (2 / (a * a) - 2) / 4 : 1e5f; }
+// The Phong exponent that picks the lobe class of GGX with roughness a. Below
+// kGgxDiffuseRoughness, that of the Phong lobe of reflected directions as wide as GGX's:
+// (2 / a^2 - 2) / 4 (the usual 2 / a^2 - 2 matches the distribution of microfacet
+// normals; reflection doubles angles, so the lobe of directions is four times wider in
+// exponent). From it up, 0: the diffuse class, whose bins follow the normal. A rough
+// GGX lobe seen obliquely spreads about the normal more than about the mirror
+// direction; the diffuse class gave lower variance at every point measured from 0.15 up,
+// and a worse worst point below (measured: docs/performance-log.md, 'ggx_lobe_exponent').
+inline constexpr float kGgxDiffuseRoughness = 0.15f;
+inline float ggx_lobe_exponent(float a) noexcept {
+    return a >= kGgxDiffuseRoughness ? 0.0f : a > 0 ? (2 / (a * a) - 2) / 4 : 1e5f;
+}
 
 // The direction that picks a shading point's bin: the normal for the diffuse class (0),
 // whose lobe is the cosine about it; for glossy classes the mirror direction of the
