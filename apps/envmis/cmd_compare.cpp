@@ -361,6 +361,8 @@ std::string options_text(const CompareArgs& a) {
          << " env-samples=" << a.env_samples << " bsdf-samples=" << a.bsdf_samples << " seed=" << a.seed
          << " normal=" << a.normal << " view=" << a.view << " points=" << a.points;
     if (a.view_angle != 0) text << " view-angle=" << a.view_angle;
+    if (a.bin_cost != BinnedOptions{}.cost) text << " bin-cost=" << a.bin_cost;
+    if (a.cell_columns != 0) text << " cell-columns=" << a.cell_columns;
     char alpha[32];
     std::snprintf(alpha, sizeof alpha, "%.9g", a.map.alpha.value_or(1.0f));
     text << " alpha="

@@ -231,6 +231,12 @@ TEST_F(Library, CompareWritesEachMapsJsonAndASummaryAndSkipsThemOnTheSecondRun) 
     expect_all("out/summary.json", "up-to-date");
     envmis(with({"compare", "maps", "--out-dir", "out", "--seed", "2"}, kStudy));
     expect_all("out/summary.json", "written");
+    // The bins' options are the results' too.
+    envmis(with({"compare", "maps", "--out-dir", "out", "--seed", "2", "--cell-columns", "2"}, kStudy));
+    expect_all("out/summary.json", "written");
+    envmis(
+        with({"compare", "maps", "--out-dir", "out", "--seed", "2", "--cell-columns", "2", "--bin-cost", "2"}, kStudy));
+    expect_all("out/summary.json", "written");
     // report takes out/*.json: the summary is skipped with a note.
     const Result report = envmis({"report", "out/city.json", "out/studio.json", "out/summary.json", "-o", "r.md"});
     EXPECT_EQ(report.exit_code, 0) << report;
