@@ -103,7 +103,7 @@ CLI::Option* add_cell_columns_flag(CLI::App& app, uint32_t& columns) {
             "With --bins: columns of the bins' cell grid (rows: half as many for equirect, as many for equal-area; "
             "0: width / 32, clamped to 1 to 128)")
         ->type_name("N")
-        ->check(in_range(uint32_t{0}, uint32_t{4096}));
+        ->check(in_range(uint32_t{0}, kMaxCellColumns));
 }
 
 CLI::Option* add_bin_cost_flag(CLI::App& app, float& cost) {

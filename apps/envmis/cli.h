@@ -73,7 +73,7 @@ CLI::Validator bins_validator();
 CLI::Validator non_empty();
 // --bin-cost R (BinnedOptions::cost, 1 to 100), for the commands that build bins.
 CLI::Option* add_bin_cost_flag(CLI::App& app, float& cost);
-// --cell-columns N (BinnedOptions::cell_columns, 0 to 4096), for the commands that build bins.
+// --cell-columns N (BinnedOptions::cell_columns, 0 to kMaxCellColumns), for the commands that build bins.
 CLI::Option* add_cell_columns_flag(CLI::App& app, uint32_t& columns);
 // A direction "X,Y,Z" (a shading normal, a view): three finite numbers, not all zero,
 // normalised; empty where the text is not one. The validator refuses what it refuses.
