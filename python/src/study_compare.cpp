@@ -70,11 +70,12 @@ py::dict inputs_dict(const CompareSetup& s, const std::string& name, size_t poin
     return to_python(inputs).cast<py::dict>();
 }
 
-// compare --exact's figures as its JSON holds them: {bsdf: {technique: {ratio, worst}}}.
+// compare --exact's figures as its JSON holds them: {bsdf: {technique: {ratio, worst, points}}}.
 nlohmann::json exact_json(const CompareSetup& s, const std::atomic<bool>& stop) {
     nlohmann::json exact = nlohmann::json::object();
     for (const ExactRatio& r : exact_ratios(s, {&stop, {}}))
-        exact[s.options.bsdfs[r.bsdf].name()][r.technique.name()] = {{"ratio", r.ratio}, {"worst", r.worst}};
+        exact[s.options.bsdfs[r.bsdf].name()][r.technique.name()] = {
+            {"ratio", r.ratio}, {"worst", r.worst}, {"points", r.points}};
     return exact;
 }
 

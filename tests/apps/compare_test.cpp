@@ -6,6 +6,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -174,7 +176,8 @@ TEST(Compare, BinsThatAreNotASquareNumberAreRefused) {
 }
 
 // The -bins techniques run through the table, the JSON and --exact, whose ratio of
-// mis-balance over itself is 1 and whose -bins ratio is a positive number.
+// mis-balance over itself is 1 and whose -bins ratio is a positive number, the geometric
+// mean of the points' ratios, the worst of which is the worst point's.
 TEST(Compare, BinsTechniquesAreReportedWithTheirExactRatios) {
     const fs::path dir = small_map_folder("envmis_compare_bins_run_test");
     const CliRun r = run_compare(dir,
@@ -186,7 +189,14 @@ TEST(Compare, BinsTechniquesAreReportedWithTheirExactRatios) {
     EXPECT_EQ(results["results"].size(), 8u);
     for (const char* bsdf : {"lambert", "ggx:0.1"}) {
         EXPECT_DOUBLE_EQ(results["exact"][bsdf]["mis-balance"]["ratio"].get<double>(), 1.0);
-        EXPECT_GT(results["exact"][bsdf]["mis-balance-bins"]["ratio"].get<double>(), 0.0);
+        const nlohmann::json& bins = results["exact"][bsdf]["mis-balance-bins"];
+        EXPECT_GT(bins["ratio"].get<double>(), 0.0);
+        const auto points = bins["points"].get<std::vector<double>>();
+        ASSERT_EQ(points.size(), 3u);
+        double log_sum = 0;
+        for (double v : points) log_sum += std::log(v);
+        EXPECT_NEAR(std::exp(log_sum / 3), bins["ratio"].get<double>(), 1e-9 * bins["ratio"].get<double>());
+        EXPECT_DOUBLE_EQ(*std::max_element(points.begin(), points.end()), bins["worst"].get<double>());
         EXPECT_FALSE(results["exact"][bsdf].contains("mis-optimal-bins")) << "optimal MIS has no exact variance";
     }
     fs::remove_all(dir);

@@ -157,6 +157,25 @@ Lobe lobe_at(const Nodes& n, Vec3 normal, float exponent) {
     return lobe;
 }
 
+// The GGX lobe of roughness a seen along the axis: a direction at cosine c has a half
+// vector at cos^2 = (1 + c) / 2; density D / 4 (visible normals, head-on view), value
+// D G2 / 4 with Smith's G2 = 1 / (1 + Lambda), Fresnel 1. No cut: its tails fall as a
+// power, where a Phong lobe's fall exponentially, and a light far off the axis may
+// still send most of its light through them.
+Lobe ggx_lobe_at(const Nodes& n, Vec3 axis, double a) {
+    Lobe lobe;
+    const double a2 = a * a;
+    for (uint32_t i = 0; i < n.direction.size(); ++i) {
+        const double c = dot(n.direction[i], axis);
+        if (!(c > 0) || !(n.sum_l[i] > 0)) continue;
+        const double t = 0.5 * (1 + c) * (a2 - 1) + 1, d = a2 / (kPi * t * t);
+        const double lambda = 0.5 * (std::sqrt(1 + a2 * (1 - c * c) / (c * c)) - 1);
+        lobe.visible.push_back(i), lobe.f.push_back(n.sum_l[i] / n.sum_w[i] * d / (4 * (1 + lambda)));
+        lobe.p_bsdf.push_back(d / 4);
+    }
+    return lobe;
+}
+
 // Exact variance of one 1 + 1 balance MIS estimate at the lobe's normal (mis_variance.h).
 double mis_variance(const Nodes& n, const Lobe& lobe, std::span<const double> cell_probability,
                     std::span<const double> cell_mass) {
@@ -177,6 +196,24 @@ std::vector<double> probabilities(std::vector<double> mass) {
     if (!(total > 0)) return {};
     for (double& m : mass) m /= total;
     return mass;
+}
+
+// The GGX roughness a glossy class's choice weighs besides its Phong lobe: GGX lobes
+// take the class of their ggx_lobe_exponent (binned.h), and their tails, which a Phong
+// lobe lacks, can make compensation lose where a Phong lobe's choice predicts a gain
+// (GGX 0.08 on night.exr: 2.45x the variance of plain balance MIS, 14 shared maps,
+// docs/performance.md). The roughness is that of the exponent midway, on lobe_class's
+// scale, between the lowest and highest exponents of GGX lobes the class takes (the top
+// class's own exponent bounds it, or the roughest GGX); 0 where it takes none.
+double ggx_roughness_of(std::span<const float> exponents, uint32_t c) {
+    const auto key = [](double e) { return std::log1p(e); };
+    const double roughest = key(ggx_lobe_exponent(std::nextafter(kGgxDiffuseRoughness, 0.0f)));
+    const double lo = std::max(0.5 * (key(exponents[c - 1]) + key(exponents[c])), roughest);
+    const double hi =
+        c + 1 < exponents.size() ? 0.5 * (key(exponents[c]) + key(exponents[c + 1])) : std::max(key(exponents[c]), lo);
+    if (hi < lo) return 0;
+    const double e = std::expm1(0.5 * (lo + hi));
+    return std::sqrt(2 / (4 * e + 2));
 }
 
 // Normals the choice weighs a bin's candidates at: a 3 x 3 grid over its blend support
@@ -232,6 +269,7 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
         const Geometry& geometry = geometries.of(c);
         const uint32_t g = shape.side(c);
         const float exponent = shape.lobe_exponents[c];
+        const double ggx_a = glossy ? ggx_roughness_of(shape.lobe_exponents, c) : 0;
         parallel_for(g * g, 1, stop, [&](uint32_t lo, uint32_t hi) {
             std::vector<double> mass(cells);
             for (uint32_t b = lo; b < hi; ++b) {
@@ -242,18 +280,23 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
                             geometry.weight(b, cell, glossy) * hist.above(cell, thresholds[glossy][b * count + j]);
                     p[j] = probabilities(mass);
                 }
-                std::vector<double> log_ratio(count, 0);
+                std::vector<double> log_ratio(count, 0), ggx_log_ratio(count, 0);
                 double weights = 0;
-                for (const WeightedNormal& at : bin_samples(b, g)) {
-                    weights += at.weight;
-                    const Lobe lobe = lobe_at(nodes, at.normal, exponent);
+                const auto add = [&](const Lobe& lobe, double weight, std::vector<double>& to) {
                     const double base = mis_variance(nodes, lobe, plain_p, hist.total_l);
                     for (size_t j = 0; j < count; ++j) {
                         const double v = p[j].empty() ? 0 : mis_variance(nodes, lobe, p[j], hist.total_l);
-                        if (base > 0)
-                            log_ratio[j] += at.weight * (v > 0 ? std::log(v / base) : (p[j].empty() ? 1e9 : 0));
+                        if (base > 0) to[j] += weight * (v > 0 ? std::log(v / base) : (p[j].empty() ? 1e9 : 0));
                     }
+                };
+                for (const WeightedNormal& at : bin_samples(b, g)) {
+                    weights += at.weight;
+                    add(lobe_at(nodes, at.normal, exponent), at.weight, log_ratio);
+                    if (glossy && ggx_a > 0) add(ggx_lobe_at(nodes, at.normal, ggx_a), at.weight, ggx_log_ratio);
                 }
+                // A glossy class serves Phong and GGX lobes alike: a candidate must do for both.
+                if (glossy && ggx_a > 0)
+                    for (size_t j = 0; j < count; ++j) log_ratio[j] = std::max(log_ratio[j], ggx_log_ratio[j]);
                 const size_t best = std::min_element(log_ratio.begin(), log_ratio.end()) - log_ratio.begin();
                 choices[shape.first(c) + b] = log_ratio[best] / weights < -std::log(options.cost) - 1e-6
                                                   ? BinChoice{alphas[best], thresholds[glossy][b * count + best]}

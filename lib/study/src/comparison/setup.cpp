@@ -105,10 +105,11 @@ std::vector<ExactRatio> exact_ratios(const CompareSetup& setup, const RunControl
         step();
         for (const Technique& t : fixed) {
             const std::vector<double> v = exact_point_variances(inputs, t, b, 1, control.stop);
-            double worst = 0;
+            std::vector<double> points(v.size(), 0.0);
             for (size_t p = 0; p < v.size(); ++p)
-                if (v[p] > 0 && baseline[p] > 0) worst = std::max(worst, v[p] / baseline[p]);
-            ratios.push_back({b, t, geometric_mean_ratios(v, baseline, 1).front(), worst});
+                if (v[p] > 0 && baseline[p] > 0) points[p] = v[p] / baseline[p];
+            const double worst = points.empty() ? 0 : *std::max_element(points.begin(), points.end());
+            ratios.push_back({b, t, geometric_mean_ratios(v, baseline, 1).front(), worst, std::move(points)});
             step();
         }
     }

@@ -42,7 +42,8 @@
 // compensation), so each bin holds one cell table per lobe class (by default diffuse,
 // Phong 20 and Phong 200), and a shading point picks the class nearest its BSDF's
 // sharpness (lobe_class). alpha_b is chosen per bin and class at build time: the exact
-// variance of 1 + 1 balance MIS, view along the normal, at nine normals of the bin's
+// variance of 1 + 1 balance MIS (the class's Phong lobe, and for a glossy class a GGX
+// lobe too: envmis/build/bins.h), view along the normal, at nine normals of the bin's
 // blend support (weighted as the blend weighs them), on a 64-column copy of the map
 // (texels grouped inside cells), over that of the plain density; the candidate with the
 // lowest weighted geometric mean wins where that mean is below 1 / cost (BinnedOptions:

@@ -75,12 +75,13 @@ struct CompareSetup {
 CompareSetup prepare_compare(std::shared_ptr<const EnvMap> map, CompareRequest request, StopFlag stop = nullptr);
 
 // compare --exact's figures for one technique on one BSDF: its exact variance
-// (quadrature, one subdivision) over mis-balance's, the geometric mean over points and
-// the worst point.
+// (quadrature, one subdivision) over mis-balance's, at each point (0 where either is 0),
+// their geometric mean and the worst point.
 struct ExactRatio {
     size_t bsdf = 0;  // in options.bsdfs order
     Technique technique;
     double ratio = 0, worst = 0;
+    std::vector<double> points;
 };
 
 // The exact ratios of every fixed-weight technique of the setup (adaptive and mixture
