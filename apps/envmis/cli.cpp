@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -90,6 +91,18 @@ CLI::Validator size_validator(bool single, uint32_t min_side, uint32_t max_side)
 
 CLI::Validator non_empty() {
     return CLI::Validator([](std::string& text) { return text.empty() ? "expected a path, got ''" : ""; }, "");
+}
+
+CLI::Validator output_extension(const std::string& extension, const std::string& format) {
+    return CLI::Validator(
+        [extension, format](std::string& text) -> std::string {
+            if (text.empty()) return "expected a path, got ''";
+            std::string ext = std::filesystem::path(text).extension().string();
+            std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+            if (ext == extension) return "";
+            return text + ": writes " + format + ", so the name must end in " + extension;
+        },
+        "");
 }
 
 CLI::Validator bins_validator() {
@@ -194,6 +207,31 @@ int exit_interrupted(const std::string& detail) {
     std::cerr << "envmis: interrupted by " << (signal == SIGTERM ? "SIGTERM" : "SIGINT")
               << (detail.empty() || detail == Interrupted().what() ? "" : ": " + printable(detail)) << "\n";
     return 128 + (signal ? signal : SIGINT);
+}
+
+std::string nearest_name(std::string_view word, const std::vector<std::string>& names) {
+    // Optimal string alignment distance, one row at a time plus the two before it.
+    const auto distance = [](std::string_view a, std::string_view b) {
+        std::vector<size_t> before(b.size() + 1), last(b.size() + 1), row(b.size() + 1);
+        for (size_t j = 0; j <= b.size(); ++j) last[j] = j;
+        for (size_t i = 1; i <= a.size(); ++i) {
+            row[0] = i;
+            for (size_t j = 1; j <= b.size(); ++j) {
+                row[j] = std::min({last[j] + 1, row[j - 1] + 1, last[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+                if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+                    row[j] = std::min(row[j], before[j - 2] + 1);
+            }
+            std::swap(before, last), std::swap(last, row);
+        }
+        return last[b.size()];
+    };
+    std::string best;
+    size_t best_distance = 3;
+    for (const std::string& name : names) {
+        const size_t d = !word.empty() && name.starts_with(word) ? 0 : distance(word, name);
+        if (d < best_distance) best = name, best_distance = d;
+    }
+    return best;
 }
 
 std::string printable(std::string_view text) {

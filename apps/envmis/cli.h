@@ -14,6 +14,7 @@
 #include <memory>
 #include <optional>
 #include <ostream>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -71,6 +72,9 @@ CLI::Validator size_validator(bool single, uint32_t min_side = 1, uint32_t max_s
 CLI::Validator bins_validator();
 // An output path flag given an empty value ("-o ''") is refused, not taken as "none".
 CLI::Validator non_empty();
+// A path that ends in `extension` (".png"; any case), for outputs written in one format
+// only, so that a file never holds another format than its name says.
+CLI::Validator output_extension(const std::string& extension, const std::string& format);
 // --bin-cost R (BinnedOptions::cost, 1 to 100), for the commands that build bins.
 CLI::Option* add_bin_cost_flag(CLI::App& app, float& cost);
 // --cell-columns N (BinnedOptions::cell_columns, 0 to kMaxCellColumns), for the commands that build bins.
@@ -171,6 +175,19 @@ void throw_if_interrupted();
 // What main prints and returns once a signal has arrived, `detail` (Interrupted's
 // message, unless it is the plain "interrupted") after the signal's name.
 int exit_interrupted(const std::string& detail);
+
+// Exit statuses: 0 success, 1 a failure of the work (input, output, memory), 2 a usage
+// error (an unknown command, flag or value: nothing was started), 128 + the signal's
+// number when interrupted (exit_interrupted).
+inline constexpr int kExitFailure = 1, kExitUsage = 2;
+// A flag's value or a combination of flags refused after parsing (main exits kExitUsage).
+struct UsageError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+// The name among `names` nearest `word` by edit distance (insertions, deletions,
+// substitutions and swaps of neighbours), if it is at most 2 edits away or `word` is a
+// prefix of it; empty otherwise.
+std::string nearest_name(std::string_view word, const std::vector<std::string>& names);
 
 // Progress on stderr: "label  42%", redrawn in place when stderr is a terminal; where it
 // is not, one line each time the percentage changes if the environment variable

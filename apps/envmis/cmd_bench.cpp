@@ -208,7 +208,7 @@ BenchMap bench_map(const BenchArgs& args) {
     if (args.input.empty()) {
         const Size size = *parse_size(args.size, false);  // the flag's validator has accepted it
         if (options.mapping == Mapping::equal_area && size.width != size.height)
-            throw std::runtime_error("--size " + args.size + ": an equal-area sky is square, e.g. 5792x5792");
+            throw UsageError("--size " + args.size + ": an equal-area sky is square, e.g. 5792x5792");
         check_image_size("--size " + args.size, size, kBytesPerTexel);
         BenchMap map{reference::synthetic_sky(size.width, size.height, options.mapping), "synthetic-sky", options, {}};
         const uint32_t side = square_side(map.image);

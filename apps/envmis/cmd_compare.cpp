@@ -206,7 +206,7 @@ CompareRequest compare_request(const CompareArgs& args, std::vector<Technique>& 
     options.seed = args.seed;
     options.bsdfs.clear();
     for (const std::string& b : split_list(args.bsdfs)) options.bsdfs.push_back(Bsdf::parse(b));
-    if (options.bsdfs.empty()) throw std::runtime_error("--bsdf '" + args.bsdfs + "': expected at least one BSDF");
+    if (options.bsdfs.empty()) throw UsageError("--bsdf '" + args.bsdfs + "': expected at least one BSDF");
     for (const std::string& t : split_list(args.techniques)) requested.push_back(Technique::parse(t));
     if (!requested.empty()) options.techniques = requested;
     options.allocation = {args.env_samples, args.bsdf_samples};
@@ -580,10 +580,10 @@ void run_library_compare(const CompareArgs& args) {
         for (const std::string& input : args.inputs)
             if (std::filesystem::is_directory(input, ec))
                 throw std::runtime_error(input + ": a directory; a folder of maps needs --out-dir DIR (library mode)");
-        throw std::runtime_error("--out-dir: required with several inputs, or with --summary (library mode)");
+        throw UsageError("--out-dir: required with several inputs, or with --summary (library mode)");
     }
     if (!args.json.empty())
-        throw std::runtime_error("--json: not in library mode; each map's JSON goes to --out-dir/<stem>.json");
+        throw UsageError("--json: not in library mode; each map's JSON goes to --out-dir/<stem>.json");
     const std::filesystem::path dir = args.out_dir;
     const std::vector<LibraryItem> items = plan_outputs(expand_inputs(args.inputs, args.recursive, true), dir, ".json");
     std::filesystem::create_directories(dir);

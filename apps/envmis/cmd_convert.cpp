@@ -22,7 +22,9 @@ struct ConvertArgs {
 
 void add_convert_flags(CLI::App& sub, ConvertArgs& args) {
     sub.add_option("input", args.input, "HDR image")->required();
-    sub.add_option("-o,--output", args.output, "OpenEXR file to write (float RGB)")->required()->check(non_empty());
+    sub.add_option("-o,--output", args.output, "OpenEXR file to write (float RGB)")
+        ->required()
+        ->check(output_extension(".exr", "OpenEXR"));
     const auto mappings = CLI::IsMember({"equirect", "equal-area"});
     sub.add_option("--from", args.from, "Mapping of the input")->capture_default_str()->check(mappings);
     sub.add_option("--to", args.to, "Mapping of the output")->capture_default_str()->check(mappings);
@@ -49,8 +51,8 @@ Size requested_size(const std::string& text, Mapping to) {
     if (size.height != 0) return size;
     if (to == Mapping::equal_area) return {size.width, size.width};
     if (size.width > kMaxCells1D / 2)
-        throw std::runtime_error("--size " + text + ": an equirect output is 2N x N, N at most " +
-                                 std::to_string(kMaxCells1D / 2));
+        throw UsageError("--size " + text + ": an equirect output is 2N x N, N at most " +
+                         std::to_string(kMaxCells1D / 2));
     return {2 * size.width, size.width};
 }
 

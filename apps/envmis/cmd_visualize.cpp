@@ -45,7 +45,7 @@ struct VisualizeArgs {
 
 void add_visualize_flags(CLI::App& sub, VisualizeArgs& args) {
     sub.add_option("input", args.input, "HDR image or table")->required();
-    sub.add_option("-o,--output", args.output, "PNG file to write")->required()->check(non_empty());
+    sub.add_option("-o,--output", args.output, "PNG file to write")->required()->check(output_extension(".png", "PNG"));
     sub.add_option("--panel-width", args.panel_width,
                    "Width of each panel in pixels (panels keep the map's aspect and are at most 4096 high: a tall "
                    "map's are narrower; a map over 64 times taller than wide is refused)")

@@ -1,4 +1,5 @@
 // envmis: precompute, inspect, sample, visualise and benchmark environment-map samplers.
+#include <algorithm>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
@@ -27,15 +28,26 @@ int main(int argc, char** argv) {
     const std::vector<Subcommand> subcommands = {add_compare(app), add_report(app), add_precompute(app),
                                                  add_info(app),    add_sample(app), add_visualize(app),
                                                  add_bench(app),   add_convert(app)};
+    app.footer("Exit status: 0 success, 1 failure, 2 usage error (nothing started), 128 + N on signal N.");
+    if (argc > 1 && argv[1][0] != '-') {
+        std::vector<std::string> names;
+        for (const Subcommand& s : subcommands) names.push_back(s.app->get_name());
+        if (std::find(names.begin(), names.end(), argv[1]) == names.end()) {
+            const std::string near = nearest_name(argv[1], names);
+            std::cerr << "envmis: unknown command '" << printable(argv[1]) << "'"
+                      << (near.empty() ? "" : "; did you mean '" + near + "'?") << " (see --help)\n";
+            return kExitUsage;
+        }
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        const int status = app.exit(e);
+        const int status = app.exit(e) == 0 ? 0 : kExitUsage;
         // --help and --version print to standard output: one that cannot take it (full,
         // closed) makes the run a failure, as it does for every command's output.
         if (status == 0 && (std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout)) {
             std::cerr << "envmis: standard output: " << std::strerror(errno) << "\n";
-            return 1;
+            return kExitFailure;
         }
         return status;
     }
@@ -46,16 +58,19 @@ int main(int argc, char** argv) {
         standard_output.finish();
     } catch (const envmis::Interrupted& e) {
         return exit_interrupted(e.what());
+    } catch (const UsageError& e) {
+        std::cerr << "envmis: " << printable(e.what()) << "\n";
+        return kExitUsage;
     } catch (const std::bad_alloc&) {
         // The last resort: sizes are checked against free memory before large allocations.
         std::cerr << "envmis: out of memory (try a smaller size, or free memory)\n";
-        return 1;
+        return kExitFailure;
     } catch (const std::exception& e) {
         // A failure caused by the interruption (a library's read stopped half-way) is the
         // interruption's.
         if (interrupted()) return exit_interrupted(e.what());
         std::cerr << "envmis: " << printable(e.what()) << "\n";
-        return 1;
+        return kExitFailure;
     }
     // A signal during the last of the work, after its last check, still says so: the
     // outputs are complete, but the exit status must not tell a script the run was whole.

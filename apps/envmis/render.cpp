@@ -94,8 +94,8 @@ namespace {
 Scene parse_scene(const std::string& size, uint32_t spheres) {
     const std::optional<Size> parsed = parse_size(size, false, kMinImageSide, kMaxImageSide);
     if (!parsed)
-        throw std::runtime_error("--image '" + size + "': expected WxH, each " + std::to_string(kMinImageSide) +
-                                 " to " + std::to_string(kMaxImageSide));
+        throw UsageError("--image '" + size + "': expected WxH, each " + std::to_string(kMinImageSide) + " to " +
+                         std::to_string(kMaxImageSide));
     const auto [w, h] = *parsed;
     return {w, h, spheres, 0.45f * std::min(static_cast<float>(w) / spheres, static_cast<float>(h))};
 }

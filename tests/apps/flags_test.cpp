@@ -1,13 +1,15 @@
 // Specification of the count, size and seed flags of `envmis` precompute, info, sample,
 // visualize, bench and convert: a negative or out-of-range value is refused before any
-// work starts, with exit code != 0, nothing on stdout, one line on stderr that names the
-// flag, and no output file. Every test runs the real binary (ENVMIS_CLI) in a temporary
+// work starts, with exit status 2 (a usage error), nothing on stdout, one line on stderr
+// that names the flag, and no output file; a mistyped command is named with the nearest
+// one; a failure of the work itself exits 1. Every test runs the real binary (ENVMIS_CLI) in a temporary
 // folder of its own.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli_run.h"
@@ -47,7 +49,7 @@ class FlagBounds : public Folder {};
 TEST_P(Flags, AnOutOfRangeValueIsRefusedInOneLineNamingTheFlagBeforeAnyWork) {
     const BadFlag& c = GetParam();
     const Result r = envmis(c.args);
-    EXPECT_NE(r.exit_code, 0) << r;
+    EXPECT_EQ(r.exit_code, 2) << r;
     EXPECT_EQ(r.out, "") << r;
     EXPECT_TRUE(!r.err.empty() && r.err.back() == '\n' && r.err.find('\n') == r.err.size() - 1)
         << "expected exactly one line on stderr" << r;
@@ -161,6 +163,43 @@ INSTANTIATE_TEST_SUITE_P(
         BadFlag{"InfoNegativeAlpha", {"info", kStudio, "--alpha", "-1"}, "--alpha"},
         BadFlag{"VisualizeNegativeAlpha", visualize({"--alpha", "-1"}), "--alpha"}),
     [](const testing::TestParamInfo<BadFlag>& info) { return info.param.name; });
+
+TEST_F(FlagBounds, AMistypedCommandIsAUsageErrorThatNamesTheNearestCommand) {
+    for (const auto& [typed, meant] : {std::pair<std::string, std::string>{"compre", "compare"},
+                                       {"comprae", "compare"},
+                                       {"prec", "precompute"},
+                                       {"infp", "info"},
+                                       {"vizualize", "visualize"}}) {
+        const Result r = envmis({typed, kStudio});
+        EXPECT_EQ(r.exit_code, 2) << r;
+        EXPECT_EQ(r.out, "") << r;
+        EXPECT_EQ(r.err, "envmis: unknown command '" + typed + "'; did you mean '" + meant + "'? (see --help)\n") << r;
+    }
+    const Result far = envmis({"bogus"});
+    EXPECT_EQ(far.exit_code, 2) << far;
+    EXPECT_EQ(far.err, "envmis: unknown command 'bogus' (see --help)\n") << far;
+    EXPECT_TRUE(folder_is_empty());
+}
+
+TEST_F(FlagBounds, AnOutputNamedForAnotherFormatThanTheOneWrittenIsRefused) {
+    for (const auto& [args, format] :
+         {std::pair<std::vector<std::string>, std::string>{{"visualize", kStudio, "-o", "vis.jpg"}, "PNG"},
+          {{"convert", kStudio, "-o", "square.png"}, "OpenEXR"}}) {
+        const Result r = envmis(args);
+        EXPECT_EQ(r.exit_code, 2) << r;
+        EXPECT_NE(r.err.find("writes " + format), std::string::npos) << r;
+        EXPECT_TRUE(folder_is_empty()) << r;
+    }
+    EXPECT_EQ(envmis({"visualize", kStudio, "-o", "vis.PNG", "--panel-width", "64"}).exit_code, 0);
+}
+
+TEST_F(FlagBounds, AFailureOfTheWorkExitsOneAndHelpNamesTheStatuses) {
+    const Result missing = envmis({"info", "no-such-map.exr"});
+    EXPECT_EQ(missing.exit_code, 1) << missing;
+    const Result help = envmis({"--help"});
+    EXPECT_EQ(help.exit_code, 0) << help;
+    EXPECT_NE(help.out.find("Exit status: 0 success, 1 failure, 2 usage error"), std::string::npos) << help;
+}
 
 // The limits themselves are accepted.
 TEST_F(FlagBounds, TheLimitsThemselvesAreAccepted) {
