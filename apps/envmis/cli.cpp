@@ -380,6 +380,7 @@ LoadedMap load_map(const std::string& path, const BuildRequest& request, std::os
         LoadedMap loaded{std::move(table.map), std::move(table.source), true, "envmis table"};
         loaded.table_version = table.version;
         loaded.mapped = table.mapped;
+        loaded.compact = read_table_header(path).compact;
         loaded.bins = std::move(table.bins);
         loaded.load_ms = milliseconds_since(start);
         return loaded;
@@ -436,6 +437,8 @@ void print_bins(std::ostream& out, const BinLayout& layout) {
         }
         out << "\n";
     }
+    out << "                (alpha a: max(L - a E_b / pi, 0) times the bin's cosine factor; plain: the map's own "
+           "density)\n";
 }
 
 }  // namespace
@@ -477,7 +480,9 @@ void print_summary(std::ostream& out, const LoadedMap& loaded, const EnvMap& m) 
     out << "  colour        " << printable(loaded.source.input_colorspace) << " -> "
         << printable(loaded.source.working_colorspace) << ", luma (" << o.luma.r << ", " << o.luma.g << ", " << o.luma.b
         << ")\n";
-    out << "  mapping       " << to_string(o.mapping) << ", axes " << o.axes.to_string() << "\n";
+    out << "  mapping       " << to_string(o.mapping) << ", axes " << o.axes.to_string();
+    if (const std::string_view preset = o.axes.preset(); !preset.empty()) out << " (" << preset << ")";
+    out << "\n";
     out << "  luminance     max " << s.max_luminance << ", min positive " << s.min_positive_luminance;
     if (s.min_positive_luminance > 0)
         out << ", dynamic range " << s.max_luminance / s.min_positive_luminance << " ("
@@ -495,9 +500,10 @@ void print_summary(std::ostream& out, const LoadedMap& loaded, const EnvMap& m) 
     out << "  bad pixels    " << s.bad_pixels.nan << " NaN, " << s.bad_pixels.infinite << " Inf, "
         << s.bad_pixels.negative << " negative channel values (replaced by 0)\n";
     out << "  fallback      " << to_string(s.fallback) << "\n";
-    out << "  complete pdf  " << (m.complete() ? "yes" : "no: combine with BSDF sampling through MIS") << "\n";
+    out << "  complete pdf  " << (m.complete() ? "yes" : "no: combine with BSDF sampling through MIS")
+        << (loaded.bins ? " (the plain map's; the bins': 'bins complete' below)" : "") << "\n";
     out << "  memory        " << std::setprecision(3) << m.distribution().bytes() / texels
-        << " bytes/texel (distribution) + " << sizeof(Rgb) << " (radiance)\n";
+        << " bytes/texel (distribution) + " << sizeof(Rgb) << " (float RGB radiance), in memory\n";
     out.flags(flags);
     if (loaded.bins) print_bins(out, *loaded.bins);
 }

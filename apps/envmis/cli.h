@@ -130,6 +130,7 @@ struct LoadedMap {
     std::string format;          // "envmis table", "openexr", "hdr", ...
     uint32_t table_version = 0;  // the table file's format version
     bool mapped = false;         // the map borrows its radiance from a mapping of the table file
+    bool compact = false;        // the table file holds RGBE radiance (decoded into memory)
     uint32_t channels = 3;
     double load_ms = 0, build_ms = 0;
     std::optional<AlphaChoice> alpha_choice = {};  // with --alpha auto, for an image

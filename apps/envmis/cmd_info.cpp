@@ -32,7 +32,9 @@ void print_info(const InfoArgs& args, const LoadedMap& loaded) {
     std::cout << printable(args.input) << ": ";
     if (loaded.from_table)
         std::cout << "envmis table, format version " << loaded.table_version
-                  << (loaded.mapped ? ", radiance used in place from a mapping of the file" : "") << "\n";
+                  << (loaded.mapped ? ", radiance used in place from a mapping of the file" : "")
+                  << (loaded.compact ? ", compact (RGBE radiance, 4 bytes/texel on disk, decoded into memory)" : "")
+                  << "\n";
     else
         std::cout << "image, " << loaded.channels << " channels\n";
     print_summary(std::cout, loaded);

@@ -500,6 +500,8 @@ TEST_F(Cli, PrecomputeWithBinsWritesABinnedTableThatInfoDescribes) {
     ASSERT_EQ(info.exit_code, 0) << info;
     for (const char* line :
          {"binned.envmis: envmis table, format version 6", R"(bins +64 \(8 x 8)", R"(bin alphas +Phong 20: )",
+          R"(complete pdf +(yes|no.*) \(the plain map's; the bins': 'bins complete' below\))",
+          R"(alpha a: max\(L - a E_b / pi, 0\) times the bin's cosine factor; plain: the map's own density)",
           R"(bins complete +diffuse (yes|no), Phong 20)",
           R"(bins build +[0-9.]+ ms \(rebuilt from the stored layout\), [0-9]+ bytes over the plain map)"})
         EXPECT_TRUE(contains(info.out, line)) << "missing /" << line << "/" << info;
@@ -510,6 +512,26 @@ TEST_F(Cli, PrecomputeWithBinsWritesABinnedTableThatInfoDescribes) {
         contains(fixed.out, R"(bins +1 \(1 x 1 octahedral grid of normals; the diffuse class 1, 1 x 1\), cells 4 x 2)"))
         << fixed;
     EXPECT_TRUE(contains(fixed.out, R"(bin alphas +diffuse: +1 alpha 0\n)")) << fixed;
+}
+
+// What the summary prints agrees with the options and the file: the axes by their preset's
+// name too, memory as in memory, a compact table said to be one.
+TEST_F(Cli, TheSummaryNamesTheAxesPresetMemoryInMemoryAndACompactTable) {
+    write_exr(file("map.exr"), gradient(64, 32));
+    const Result r = envmis({"precompute", "map.exr", "-o", "y.envmis", "--axes", "y-up", "--compact"});
+    ASSERT_EQ(r.exit_code, 0) << r;
+    EXPECT_TRUE(contains(r.out, R"(axes x,z,-y \(y-up\))")) << r;
+    EXPECT_TRUE(
+        contains(r.out, R"(memory +[0-9.]+ bytes/texel \(distribution\) \+ 12 \(float RGB radiance\), in memory)"))
+        << r;
+    const Result info = envmis({"info", "y.envmis"});
+    ASSERT_EQ(info.exit_code, 0) << info;
+    EXPECT_TRUE(contains(info.out, R"(format version 6, compact \(RGBE radiance, 4 bytes/texel on disk)")) << info;
+    EXPECT_TRUE(contains(info.out, R"(axes x,z,-y \(y-up\))")) << info;
+    ASSERT_EQ(envmis({"precompute", "map.exr", "-o", "p.envmis", "--axes", "x,-z,y"}).exit_code, 0);
+    const Result other = envmis({"info", "p.envmis"});
+    EXPECT_TRUE(contains(other.out, R"(axes x,-z,y\n)")) << other;
+    EXPECT_FALSE(contains(other.out, "compact")) << other;
 }
 
 TEST_F(Cli, PrecomputeRefusesBinsThatAreNotASquareNumberInOneLineAndWritesNothing) {

@@ -207,7 +207,8 @@ TEST_F(OutputFaults, AnOutputThatIsTheInputIsRefusedAndTheInputKept) {
     const std::string original = read_file(file("map.exr"));
     for (const std::string name : {"map.exr", "link.exr", "hard.exr"}) {
         std::vector<std::vector<std::string>> runs;
-        for (const Writer& w : kWriters) runs.push_back(writer_args(w, name, "map.exr"));
+        for (const Writer& w : kWriters)
+            if (w.subcommand != std::string("visualize")) runs.push_back(writer_args(w, name, "map.exr"));
         runs.push_back({"convert", "map.exr", "-o", name});
         runs.push_back({"compare", "map.exr", "--points", "1", "--spp", "4", "--json", name});
         runs.push_back({"compare", "map.exr", "--points", "1", "--spp", "4", "--csv", name});
@@ -219,6 +220,16 @@ TEST_F(OutputFaults, AnOutputThatIsTheInputIsRefusedAndTheInputKept) {
     }
     EXPECT_TRUE(fs::is_symlink(file("link.exr")));
     EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 3);
+    // visualize writes PNG only: a PNG input named as its output, itself or linked.
+    ASSERT_EQ(envmis({"visualize", "map.exr", "-o", "map.png", "--panel-width", "64"}).exit_code, 0);
+    fs::create_symlink("map.png", file("link.png"));
+    fs::create_hard_link(file("map.png"), file("hard.png"));
+    const std::string picture = read_file(file("map.png"));
+    for (const std::string name : {"map.png", "link.png", "hard.png"}) {
+        expect_one_line_error(envmis({"visualize", "map.png", "-o", name}), name,
+                              "is the input map.png; refusing to overwrite an input");
+        ASSERT_EQ(read_file(file("map.png")), picture) << name;
+    }
 }
 
 TEST_F(OutputFaults, TwoOutputsOfOneRunThatAreOneFileAreRefused) {

@@ -223,6 +223,10 @@ struct WeightedNormal {
     Vec3 normal;
     double weight;
 };
+Vec3 bin_centre(uint32_t bin, uint32_t g) {
+    return folded_octahedral_normal((bin % g + 0.5f) / static_cast<float>(g), (bin / g + 0.5f) / static_cast<float>(g));
+}
+
 std::vector<WeightedNormal> bin_samples(uint32_t bin, uint32_t g) {
     std::vector<WeightedNormal> samples;
     for (int dt = -1; dt <= 1; ++dt)
@@ -280,8 +284,8 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
                             geometry.weight(b, cell, glossy) * hist.above(cell, thresholds[glossy][b * count + j]);
                     p[j] = probabilities(mass);
                 }
-                std::vector<double> log_ratio(count, 0), ggx_log_ratio(count, 0);
-                double weights = 0;
+                // Per candidate, the weighted mean of log(variance / the plain density's).
+                std::vector<double> log_ratio(count, 0);
                 const auto add = [&](const Lobe& lobe, double weight, std::vector<double>& to) {
                     const double base = mis_variance(nodes, lobe, plain_p, hist.total_l);
                     for (size_t j = 0; j < count; ++j) {
@@ -289,16 +293,23 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
                         if (base > 0) to[j] += weight * (v > 0 ? std::log(v / base) : (p[j].empty() ? 1e9 : 0));
                     }
                 };
+                double weights = 0;
                 for (const WeightedNormal& at : bin_samples(b, g)) {
                     weights += at.weight;
                     add(lobe_at(nodes, at.normal, exponent), at.weight, log_ratio);
-                    if (glossy && ggx_a > 0) add(ggx_lobe_at(nodes, at.normal, ggx_a), at.weight, ggx_log_ratio);
                 }
-                // A glossy class serves Phong and GGX lobes alike: a candidate must do for both.
-                if (glossy && ggx_a > 0)
-                    for (size_t j = 0; j < count; ++j) log_ratio[j] = std::max(log_ratio[j], ggx_log_ratio[j]);
+                for (double& r : log_ratio) r /= weights;
+                // A glossy class serves GGX lobes too, whose tails reach lights its Phong
+                // lobe does not: a candidate must do for both. GGX at the bin's centre only:
+                // its lobe covers the whole hemisphere, the choice's dearest, and weighing
+                // it at the 9 normals changed no figure measured (docs/performance-log.md).
+                if (glossy && ggx_a > 0) {
+                    std::vector<double> ggx(count, 0);
+                    add(ggx_lobe_at(nodes, bin_centre(b, g), ggx_a), 1, ggx);
+                    for (size_t j = 0; j < count; ++j) log_ratio[j] = std::max(log_ratio[j], ggx[j]);
+                }
                 const size_t best = std::min_element(log_ratio.begin(), log_ratio.end()) - log_ratio.begin();
-                choices[shape.first(c) + b] = log_ratio[best] / weights < -std::log(options.cost) - 1e-6
+                choices[shape.first(c) + b] = log_ratio[best] < -std::log(options.cost) - 1e-6
                                                   ? BinChoice{alphas[best], thresholds[glossy][b * count + best]}
                                                   : BinChoice{-1, 0};
             }

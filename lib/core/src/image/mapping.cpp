@@ -14,6 +14,12 @@ bool Axes::valid() const noexcept {
     return seen == 0b1110;
 }
 
+std::string_view Axes::preset() const noexcept {
+    for (const std::string_view name : {"z-up", "y-up", "mitsuba3", "blender"})
+        if (parse(name) == *this) return name;
+    return {};
+}
+
 Axes Axes::parse(std::string_view text) {
     if (text == "z-up" || text == "pbrt-v4") return Axes{{1, 2, 3}};
     if (text == "y-up") return Axes{{1, 3, -2}};

@@ -8,10 +8,10 @@
 // texels apart) stands for the map; for each candidate alpha the bin's cell masses give a
 // density, and the variance of one environment plus one BSDF sample, balance heuristic,
 // a Phong lobe of the class's exponent, is summed exactly over the nodes at 9 normals of
-// the bin (for a glossy class also that of a GGX lobe of the roughness the class takes,
-// whose tails a Phong lobe lacks: each candidate scores the worse of the two); a candidate
-// wins where it lowers the geometric mean of the ratio to the plain density's by more than
-// options.cost (BinnedOptions), else the bin stays plain.
+// the bin (for a glossy class also that of a GGX lobe of the roughness the class takes at
+// the bin's centre, whose tails a Phong lobe lacks: each candidate scores the worse of the
+// two); a candidate wins where it lowers the geometric mean of the ratio to the plain
+// density's by more than options.cost (BinnedOptions), else the bin stays plain.
 //
 // Cost: a pass over the texels, then O(bins x candidates x normals x nodes); parallel
 // over bins (detail/parallel.h), deterministic for any number of threads.

@@ -52,6 +52,9 @@ struct ENVMIS_CORE_API Axes {
     // Throws std::invalid_argument naming the text if it is not a signed permutation.
     static Axes parse(std::string_view text);
     std::string to_string() const;
+    // The preset these axes are ("z-up", "y-up", "mitsuba3", "blender"; pbrt-v4 is z-up),
+    // or empty.
+    std::string_view preset() const noexcept;
     bool valid() const noexcept;
     ENVMIS_HD bool identity() const noexcept { return code[0] == 1 && code[1] == 2 && code[2] == 3; }
     friend bool operator==(const Axes&, const Axes&) = default;
