@@ -380,7 +380,7 @@ LoadedMap load_map(const std::string& path, const BuildRequest& request, std::os
         LoadedMap loaded{std::move(table.map), std::move(table.source), true, "envmis table"};
         loaded.table_version = table.version;
         loaded.mapped = table.mapped;
-        loaded.compact = read_table_header(path).compact;
+        loaded.compact = table.compact;
         loaded.bins = std::move(table.bins);
         loaded.load_ms = milliseconds_since(start);
         return loaded;

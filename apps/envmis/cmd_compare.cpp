@@ -434,10 +434,10 @@ void write_exact(std::ostream& out, const CompareArgs& args, const Setup& s, Wri
         for (const ExactRatio& r : ratios) {
             if (r.bsdf != b) continue;
             char text[96];
-            std::snprintf(text, sizeof text, " %s %.3f (%.3f)", r.technique.name().c_str(), r.ratio, r.worst);
+            std::snprintf(text, sizeof text, " %s %.3f (%.3f)", r.technique.name().c_str(), r.ratio, r.worst());
             out << text;
             w.json["exact"][s.options.bsdfs[b].name()][r.technique.name()] = {
-                {"ratio", r.ratio}, {"worst", r.worst}, {"points", r.points}};
+                {"ratio", r.ratio}, {"worst", r.worst()}, {"points", r.points}};
         }
         out << "\n";
     }

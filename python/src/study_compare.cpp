@@ -75,7 +75,7 @@ nlohmann::json exact_json(const CompareSetup& s, const std::atomic<bool>& stop) 
     nlohmann::json exact = nlohmann::json::object();
     for (const ExactRatio& r : exact_ratios(s, {&stop, {}}))
         exact[s.options.bsdfs[r.bsdf].name()][r.technique.name()] = {
-            {"ratio", r.ratio}, {"worst", r.worst}, {"points", r.points}};
+            {"ratio", r.ratio}, {"worst", r.worst()}, {"points", r.points}};
     return exact;
 }
 

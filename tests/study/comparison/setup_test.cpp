@@ -133,7 +133,7 @@ TEST(CompareSetup, ExactRatiosCoverTheFixedWeightTechniquesAndBalanceIsOneOverIt
         EXPECT_TRUE(r.technique.name() == "env" || r.technique.name() == "mis-balance") << r.technique.name();
         if (r.technique.name() == "mis-balance") {
             EXPECT_EQ(r.ratio, 1.0);
-            EXPECT_EQ(r.worst, 1.0);
+            EXPECT_EQ(r.worst(), 1.0);
         } else {
             EXPECT_GT(r.ratio, 0.0);
         }

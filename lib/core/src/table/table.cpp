@@ -302,7 +302,7 @@ BinLayout parse_bins(std::span<const std::byte> section, uint64_t digest, const 
 template <class Build>
 Table checked_table(std::string_view name, const Header& header, std::optional<BinLayout> bins, Build&& build) {
     try {
-        return Table{build(), header.source, header.version, false, std::move(bins), std::string(name)};
+        return Table{build(), header.source, header.version, false, header.compact, std::move(bins), std::string(name)};
     } catch (const std::invalid_argument& e) {
         fail(name, std::string("inconsistent contents: ") + e.what());
     }

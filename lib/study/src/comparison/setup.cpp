@@ -108,8 +108,7 @@ std::vector<ExactRatio> exact_ratios(const CompareSetup& setup, const RunControl
             std::vector<double> points(v.size(), 0.0);
             for (size_t p = 0; p < v.size(); ++p)
                 if (v[p] > 0 && baseline[p] > 0) points[p] = v[p] / baseline[p];
-            const double worst = points.empty() ? 0 : *std::max_element(points.begin(), points.end());
-            ratios.push_back({b, t, geometric_mean_ratios(v, baseline, 1).front(), worst, std::move(points)});
+            ratios.push_back({b, t, geometric_mean_ratios(v, baseline, 1).front(), std::move(points)});
             step();
         }
     }

@@ -52,6 +52,7 @@ struct Table {
     TableSource source;
     uint32_t version = 0;  // the file's format version
     bool mapped = false;   // the map borrows its radiance from a mapping of the file
+    bool compact = false;  // the file holds RGBE radiance, decoded into the map
     // The bins of a binned map (tables of version 4 or later written from a BinnedEnvMap): `map` is
     // then the plain map they were built over. Checked against the map's size when read;
     // binned_map rebuilds them.

@@ -4,6 +4,7 @@
 // arguments into a CompareRequest; everything from there on is this file's.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -80,8 +81,9 @@ CompareSetup prepare_compare(std::shared_ptr<const EnvMap> map, CompareRequest r
 struct ExactRatio {
     size_t bsdf = 0;  // in options.bsdfs order
     Technique technique;
-    double ratio = 0, worst = 0;
+    double ratio = 0;
     std::vector<double> points;
+    double worst() const noexcept { return points.empty() ? 0 : *std::max_element(points.begin(), points.end()); }
 };
 
 // The exact ratios of every fixed-weight technique of the setup (adaptive and mixture
