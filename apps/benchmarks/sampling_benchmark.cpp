@@ -142,6 +142,7 @@ const std::vector<envmis::Vec3>& normals();
 const std::vector<float>& choices();
 struct BatchPoints {
     std::vector<float> ux, uy, nx, ny, nz, dx, dy, dz, choice;  // points, normals, directions, bin picks
+    std::vector<float> head_on;                                 // view cosines 1
 };
 const BatchPoints& batch_points() {
     static const BatchPoints p = [] {
@@ -150,6 +151,7 @@ const BatchPoints& batch_points() {
         for (const envmis::Vec3 n : normals()) b.nx.push_back(n.x), b.ny.push_back(n.y), b.nz.push_back(n.z);
         for (const envmis::Vec3 d : directions()) b.dx.push_back(d.x), b.dy.push_back(d.y), b.dz.push_back(d.z);
         b.choice = choices();
+        b.head_on.assign(b.nx.size(), 1.0f);
         return b;
     }();
     return p;
@@ -246,7 +248,7 @@ void sample_binned(benchmark::State& state) {
     size_t i = 0;
     for (auto _ : state) {
         const size_t k = i++ & (us.size() - 1);
-        const envmis::EnvSample e = view.sample(ns[k], 0, cs[k], us[k]);
+        const envmis::EnvSample e = view.sample({ns[k]}, 0, cs[k], us[k]);
         benchmark::DoNotOptimize(e);
     }
 }
@@ -258,7 +260,8 @@ void sample_binned_batch(benchmark::State& state) {
     const envmis::SampleArrays arrays = sample_arrays(out.data());
     size_t first = 0;
     for (auto _ : state) {
-        envmis::sample_many(view, 0, {p.nx.data() + first, p.ny.data() + first, p.nz.data() + first},
+        envmis::sample_many(view, 0,
+                            {p.nx.data() + first, p.ny.data() + first, p.nz.data() + first, p.head_on.data() + first},
                             p.choice.data() + first, {p.ux.data() + first, p.uy.data() + first}, arrays, kBatch);
         benchmark::DoNotOptimize(out.data());
         first = (first + kBatch) & (p.ux.size() - 1);
@@ -274,7 +277,7 @@ void pdf_binned(benchmark::State& state) {
     size_t i = 0;
     for (auto _ : state) {
         const size_t k = i++ & (ds.size() - 1);
-        benchmark::DoNotOptimize(view.pdf(ns[k], 0, cs[k], ds[k]));
+        benchmark::DoNotOptimize(view.pdf({ns[k]}, 0, cs[k], ds[k]));
     }
 }
 

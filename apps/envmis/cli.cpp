@@ -409,6 +409,28 @@ std::string lobe_name(float exponent) {
     return name.str();
 }
 
+// Per glossy class, how many compensated bins keep their density up to each view angle
+// (BinChoice::min_view_cos, in whole degrees from the normal; widest first).
+void print_view_limits(std::ostream& out, const BinLayout& layout) {
+    for (uint32_t c = 1; c < layout.classes(); ++c) {
+        std::map<int, uint32_t, std::greater<>> limits;
+        for (size_t i = layout.first(c); i < layout.first(c + 1) && i < layout.choices.size(); ++i)
+            if (!layout.choices[i].plain())
+                ++limits[static_cast<int>(std::lround(std::acos(layout.choices[i].min_view_cos) * 180 / kPi))];
+        if (limits.empty()) continue;
+        out << "  bin views     " << std::left << std::setw(11) << lobe_name(layout.lobe_exponents[c]) + ":"
+            << std::right;
+        const char* separator = "";
+        for (const auto& [degrees, count] : limits) {
+            out << separator << count << (degrees >= 90 ? " every view" : " up to " + std::to_string(degrees) + " deg");
+            separator = ", ";
+        }
+        out << "\n";
+    }
+    out << "                (view: from the normal; a compensated glossy bin seen more obliquely samples the plain "
+           "density)\n";
+}
+
 // The bins' grids and lobe classes, and per class how many bins chose each alpha.
 void print_bins(std::ostream& out, const BinLayout& layout) {
     const uint32_t g = layout.bins_per_side, gd = layout.diffuse_bins_per_side;
@@ -439,6 +461,7 @@ void print_bins(std::ostream& out, const BinLayout& layout) {
     }
     out << "                (alpha a: max(L - a E_b / pi, 0) times the bin's cosine factor; plain: the map's own "
            "density)\n";
+    print_view_limits(out, layout);
 }
 
 }  // namespace

@@ -63,6 +63,7 @@ float every_output(const EnvMapView::Lookup& l) { return l.pdf + l.radiance.r + 
 constexpr uint32_t kBatch = 64;
 struct BatchInputs {
     std::vector<float> ux, uy, x, y, z, nx, ny, nz, choice;  // n, choice: the binned sampler's
+    std::vector<float> head_on;                              // view cosines 1: the bins' own densities
     std::vector<float> out = std::vector<float>(7 * kBatch);
 
     BatchInputs(const std::vector<Vec2>& us, const std::vector<Vec3>& directions, const std::vector<Vec3>& normals = {},
@@ -71,6 +72,10 @@ struct BatchInputs {
         for (const Vec2 u : us) ux.push_back(u.x), uy.push_back(u.y);
         for (const Vec3 d : directions) x.push_back(d.x), y.push_back(d.y), z.push_back(d.z);
         for (const Vec3 n : normals) nx.push_back(n.x), ny.push_back(n.y), nz.push_back(n.z);
+        head_on.assign(nx.size(), 1.0f);
+    }
+    LobeAxisArrays axes(size_t first) const {
+        return {nx.data() + first, ny.data() + first, nz.data() + first, head_on.data() + first};
     }
     SampleArrays sample_out(float* o) const {
         return {o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch, o + 4 * kBatch, o + 5 * kBatch, o + 6 * kBatch};
@@ -94,13 +99,13 @@ struct BatchInputs {
     }
     double sample_cost(const BinnedEnvMapView& view, uint32_t lobe) {
         return ns_per_item(ux.size(), [&](size_t first, uint32_t n, float* o) {
-            sample_many(view, lobe, {nx.data() + first, ny.data() + first, nz.data() + first}, choice.data() + first,
-                        {ux.data() + first, uy.data() + first}, sample_out(o), n);
+            sample_many(view, lobe, axes(first), choice.data() + first, {ux.data() + first, uy.data() + first},
+                        sample_out(o), n);
         });
     }
     double lookup_cost(const BinnedEnvMapView& view, uint32_t lobe) {
         return ns_per_item(x.size(), [&](size_t first, uint32_t n, float* o) {
-            lookup_many(view, lobe, {nx.data() + first, ny.data() + first, nz.data() + first}, choice.data() + first,
+            lookup_many(view, lobe, axes(first), choice.data() + first,
                         {x.data() + first, y.data() + first, z.data() + first},
                         {o, o + kBatch, o + 2 * kBatch, o + 3 * kBatch}, n);
         });
@@ -387,7 +392,7 @@ void time_binned_calls(const EnvMapView (&today)[2], const BinnedEnvMapView& bin
         inputs.push_back({points.us[i], points.directions[i], points.normals[i], points.choices[i]});
     BatchInputs batch(points.us, points.directions, points.normals, points.choices);
     std::vector<std::pair<uint32_t, Vec3>> picked;  // (class_bin, direction)
-    for (const Input& in : inputs) picked.emplace_back(pick_bin(binned.blend(in.normal, 0), in.choice), in.direction);
+    for (const Input& in : inputs) picked.emplace_back(pick_bin(binned.blend({in.normal}, 0), in.choice), in.direction);
     std::vector<double> ns[3][4], ratio[2][4], lookup_ns[3], speedup[3][3], pdf_in_bin, pdf_in_bin_ratio;
     for (int r = 0; r < repeats; ++r) {
         throw_if_interrupted();
@@ -401,16 +406,16 @@ void time_binned_calls(const EnvMapView (&today)[2], const BinnedEnvMapView& bin
                 ns_per_call(inputs, [&](const Input& in) { return every_output(today[k].lookup(in.direction)); });
         }
         t[2][0] = ns_per_call(
-            inputs, [&](const Input& in) { return every_output(binned.sample(in.normal, 0, in.choice, in.u)); });
+            inputs, [&](const Input& in) { return every_output(binned.sample({in.normal}, 0, in.choice, in.u)); });
         t[2][1] =
-            ns_per_call(inputs, [&](const Input& in) { return binned.pdf(in.normal, 0, in.choice, in.direction); });
+            ns_per_call(inputs, [&](const Input& in) { return binned.pdf({in.normal}, 0, in.choice, in.direction); });
         t[2][2] = batch.sample_cost(binned, 0);
         t[2][3] = batch.lookup_cost(binned, 0);
         lookup[2] = ns_per_call(inputs, [&](const Input& in) {
-            return every_output(binned.lookup(in.normal, 0, in.choice, in.direction));
+            return every_output(binned.lookup({in.normal}, 0, in.choice, in.direction));
         });
         pdf_in_bin.push_back(ns_per_call(
-            picked, [&](const std::pair<uint32_t, Vec3>& p) { return binned.bin_at(p.first).pdf(p.second); }));
+            picked, [&](const std::pair<uint32_t, Vec3>& p) { return binned.bin_at(p.first, 1).pdf(p.second); }));
         pdf_in_bin_ratio.push_back(pdf_in_bin.back() / t[kPlain][1]);
         for (int c = 0; c < 4; ++c) {
             for (int k = 0; k < 3; ++k) ns[k][c].push_back(t[k][c]);

@@ -107,7 +107,7 @@ void write_map_samples(std::ostream& out, const SampleArgs& args, const LoadedMa
     const Vec3 normal = *parse_direction(args.normal);  // the flags' validators have accepted them
     const Vec3 wo = args.view.empty() ? normal : *parse_direction(args.view);
     const uint32_t lobe = binned->lobe_class(Bsdf::parse(args.lobe).phong_exponent());
-    const Vec3 axis = lobe_axis(lobe, normal, wo);
+    const LobeAxis axis = lobe_axis(lobe, normal, wo);
     write_samples(
         out,
         [&](float u0, float u1, auto&& uniform) {

@@ -187,7 +187,7 @@ Rgb trace(const Environment& env, const Scene& scene, const Ray& ray, Technique 
     if (!hit) return env.global.eval(ray.direction);
     if (env.binned) {
         // One pick of the bins around the lobe axis serves both samples' MIS weights.
-        const Vec3 axis = envmis::lobe_axis(hit->lobe, hit->normal, ray.direction * -1.0f);
+        const envmis::LobeAxis axis = envmis::lobe_axis(hit->lobe, hit->normal, ray.direction * -1.0f);
         return direct_lighting(env.binned->bin(axis, hit->lobe, rng.uniform()), scene, *hit, ray.direction * -1.0f,
                                technique, rng);
     }

@@ -286,6 +286,24 @@ py::array_t<float, py::array::c_style> choices_for(const py::object& choices, co
     return array;
 }
 
+// Each point's view cosine (LobeAxis::view_cos): in [0, 1]; 1 (head-on) where None.
+py::array_t<float, py::array::c_style> view_cos_for(const py::object& view_cos, const char* where, py::ssize_t n) {
+    if (view_cos.is_none()) {
+        py::array_t<float, py::array::c_style> ones(n);
+        std::fill_n(ones.mutable_data(), n, 1.0f);
+        return ones;
+    }
+    auto array = float_array(view_cos, where, "view_cos", {-1});
+    if (array.shape(0) != n)
+        throw std::invalid_argument(std::string(where) + ": view_cos must be a float32 array of shape (N,) with N = " +
+                                    std::to_string(n) + ", one per normal; got " + std::to_string(array.shape(0)));
+    for (py::ssize_t i = 0; i < n; ++i)
+        if (!(array.data()[i] >= 0.0f && array.data()[i] <= 1.0f))
+            throw std::invalid_argument(std::string(where) + ": view_cos[" + std::to_string(i) +
+                                        "] = " + std::to_string(array.data()[i]) + " is outside [0, 1]");
+    return array;
+}
+
 uint32_t lobe_of(const BinnedEnvMap& map, uint32_t lobe, const char* where) {
     if (lobe >= map.classes())
         throw std::invalid_argument(std::string(where) + ": lobe " + std::to_string(lobe) +
@@ -295,35 +313,40 @@ uint32_t lobe_of(const BinnedEnvMap& map, uint32_t lobe, const char* where) {
 }
 
 py::object sample_binned(const BinnedEnvMap& map, const py::object& u_object, const py::object& normals_object,
-                         const py::object& choices_object, uint32_t lobe, const py::object& out_object) {
+                         const py::object& choices_object, uint32_t lobe, const py::object& view_cos_object,
+                         const py::object& out_object) {
     const char* where = "envmis.BinnedEnvMap.sample";
     const auto u = float_array(u_object, where, "u", {-1, 2});
     check_unit_points(u, where, "u");
     const auto normals = normals_for(normals_object, where, u.shape(0), "u");
     const auto choices = choices_for(choices_object, where, u.shape(0));
+    const auto view_cos = view_cos_for(view_cos_object, where, u.shape(0));
     lobe_of(map, lobe, where);
     SampleOutputs out(u.shape(0), out_object, where);
     const InterleavedSamples arrays = out.arrays();
     {
         py::gil_scoped_release released;
-        sample(map.view(), lobe, normals.data(), choices.data(), u.data(), arrays, static_cast<size_t>(u.shape(0)));
+        sample(map.view(), lobe, normals.data(), view_cos.data(), choices.data(), u.data(), arrays,
+               static_cast<size_t>(u.shape(0)));
     }
     return out.to_python();
 }
 
 py::array_t<float> pdf_binned(const BinnedEnvMap& map, const py::object& directions_object,
-                              const py::object& normals_object, const py::object& choices_object, uint32_t lobe) {
+                              const py::object& normals_object, const py::object& choices_object, uint32_t lobe,
+                              const py::object& view_cos_object) {
     const char* where = "envmis.BinnedEnvMap.pdf";
     const auto directions = float_array(directions_object, where, "directions", {-1, 3});
     const py::ssize_t n = directions.shape(0);
     const auto normals = normals_for(normals_object, where, n, "directions");
     const auto choices = choices_for(choices_object, where, n);
+    const auto view_cos = view_cos_for(view_cos_object, where, n);
     lobe_of(map, lobe, where);
     py::array_t<float> out = new_float_array({n});
     float* data = out.mutable_data();
     {
         py::gil_scoped_release released;
-        lookup(map.view(), lobe, normals.data(), choices.data(), directions.data(), {data, nullptr},
+        lookup(map.view(), lobe, normals.data(), view_cos.data(), choices.data(), directions.data(), {data, nullptr},
                static_cast<size_t>(n));
     }
     return out;
@@ -427,9 +450,9 @@ void bind_binned(py::module_& m) {
             "from_table", [](const std::shared_ptr<BinnedEnvMap>& map) { return provenance_of(map).from_table; },
             docs::kFromTable)
         .def("sample", &sample_binned, py::arg("u"), py::arg("normals"), py::arg("choices"), py::arg("lobe") = 0,
-             py::kw_only(), py::arg("out") = py::none(), docs::kBinnedSample)
+             py::kw_only(), py::arg("view_cos") = py::none(), py::arg("out") = py::none(), docs::kBinnedSample)
         .def("pdf", &pdf_binned, py::arg("directions"), py::arg("normals"), py::arg("choices"), py::arg("lobe") = 0,
-             docs::kBinnedPdf)
+             py::kw_only(), py::arg("view_cos") = py::none(), docs::kBinnedPdf)
         .def(
             "eval", [](const BinnedEnvMap& map, const py::object& d) { return lookup_plain(map.plain(), d, false); },
             py::arg("directions"), docs::kEval)

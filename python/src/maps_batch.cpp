@@ -86,12 +86,12 @@ void sample(const EnvMapView& env, const float* u, InterleavedSamples out, size_
     });
 }
 
-void sample(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* choices, const float* u,
-            InterleavedSamples out, size_t n) noexcept {
-    sample_chunks(u, normals, out, n,
-                  [&](PointArrays in, DirectionArrays normal, SampleArrays o, uint32_t m, size_t first) {
-                      sample_many(env, lobe, normal, choices + first, in, o, m);
-                  });
+void sample(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* view_cos,
+            const float* choices, const float* u, InterleavedSamples out, size_t n) noexcept {
+    sample_chunks(
+        u, normals, out, n, [&](PointArrays in, DirectionArrays normal, SampleArrays o, uint32_t m, size_t first) {
+            sample_many(env, lobe, {normal.x, normal.y, normal.z, view_cos + first}, choices + first, in, o, m);
+        });
 }
 
 void lookup(const EnvMapView& env, const float* directions, InterleavedLookups out, size_t n) noexcept {
@@ -100,12 +100,13 @@ void lookup(const EnvMapView& env, const float* directions, InterleavedLookups o
         [&](DirectionArrays in, DirectionArrays, LookupArrays o, uint32_t m, size_t) { lookup_many(env, in, o, m); });
 }
 
-void lookup(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* choices,
-            const float* directions, InterleavedLookups out, size_t n) noexcept {
-    lookup_chunks(directions, normals, out, n,
-                  [&](DirectionArrays in, DirectionArrays normal, LookupArrays o, uint32_t m, size_t first) {
-                      lookup_many(env, lobe, normal, choices + first, in, o, m);
-                  });
+void lookup(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* view_cos,
+            const float* choices, const float* directions, InterleavedLookups out, size_t n) noexcept {
+    lookup_chunks(
+        directions, normals, out, n,
+        [&](DirectionArrays in, DirectionArrays normal, LookupArrays o, uint32_t m, size_t first) {
+            lookup_many(env, lobe, {normal.x, normal.y, normal.z, view_cos + first}, choices + first, in, o, m);
+        });
 }
 
 double time_sample_many(const EnvMapView& env, const float* u, size_t n, int repeats, bool fresh_outputs) {

@@ -28,14 +28,15 @@ struct InterleavedLookups {
 
 // u: n x 2 points in [0,1)^2.
 void sample(const EnvMapView& env, const float* u, InterleavedSamples out, size_t n) noexcept;
-// normals: n x 3 (world frame), one per point; choices: n picks in [0,1) among the bins
-// around each normal (BinnedEnvMapView::bin).
-void sample(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* choices, const float* u,
-            InterleavedSamples out, size_t n) noexcept;
+// normals: n x 3 (world frame), one per point, or lobe axes (lobe_axis) with their view
+// cosines `view_cos` (n); choices: n picks in [0,1) among the bins around each normal
+// (BinnedEnvMapView::bin).
+void sample(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* view_cos,
+            const float* choices, const float* u, InterleavedSamples out, size_t n) noexcept;
 // directions: n x 3 unit vectors (world frame).
 void lookup(const EnvMapView& env, const float* directions, InterleavedLookups out, size_t n) noexcept;
-void lookup(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* choices,
-            const float* directions, InterleavedLookups out, size_t n) noexcept;
+void lookup(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* view_cos,
+            const float* choices, const float* directions, InterleavedLookups out, size_t n) noexcept;
 
 // The median of `repeats` wall times (seconds) of the core's sample_many on n points
 // given as one array per coordinate (u's columns), writing every output sample writes

@@ -143,14 +143,16 @@ inline constexpr const char* kBinnedSample = R"(Directions drawn for N (point, n
 
 u: float32 (N, 2) in [0, 1)^2 (checked as EnvMap.sample checks it); normals: float32 (N, 3), the shading normals in the world
 frame (or lobe axes); choices: float32 (N,) in [0, 1), each point's pick among the bins
-around its normal; lobe: the lobe class (0 to classes - 1). Returns Samples as EnvMap.sample does, bit-identical to N single calls
+around its normal; lobe: the lobe class (0 to classes - 1); view_cos: float32 (N,) in [0, 1], for a glossy
+class each point's cosine of its view to its normal (C++ lobe_axis; default 1, head-on): a glossy bin seen
+more obliquely than its limit samples the plain density. Returns Samples as EnvMap.sample does, bit-identical to N single calls
 of the C++ BinnedEnvMapView::sample; out as EnvMap.sample's; NaN throughout for a normal that is not
 finite or is zero (NaN in, NaN out). O(N), GIL released.)";
 inline constexpr const char* kBinnedPdf = R"(The solid-angle pdf (per steradian) of each direction under the bin
 its normal and choice pick (lobe class `lobe`): what sample() with them would have drawn.
 
 directions, normals: float32 (N, 3), world frame; directions unit length (not
-normalised); choices: float32 (N,) in [0, 1). Returns float32 (N,), NaN where a direction or
+normalised); choices: float32 (N,) in [0, 1); view_cos as sample()'s. Returns float32 (N,), NaN where a direction or
 normal is not finite or is zero. O(N), GIL released.)";
 
 inline constexpr const char* kLoad = R"(Loads an HDR image (or a table file) as `envmis precompute` builds it.

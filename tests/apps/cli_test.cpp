@@ -234,7 +234,7 @@ TEST_F(Cli, InfoDescribesATableAndTheImageItCameFrom) {
     ASSERT_EQ(envmis({"precompute", (kBundled / "studio.exr").string(), "-o", "studio.envmis"}).exit_code, 0);
     const Result table = envmis({"info", "studio.envmis"});
     ASSERT_EQ(table.exit_code, 0) << table;
-    EXPECT_TRUE(contains(table.out, "studio.envmis: envmis table, format version 6")) << table;
+    EXPECT_TRUE(contains(table.out, "studio.envmis: envmis table, format version 7")) << table;
     expect_studio_summary(table);
 
     const Result image = envmis({"info", (kBundled / "studio.exr").string()});
@@ -472,11 +472,11 @@ INSTANTIATE_TEST_SUITE_P(
                                  for (char& b : bytes) b = static_cast<char>((x = x * 1664525u + 1013904223u) >> 24);
                                  write_file(p, bytes);
                              }},
-                    BadInput{"TableOfANewerVersion", "newer.envmis", "version 7.*newer",
+                    BadInput{"TableOfANewerVersion", "newer.envmis", "version 8.*newer",
                              [](Cli& t, const fs::path& p) {
                                  // The format version: uint32, little-endian, at byte 8.
                                  t.damaged_table(
-                                     p, [](std::string& bytes) { bytes.replace(8, 4, std::string("\x07\0\0\0", 4)); });
+                                     p, [](std::string& bytes) { bytes.replace(8, 4, std::string("\x08\0\0\0", 4)); });
                              }},
                     BadInput{"Folder", "folder.exr", "directory",
                              [](Cli&, const fs::path& p) { fs::create_directory(p); }}),
@@ -499,7 +499,7 @@ TEST_F(Cli, PrecomputeWithBinsWritesABinnedTableThatInfoDescribes) {
     const Result info = envmis({"info", "binned.envmis"});
     ASSERT_EQ(info.exit_code, 0) << info;
     for (const char* line :
-         {"binned.envmis: envmis table, format version 6", R"(bins +64 \(8 x 8)", R"(bin alphas +Phong 20: )",
+         {"binned.envmis: envmis table, format version 7", R"(bins +64 \(8 x 8)", R"(bin alphas +Phong 20: )",
           R"(complete pdf +(yes|no.*) \(the plain map's; the bins': 'bins complete' below\))",
           R"(alpha a: max\(L - a E_b / pi, 0\) times the bin's cosine factor; plain: the map's own density)",
           R"(bins complete +diffuse (yes|no), Phong 20)",
@@ -526,7 +526,7 @@ TEST_F(Cli, TheSummaryNamesTheAxesPresetMemoryInMemoryAndACompactTable) {
         << r;
     const Result info = envmis({"info", "y.envmis"});
     ASSERT_EQ(info.exit_code, 0) << info;
-    EXPECT_TRUE(contains(info.out, R"(format version 6, compact \(RGBE radiance, 4 bytes/texel on disk)")) << info;
+    EXPECT_TRUE(contains(info.out, R"(format version 7, compact \(RGBE radiance, 4 bytes/texel on disk)")) << info;
     EXPECT_TRUE(contains(info.out, R"(axes x,z,-y \(y-up\))")) << info;
     ASSERT_EQ(envmis({"precompute", "map.exr", "-o", "p.envmis", "--axes", "x,-z,y"}).exit_code, 0);
     const Result other = envmis({"info", "p.envmis"});

@@ -57,7 +57,7 @@ __global__ void distributions(envmis::Distribution2DView d2, envmis::Distributio
 __global__ void binned(envmis::BinnedEnvMapView env, const envmis::Vec3* normals, float* out, unsigned n) {
     const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= n) return;
-    const envmis::Vec3 axis = envmis::lobe_axis(i % env.classes, normals[i], normals[i]);
+    const envmis::LobeAxis axis = envmis::lobe_axis(i % env.classes, normals[i], normals[i]);
     const envmis::BinView bin = env.bin(axis, i % env.classes, 0.001f * (i % 1000));
     const envmis::EnvSample s = bin.sample({0.5f, 0.25f});
     const envmis::EnvMapView::Lookup l = bin.lookup(s.direction);

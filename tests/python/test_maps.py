@@ -334,6 +334,29 @@ def test_a_binned_map_samples_with_the_pdf_it_reports_and_checks_its_normals():
         binned.sample(u, normals[:4], choices[:4], lobe=3)
 
 
+def test_glossy_bins_seen_obliquely_sample_and_weigh_by_their_view_cosines():
+    binned = envmis.load(PARK, bins=9)
+    rng = np.random.default_rng(4)
+    normals = rng.normal(size=(2000, 3)).astype(np.float32)
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    choices = envmis.uniform_points(1000, seed=5).reshape(-1)
+    u = envmis.uniform_points(2000, seed=6)
+    head_on = binned.sample(u, normals, choices, 1)
+    assert np.array_equal(head_on.pdf, binned.sample(u, normals, choices, 1, view_cos=np.ones(2000, np.float32)).pdf)
+    # Seen edge-on every glossy bin with a view limit samples the plain map.
+    edge_on = binned.sample(u, normals, choices, 1, view_cos=np.zeros(2000, np.float32))
+    plain = binned.plain.sample(u)
+    assert np.mean(edge_on.pdf == plain.pdf) > np.mean(head_on.pdf == plain.pdf)
+    view_cos = rng.uniform(size=2000).astype(np.float32)
+    s = binned.sample(u, normals, choices, 1, view_cos=view_cos)
+    agree = np.abs(binned.pdf(s.direction, normals, choices, 1, view_cos=view_cos) / s.pdf - 1) < 1e-4
+    assert np.mean(agree) > 0.995
+    with pytest.raises(ValueError, match=r"view_cos must be a float32 array of shape \(N,\) with N = 2000"):
+        binned.sample(u, normals, choices, 1, view_cos=view_cos[:3])
+    with pytest.raises(ValueError, match=r"view_cos\[0\] = 1.5.* is outside \[0, 1\]"):
+        binned.pdf(s.direction, normals, choices, 1, view_cos=np.full(2000, 1.5, np.float32))
+
+
 @needs_cli
 @pytest.mark.parametrize("case", ["missing", "not an image", "corrupt table", "fifo"])
 def test_a_bad_file_raises_the_message_the_command_prints(tmp_path, case):

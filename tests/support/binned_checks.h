@@ -58,17 +58,17 @@ inline std::vector<double> texel_probabilities(const BinView& bin, const EnvMap&
     return p;
 }
 
-// The bins a normal's blend picks with positive weight, as class-bin indices, and
+// The bins a lobe axis's blend picks with positive weight (as its view sees them), and
 // their weights.
 struct PickedBin {
     BinView bin;
     float weight;
 };
-inline std::vector<PickedBin> picked_bins(const BinnedEnvMapView& view, Vec3 normal, uint32_t lobe) {
-    const BinBlend blend = normal_blend(to_canonical(view.plain.axes, normal), view.side(lobe));
+inline std::vector<PickedBin> picked_bins(const BinnedEnvMapView& view, LobeAxis at, uint32_t lobe) {
+    const BinBlend blend = view.blend(at, lobe);
     std::vector<PickedBin> bins;
     for (int k = 0; k < 4; ++k)
-        if (blend.weight[k] > 0) bins.push_back({view.bin_at(view.class_bin(lobe, blend.bin[k])), blend.weight[k]});
+        if (blend.weight[k] > 0) bins.push_back({view.bin_at(blend.bin[k], blend.view_cos), blend.weight[k]});
     return bins;
 }
 
@@ -90,12 +90,13 @@ void expect_texels_follow(const std::vector<double>& p, const EnvMap& plain, siz
 // Every bin the normal may pick: samples follow its pdf (chi-square), which integrates
 // to 1 and is what the sample returns; and samples with random picks follow the blend's
 // mixture of those pdfs (the picks' weights).
-inline void expect_samples_follow_pdf(const BinnedEnvMap& binned, Vec3 normal, uint32_t lobe, uint64_t seed) {
+inline void expect_samples_follow_pdf(const BinnedEnvMap& binned, LobeAxis at, uint32_t lobe, uint64_t seed) {
     const BinnedEnvMapView view = binned.view();
-    const std::string what = "normal " + std::to_string(normal.x) + "," + std::to_string(normal.y) + "," +
-                             std::to_string(normal.z) + " lobe " + std::to_string(lobe);
+    const std::string what = "axis " + std::to_string(at.axis.x) + "," + std::to_string(at.axis.y) + "," +
+                             std::to_string(at.axis.z) + " view cosine " + std::to_string(at.view_cos) + " lobe " +
+                             std::to_string(lobe);
     Rng rng(seed);
-    const std::vector<PickedBin> picks = picked_bins(view, normal, lobe);
+    const std::vector<PickedBin> picks = picked_bins(view, at, lobe);
     std::vector<double> mixture;
     for (const PickedBin& pick : picks) {
         const std::vector<double> p = texel_probabilities(pick.bin, binned.plain());
@@ -117,8 +118,8 @@ inline void expect_samples_follow_pdf(const BinnedEnvMap& binned, Vec3 normal, u
         mixture, binned.plain(), std::max<size_t>(100000, 20 * mixture.size()),
         [&] {
             const float choice = rng.uniform();
-            const EnvSample s = view.sample(normal, lobe, choice, rng.uniform2());
-            EXPECT_EQ(s.pdf, view.bin(normal, lobe, choice).pdf_uv(s.uv));
+            const EnvSample s = view.sample(at, lobe, choice, rng.uniform2());
+            EXPECT_EQ(s.pdf, view.bin(at, lobe, choice).pdf_uv(s.uv));
             return s;
         },
         what + " (random picks)");
@@ -139,7 +140,7 @@ inline void expect_coverage(const BinnedEnvMap& map, uint32_t lobe) {
         for (int pick = 0; pick < 4; ++pick) {
             if (!(blend.weight[pick] > 0)) continue;
             const BinChoice& c = map.layout().choices[map.layout().first(lobe) + blend.bin[pick]];
-            const BinView bin = view.bin_at(view.class_bin(lobe, blend.bin[pick]));
+            const BinView bin = view.bin_at(view.class_bin(lobe, blend.bin[pick]), 1);
             for (uint32_t y = 0; y < h; ++y)
                 for (uint32_t x = 0; x < w; ++x) {
                     const Vec2 uv{(x + 0.5f) / w, (y + 0.5f) / h};

@@ -141,39 +141,67 @@ struct Lobe {
 
 constexpr double kNegligibleLog = -9.2;  // log(1e-4)
 
-Lobe lobe_at(const Nodes& n, Vec3 normal, float exponent) {
+// Where a lobe is seen from: the surface normal and the direction to the viewer.
+struct View {
+    Vec3 normal, wo;
+};
+
+// A Phong lobe of `exponent` about the mirror direction of the view (the study's: value
+// (e + 2) / (2 pi) cos^e cos_i, density (e + 1) / (2 pi) cos^e), or for exponent 0 the
+// cosine lobe about the normal.
+Lobe phong_lobe_seen(const Nodes& n, View v, float exponent) {
     Lobe lobe;
+    const Vec3 mirror = v.normal * (2 * dot(v.normal, v.wo)) - v.wo;
     for (uint32_t i = 0; i < n.direction.size(); ++i) {
-        const double c = dot(n.direction[i], normal);
-        if (!(c > 0) || !(n.sum_l[i] > 0)) continue;
+        const double ci = dot(n.direction[i], v.normal), c = exponent == 0 ? ci : dot(n.direction[i], mirror);
+        if (!(ci > 0) || !(c > 0) || !(n.sum_l[i] > 0)) continue;
         // Directions where a glossy lobe is below 1e-4 of its peak add nothing that could
         // rank candidates, and skipping them makes sharp lobes cheap to evaluate.
         if (exponent > 0 && exponent * std::log(c) < kNegligibleLog) continue;
         const double l = n.sum_l[i] / n.sum_w[i];
         const double p = exponent == 0 ? c / kPi : (exponent + 1) / (2 * kPi) * std::pow(c, exponent);
-        const double fc = exponent == 0 ? c / kPi : (exponent + 2) / (2 * kPi) * std::pow(c, exponent) * c;
+        const double fc = exponent == 0 ? c / kPi : (exponent + 2) / (2 * kPi) * std::pow(c, exponent) * ci;
         lobe.visible.push_back(i), lobe.f.push_back(l * fc), lobe.p_bsdf.push_back(p);
     }
     return lobe;
 }
 
-// The GGX lobe of roughness a seen along the axis: a direction at cosine c has a half
-// vector at cos^2 = (1 + c) / 2; density D / 4 (visible normals, head-on view), value
-// D G2 / 4 with Smith's G2 = 1 / (1 + Lambda), Fresnel 1. No cut: its tails fall as a
-// power, where a Phong lobe's fall exponentially, and a light far off the axis may
-// still send most of its light through them.
-Lobe ggx_lobe_at(const Nodes& n, Vec3 axis, double a) {
+// The GGX lobe of roughness a (the study's, Fresnel 1): value D G2 / (4 cos_o) with
+// Smith's height-correlated G2 = 1 / (1 + Lambda(wo) + Lambda(wi)), density of
+// reflected visible normals G1(wo) D / (4 cos_o). No cut: its tails fall as a power,
+// where a Phong lobe's fall exponentially, and a light far off the axis may still send
+// most of its light through them.
+Lobe ggx_lobe_seen(const Nodes& n, View v, double a) {
     Lobe lobe;
     const double a2 = a * a;
+    const auto lambda = [a2](double c) { return 0.5 * (std::sqrt(1 + a2 * (1 - c * c) / (c * c)) - 1); };
+    const double co = dot(v.normal, v.wo), lambda_o = lambda(co);
     for (uint32_t i = 0; i < n.direction.size(); ++i) {
-        const double c = dot(n.direction[i], axis);
-        if (!(c > 0) || !(n.sum_l[i] > 0)) continue;
-        const double t = 0.5 * (1 + c) * (a2 - 1) + 1, d = a2 / (kPi * t * t);
-        const double lambda = 0.5 * (std::sqrt(1 + a2 * (1 - c * c) / (c * c)) - 1);
-        lobe.visible.push_back(i), lobe.f.push_back(n.sum_l[i] / n.sum_w[i] * d / (4 * (1 + lambda)));
-        lobe.p_bsdf.push_back(d / 4);
+        const double ci = dot(n.direction[i], v.normal);
+        if (!(ci > 0) || !(n.sum_l[i] > 0)) continue;
+        const Vec3 h = normalize(n.direction[i] + v.wo);
+        const double ch = dot(h, v.normal), t = ch * ch * (a2 - 1) + 1, d = a2 / (kPi * t * t);
+        lobe.visible.push_back(i);
+        lobe.f.push_back(n.sum_l[i] / n.sum_w[i] * d / (4 * co * (1 + lambda_o + lambda(ci))));
+        lobe.p_bsdf.push_back(d / (4 * co * (1 + lambda_o)));
     }
     return lobe;
+}
+
+Lobe lobe_at(const Nodes& n, Vec3 normal, float exponent) { return phong_lobe_seen(n, {normal, normal}, exponent); }
+
+// Views of a glossy bin's lobes at `angle` from the normal: normals `angle` away from
+// the bin's axis on four sides, each with the view whose mirror direction is the axis.
+std::vector<View> views_about(Vec3 axis, double angle) {
+    const Vec3 t1 = normalize(cross(axis, std::abs(axis.z) < 0.9f ? Vec3{0, 0, 1} : Vec3{1, 0, 0}));
+    const Vec3 t2 = cross(axis, t1);
+    const auto c = static_cast<float>(std::cos(angle)), s = static_cast<float>(std::sin(angle));
+    std::vector<View> views;
+    for (Vec3 t : {t1, t2, t1 * -1.0f, t2 * -1.0f}) {
+        const Vec3 normal = axis * c + t * s;
+        views.push_back({normal, normal * (2 * dot(normal, axis)) - axis});
+    }
+    return views;
 }
 
 // Exact variance of one 1 + 1 balance MIS estimate at the lobe's normal (mis_variance.h).
@@ -236,6 +264,37 @@ std::vector<WeightedNormal> bin_samples(uint32_t bin, uint32_t g) {
             samples.push_back({folded_octahedral_normal(static_cast<float>(s), static_cast<float>(t)), weight});
         }
     return samples;
+}
+
+// The lobes a glossy class's choice weighs: its Phong exponent, and GGX of roughness
+// ggx_a (0: none).
+struct Lobes {
+    float exponent;
+    double ggx_a;
+};
+
+// The least cosine between normal and view at which a glossy bin about `axis` samples
+// its density `p` rather than the plain one `plain_p`: seen obliquely, a lobe reaches
+// towards the normal, where the bin's cosine factor about its axis may starve a bright
+// light. The views are those at kViewAngles from the axis on four sides; the limit lies
+// halfway between the last angle at which every view's variance is below the plain
+// density's and the first at which one is not.
+float view_limit(const Nodes& n, std::span<const double> mass, std::span<const double> plain_p,
+                 std::span<const double> p, Vec3 axis, Lobes lobes) {
+    constexpr double kViewAngles[] = {0.7854, 1.0472, 1.309, 1.4835};  // 45, 60, 75, 85 degrees
+    const auto loses = [&](const Lobe& lobe) {
+        const double base = mis_variance(n, lobe, plain_p, mass);
+        return base > 0 && mis_variance(n, lobe, p, mass) > base;
+    };
+    double passed = 0;
+    for (double angle : kViewAngles) {
+        for (const View& v : views_about(axis, angle))
+            if (loses(phong_lobe_seen(n, v, lobes.exponent)) ||
+                (lobes.ggx_a > 0 && loses(ggx_lobe_seen(n, v, lobes.ggx_a))))
+                return static_cast<float>(std::cos(0.5 * (passed + angle)));
+        passed = angle;
+    }
+    return 0;
 }
 
 std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, const Geometries& geometries,
@@ -304,14 +363,20 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
                 // its lobe covers the whole hemisphere, the choice's dearest, and weighing
                 // it at the 9 normals changed no figure measured (docs/performance-log.md).
                 if (glossy && ggx_a > 0) {
+                    const Vec3 centre = bin_centre(b, g);
                     std::vector<double> ggx(count, 0);
-                    add(ggx_lobe_at(nodes, bin_centre(b, g), ggx_a), 1, ggx);
+                    add(ggx_lobe_seen(nodes, {centre, centre}, ggx_a), 1, ggx);
                     for (size_t j = 0; j < count; ++j) log_ratio[j] = std::max(log_ratio[j], ggx[j]);
                 }
                 const size_t best = std::min_element(log_ratio.begin(), log_ratio.end()) - log_ratio.begin();
-                choices[shape.first(c) + b] = log_ratio[best] < -std::log(options.cost) - 1e-6
-                                                  ? BinChoice{alphas[best], thresholds[glossy][b * count + best]}
-                                                  : BinChoice{-1, 0};
+                BinChoice& choice = choices[shape.first(c) + b];
+                choice = log_ratio[best] < -std::log(options.cost) - 1e-6
+                             ? BinChoice{alphas[best], thresholds[glossy][b * count + best]}
+                             : BinChoice{-1, 0};
+                if (glossy && !choice.plain()) {
+                    const Lobes lobes{exponent, ggx_a};
+                    choice.min_view_cos = view_limit(nodes, hist.total_l, plain_p, p[best], bin_centre(b, g), lobes);
+                }
             }
         });
     }

@@ -76,6 +76,7 @@ std::vector<std::byte> bins_section(const BinLayout& layout) {
     for (const BinChoice& c : layout.choices) {
         w.put(c.alpha);
         w.put(c.threshold);
+        w.put(c.min_view_cos);
     }
     return std::move(w.bytes);
 }

@@ -32,8 +32,9 @@ TEST_P(BinnedMaps, SamplesFollowTheirPdfAndThePdfIntegratesToOne) {
     uint64_t seed = 500;
     for (uint32_t lobe : {0u, 2u})  // each class on its own grid's centres and borders
         for (Vec3 n : test::test_normals(map.layout().side(lobe))) {
-            test::expect_samples_follow_pdf(map, n, lobe, ++seed);
-            EXPECT_NEAR(test::sphere_integral(256, 512, [&](Vec3 d) { return view.pdf(n, lobe, 0.5f, d); }), 1.0, 1e-3);
+            test::expect_samples_follow_pdf(map, {n}, lobe, ++seed);
+            EXPECT_NEAR(test::sphere_integral(256, 512, [&](Vec3 d) { return view.pdf({n}, lobe, 0.5f, d); }), 1.0,
+                        1e-3);
         }
 }
 

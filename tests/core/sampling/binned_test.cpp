@@ -31,15 +31,15 @@ TEST(Binned, SamplesFollowTheirPdfForNormalsAtCentresBordersAndPoles) {
     uint64_t seed = 1;
     for (uint32_t lobe : {0u, 2u})  // each class on its own grid's centres and borders
         for (Vec3 n : test_normals(sun.layout().side(lobe))) {
-            expect_samples_follow_pdf(sun, n, lobe, ++seed);
-            expect_samples_follow_pdf(noise, n, lobe, ++seed);
+            expect_samples_follow_pdf(sun, {n}, lobe, ++seed);
+            expect_samples_follow_pdf(noise, {n}, lobe, ++seed);
         }
 }
 
 TEST(Binned, EqualAreaMapsFollowTheirPdf) {
     const BinnedEnvMap map = build_bins(plain_map(test::random_map(32, 32, 8), Mapping::equal_area));
     uint64_t seed = 100;
-    for (Vec3 n : test_normals(map.layout().side(1))) expect_samples_follow_pdf(map, n, 1, ++seed);
+    for (Vec3 n : test_normals(map.layout().side(1))) expect_samples_follow_pdf(map, {n}, 1, ++seed);
 }
 
 TEST(Binned, SolidAnglePdfIntegratesToOne) {
@@ -47,7 +47,8 @@ TEST(Binned, SolidAnglePdfIntegratesToOne) {
     const BinnedEnvMapView view = map.view();
     for (Vec3 n : test_normals(map.layout().side(0)))
         for (float choice : {0.1f, 0.5f, 0.9f})
-            EXPECT_NEAR(test::sphere_integral(256, 512, [&](Vec3 d) { return view.pdf(n, 0, choice, d); }), 1.0, 1e-3);
+            EXPECT_NEAR(test::sphere_integral(256, 512, [&](Vec3 d) { return view.pdf({n}, 0, choice, d); }), 1.0,
+                        1e-3);
 }
 
 TEST(Binned, SampleAgreesWithPdfAndEvalFromItsDirection) {
@@ -59,10 +60,10 @@ TEST(Binned, SampleAgreesWithPdfAndEvalFromItsDirection) {
     for (int i = 0; i < n; ++i) {
         const Vec3 normal = octahedral_normal(rng.uniform(), rng.uniform());
         const float choice = rng.uniform();
-        const EnvSample s = view.sample(normal, i % 3, choice, rng.uniform2());
+        const EnvSample s = view.sample({normal}, i % 3, choice, rng.uniform2());
         ASSERT_GT(s.pdf, 0);
         ASSERT_NEAR(length(s.direction), 1.0f, 1e-5f);
-        const EnvMapView::Lookup l = view.lookup(normal, i % 3, choice, s.direction);
+        const EnvMapView::Lookup l = view.lookup({normal}, i % 3, choice, s.direction);
         if (std::abs(l.pdf - s.pdf) > 1e-3f * s.pdf || l.radiance.r != s.radiance.r) ++edge_cases;
     }
     EXPECT_LT(edge_cases, n / 500);
@@ -148,13 +149,47 @@ TEST(Binned, APlainChoiceSamplesAndWeighsExactlyAsThePlainMapDoes) {
         const Vec3 n = octahedral_normal(rng.uniform(), rng.uniform());
         const Vec2 u = rng.uniform2();
         const float c = rng.uniform();
-        const EnvSample a = view.sample(n, i % 3, c, u), b = plain.sample(u);
+        const EnvSample a = view.sample({n}, i % 3, c, u), b = plain.sample(u);
         ASSERT_EQ(a.pdf, b.pdf);
         ASSERT_EQ(a.direction.x, b.direction.x);
         ASSERT_EQ(a.direction.z, b.direction.z);
         const Vec3 d = equirect_direction(rng.uniform2());
-        ASSERT_EQ(view.pdf(n, i % 3, c, d), plain.pdf(d));
+        ASSERT_EQ(view.pdf({n}, i % 3, c, d), plain.pdf(d));
     }
+}
+
+// A glossy bin's view limit: seen more obliquely, the bin samples and weighs exactly as
+// the plain map does; at its limit and above, by its own density.
+TEST(Binned, AGlossyBinSeenMoreObliquelyThanItsLimitSamplesAndWeighsAsThePlainMapDoes) {
+    const BinnedEnvMap map = build_bins(plain_map(test::sun_sky_map(128, 64)));
+    const BinnedEnvMapView view = map.view();
+    const EnvMapView plain = map.plain().view();
+    const BinLayout& layout = map.layout();
+    const uint32_t g = layout.bins_per_side;
+    int limited = 0;
+    Rng rng(22);
+    for (uint32_t b = 0; b < g * g; ++b) {
+        const BinChoice& choice = layout.choices[layout.first(1) + b];
+        if (choice.plain() || !(choice.min_view_cos > 0)) continue;
+        ++limited;
+        const Vec3 centre = octahedral_normal((b % g + 0.5f) / g, (b / g + 0.5f) / g);  // picked alone
+        const float below = std::nextafter(choice.min_view_cos, 0.0f);
+        const BinView own = view.bin({centre, choice.min_view_cos}, 1, 0.5f);
+        ASSERT_FALSE(own.plain);
+        ASSERT_EQ(own.cells.start, view.bin_at(view.class_bin(1, b), 1).cells.start);
+        for (int i = 0; i < 50; ++i) {
+            const Vec2 u = rng.uniform2();
+            const float c = rng.uniform();
+            const EnvSample a = view.sample({centre, below}, 1, c, u), p = plain.sample(u);
+            ASSERT_EQ(a.pdf, p.pdf);
+            ASSERT_EQ(a.direction.x, p.direction.x);
+            ASSERT_EQ(a.direction.z, p.direction.z);
+            const Vec3 d = equirect_direction(rng.uniform2());
+            ASSERT_EQ(view.pdf({centre, below}, 1, c, d), plain.pdf(d));
+            EXPECT_EQ(view.sample({centre, choice.min_view_cos}, 1, c, u).pdf, own.sample(u).pdf);
+        }
+    }
+    EXPECT_GT(limited, 0) << "no glossy bin of this map has a view limit";
 }
 
 TEST(Binned, TablesMixingPlainAndCompensatedBinsFollowTheirPdf) {
@@ -163,24 +198,27 @@ TEST(Binned, TablesMixingPlainAndCompensatedBinsFollowTheirPdf) {
     ASSERT_GT(mixed.plain, 0u);
     ASSERT_GT(mixed.compensated, 0u);
     uint64_t seed = 300;
-    for (Vec3 n : test_normals(map.layout().side(1))) expect_samples_follow_pdf(map, n, 1, ++seed);
+    for (Vec3 n : test_normals(map.layout().side(1))) {
+        expect_samples_follow_pdf(map, {n}, 1, ++seed);
+        expect_samples_follow_pdf(map, {n, 0.3f}, 1, ++seed);  // some bins' view limits passed
+    }
 }
 
 void expect_batch_bit_identical(const BinnedEnvMapView& view) {
     constexpr uint32_t n = 257;
     Rng rng(4);
-    float nx[n], ny[n], nz[n], c[n], ux[n], uy[n], dx[n], dy[n], dz[n];
+    float nx[n], ny[n], nz[n], vc[n], c[n], ux[n], uy[n], dx[n], dy[n], dz[n];
     for (uint32_t i = 0; i < n; ++i) {
         const Vec3 normal = octahedral_normal(rng.uniform(), rng.uniform());
         nx[i] = normal.x, ny[i] = normal.y, nz[i] = normal.z, ux[i] = rng.uniform(), uy[i] = rng.uniform();
-        c[i] = rng.uniform();
+        c[i] = rng.uniform(), vc[i] = rng.uniform();
         const Vec3 d = equirect_direction(rng.uniform2());
         dx[i] = d.x, dy[i] = d.y, dz[i] = d.z;
     }
     float x[n], y[n], z[n], pdf[n], r[n], g[n], b[n], u[n], v[n];
-    sample_many(view, 1, {nx, ny, nz}, c, {ux, uy}, {x, y, z, pdf, r, g, b, u, v}, n);
+    sample_many(view, 1, {nx, ny, nz, vc}, c, {ux, uy}, {x, y, z, pdf, r, g, b, u, v}, n);
     for (uint32_t i = 0; i < n; ++i) {
-        const EnvSample s = view.sample({nx[i], ny[i], nz[i]}, 1, c[i], {ux[i], uy[i]});
+        const EnvSample s = view.sample({{nx[i], ny[i], nz[i]}, vc[i]}, 1, c[i], {ux[i], uy[i]});
         ASSERT_EQ(s.direction.x, x[i]);
         ASSERT_EQ(s.direction.z, z[i]);
         ASSERT_EQ(s.pdf, pdf[i]);
@@ -188,9 +226,9 @@ void expect_batch_bit_identical(const BinnedEnvMapView& view) {
         ASSERT_EQ(s.uv.x, u[i]);
         ASSERT_EQ(s.uv.y, v[i]);
     }
-    lookup_many(view, 1, {nx, ny, nz}, c, {dx, dy, dz}, {r, g, b, pdf}, n);
+    lookup_many(view, 1, {nx, ny, nz, vc}, c, {dx, dy, dz}, {r, g, b, pdf}, n);
     for (uint32_t i = 0; i < n; ++i) {
-        const EnvMapView::Lookup l = view.lookup({nx[i], ny[i], nz[i]}, 1, c[i], {dx[i], dy[i], dz[i]});
+        const EnvMapView::Lookup l = view.lookup({{nx[i], ny[i], nz[i]}, vc[i]}, 1, c[i], {dx[i], dy[i], dz[i]});
         ASSERT_EQ(l.pdf, pdf[i]);
         ASSERT_EQ(l.radiance.b, b[i]);
     }
@@ -213,7 +251,7 @@ TEST(Binned, RebuildingFromTheLayoutIsBitIdentical) {
         const Vec3 n = octahedral_normal(rng.uniform(), rng.uniform());
         const Vec2 u = rng.uniform2();
         const float c = rng.uniform();
-        const EnvSample a = built.view().sample(n, i % 3, c, u), b = rebuilt.view().sample(n, i % 3, c, u);
+        const EnvSample a = built.view().sample({n}, i % 3, c, u), b = rebuilt.view().sample({n}, i % 3, c, u);
         ASSERT_EQ(a.pdf, b.pdf);
         ASSERT_EQ(a.direction.x, b.direction.x);
     }
@@ -252,8 +290,8 @@ TEST(Binned, TheDiffuseClassHasItsOwnFinerGridOfNormals) {
     const BinBlend diffuse = normal_blend(n, 21), glossy = normal_blend(n, 11);
     EXPECT_NEAR(*std::max_element(diffuse.weight, diffuse.weight + 4), 1.0f, 1e-5f);
     EXPECT_NEAR(*std::max_element(glossy.weight, glossy.weight + 4), 0.5f, 1e-5f);
-    EXPECT_EQ(view.bin(n, 0, 0.3f).cells.start, view.bin(n, 0, 0.9f).cells.start);
-    EXPECT_NE(view.bin(n, 1, 0.3f).cells.start, view.bin(n, 1, 0.9f).cells.start);
+    EXPECT_EQ(view.bin({n}, 0, 0.3f).cells.start, view.bin({n}, 0, 0.9f).cells.start);
+    EXPECT_NE(view.bin({n}, 1, 0.3f).cells.start, view.bin({n}, 1, 0.9f).cells.start);
     BinnedOptions o;
     o.bins_per_side = 5;
     o.diffuse_bins_per_side = 3;
@@ -285,9 +323,9 @@ TEST(Binned, TinyBlackAndConstantMapsWork) {
         Rng rng(1);
         for (Vec3 n : test_normals(map.layout().side(0))) {
             const float choice = rng.uniform();
-            const EnvSample s = view.sample(n, 0, choice, rng.uniform2());
+            const EnvSample s = view.sample({n}, 0, choice, rng.uniform2());
             EXPECT_GT(s.pdf, 0) << image.width << "x" << image.height;
-            EXPECT_EQ(s.pdf, view.bin(n, 0, choice).pdf_uv(s.uv));
+            EXPECT_EQ(s.pdf, view.bin({n}, 0, choice).pdf_uv(s.uv));
         }
     }
 }
@@ -301,7 +339,7 @@ void expect_finite_everywhere(const BinnedEnvMap& map, uint64_t seed, const std:
         const Vec3 axis = octahedral_normal(rng.uniform(), rng.uniform());
         const uint32_t lobe = static_cast<uint32_t>(i) % map.classes();
         const float choice = rng.uniform();
-        const BinView bin = view.bin(axis, lobe, choice);
+        const BinView bin = view.bin({axis, rng.uniform()}, lobe, choice);
         const EnvSample s = bin.sample(rng.uniform2());
         ASSERT_TRUE(s.pdf > 0 && std::isfinite(s.pdf)) << what << ": sample pdf " << s.pdf;
         ASSERT_TRUE(std::isfinite(s.direction.x + s.direction.y + s.direction.z)) << what;

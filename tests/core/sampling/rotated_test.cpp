@@ -185,8 +185,8 @@ TEST(RotatedBinned, BinsFollowTheTurnedNormalAndSamplesTheirDensity) {
     for (const Vec3 normal : test::test_normals(5)) {
         const Vec3 world_normal = rotation.to_world(normal);
         const float choice = rng.uniform();
-        const Rotated<BinView> bin = turned.bin(world_normal, 0, choice);
-        const BinView unrotated = view.bin(rotation.to_local(world_normal), 0, choice);
+        const Rotated<BinView> bin = turned.bin({world_normal}, 0, choice);
+        const BinView unrotated = view.bin({rotation.to_local(world_normal)}, 0, choice);
         ASSERT_EQ(bin.view.cells.start, unrotated.cells.start);
         // Chi-square of turned samples against the bin's texel probabilities.
         const std::vector<double> p = test::texel_probabilities(unrotated, plain);
@@ -211,25 +211,26 @@ TEST(RotatedBinned, ManyCallsAreBitIdenticalToSingleCalls) {
     const RotatedBinned turned{&view, Rotation::about(kAxis, kAngle)};
     Rng rng(35);
     const uint32_t n = 300;
-    std::vector<float> ax(n), ay(n), az(n), x(n), y(n), z(n), choices(n), u(n), v(n), out[7];
+    std::vector<float> ax(n), ay(n), az(n), vc(n), x(n), y(n), z(n), choices(n), u(n), v(n), out[7];
     for (auto& o : out) o.resize(n);
     for (uint32_t i = 0; i < n; ++i) {
         const Vec3 a = normalize(Vec3{rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f});
         const Vec3 d = normalize(Vec3{rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f});
         ax[i] = a.x, ay[i] = a.y, az[i] = a.z, x[i] = d.x, y[i] = d.y, z[i] = d.z;
-        choices[i] = rng.uniform(), u[i] = rng.uniform(), v[i] = rng.uniform();
+        choices[i] = rng.uniform(), u[i] = rng.uniform(), v[i] = rng.uniform(), vc[i] = rng.uniform();
     }
-    lookup_many(turned, 0, {ax.data(), ay.data(), az.data()}, choices.data(), {x.data(), y.data(), z.data()},
+    lookup_many(turned, 1, {ax.data(), ay.data(), az.data(), vc.data()}, choices.data(), {x.data(), y.data(), z.data()},
                 {out[0].data(), out[1].data(), out[2].data(), out[3].data()}, n);
     for (uint32_t i = 0; i < n; ++i) {
-        const EnvMapView::Lookup l = turned.bin({ax[i], ay[i], az[i]}, 0, choices[i]).lookup({x[i], y[i], z[i]});
+        const EnvMapView::Lookup l =
+            turned.bin({{ax[i], ay[i], az[i]}, vc[i]}, 1, choices[i]).lookup({x[i], y[i], z[i]});
         ASSERT_EQ(bit_cast<uint32_t>(out[3][i]), bit_cast<uint32_t>(l.pdf)) << i;
     }
     sample_many(
-        turned, 0, {ax.data(), ay.data(), az.data()}, choices.data(), {u.data(), v.data()},
+        turned, 1, {ax.data(), ay.data(), az.data(), vc.data()}, choices.data(), {u.data(), v.data()},
         {out[0].data(), out[1].data(), out[2].data(), out[3].data(), out[4].data(), out[5].data(), out[6].data()}, n);
     for (uint32_t i = 0; i < n; ++i) {
-        const EnvSample s = turned.bin({ax[i], ay[i], az[i]}, 0, choices[i]).sample({u[i], v[i]});
+        const EnvSample s = turned.bin({{ax[i], ay[i], az[i]}, vc[i]}, 1, choices[i]).sample({u[i], v[i]});
         ASSERT_EQ(bit_cast<uint32_t>(out[0][i]), bit_cast<uint32_t>(s.direction.x)) << i;
         ASSERT_EQ(bit_cast<uint32_t>(out[2][i]), bit_cast<uint32_t>(s.direction.z)) << i;
         ASSERT_EQ(bit_cast<uint32_t>(out[3][i]), bit_cast<uint32_t>(s.pdf)) << i;

@@ -587,9 +587,10 @@ void expect_identical_binned_samples(const BinnedEnvMap& expected, const BinnedE
         const uint32_t lobe = static_cast<uint32_t>(i) % expected.classes();
         const Vec2 u = rng.uniform2();
         const float c = rng.uniform();
-        const EnvSample x = a.sample(normal, lobe, c, u), y = b.sample(normal, lobe, c, u);
+        const LobeAxis at{normal, rng.uniform()};  // views of every obliquity
+        const EnvSample x = a.sample(at, lobe, c, u), y = b.sample(at, lobe, c, u);
         ASSERT_EQ(std::memcmp(&x, &y, sizeof x), 0) << "sample " << i;
-        ASSERT_EQ(a.pdf(normal, lobe, c, x.direction), b.pdf(normal, lobe, c, x.direction));
+        ASSERT_EQ(a.pdf(at, lobe, c, x.direction), b.pdf(at, lobe, c, x.direction));
     }
 }
 
@@ -603,6 +604,7 @@ void expect_same_layout(const BinLayout& a, const BinLayout& b) {
     for (size_t i = 0; i < a.choices.size(); ++i) {
         EXPECT_EQ(a.choices[i].alpha, b.choices[i].alpha) << i;
         EXPECT_EQ(a.choices[i].threshold, b.choices[i].threshold) << i;
+        EXPECT_EQ(a.choices[i].min_view_cos, b.choices[i].min_view_cos) << i;
     }
 }
 
@@ -687,7 +689,7 @@ TEST_F(BinnedTableTest, DamagedBinsSectionsAreRejectedNamingTheProblem) {
     const fs::path path = saved_binned_table();
     const std::vector<char> good = bytes_of(path);
     const auto [at, size] = bins_section_of(good);
-    ASSERT_EQ(size, 20 + 4 * 3 + 8 * (7 * 7 + 2 * 16u));  // g 4, the diffuse class's 7
+    ASSERT_EQ(size, 20 + 4 * 3 + 12 * (7 * 7 + 2 * 16u));  // g 4, the diffuse class's 7
     std::vector<char> bytes = good;
     bytes[at + size / 2] ^= 0x10;
     write_bytes(path, bytes);
@@ -713,6 +715,43 @@ TEST_F(BinnedTableTest, DamagedBinsSectionsAreRejectedNamingTheProblem) {
     field(20, std::bit_cast<uint32_t>(1.0f), "lobe exponents");
     field(20 + 12 + 4, std::bit_cast<uint32_t>(NAN), "not finite");
     field(20 + 12 + 4, std::bit_cast<uint32_t>(-1.0f), "threshold is negative");
+    field(20 + 12 + 8, std::bit_cast<uint32_t>(0.5f), "view limit is not in [0, 1], or not 0 for a diffuse");
+    const size_t glossy = 20 + 12 + 12 * 49;  // the first glossy bin's choice
+    field(glossy + 8, std::bit_cast<uint32_t>(1.5f), "view limit is not in [0, 1]");
+    field(glossy + 8, std::bit_cast<uint32_t>(NAN), "view limit is not in [0, 1]");
+}
+
+// Version 6 is version 7 without the bins' view limits: its binned tables read, every
+// bin sampling its own density at every view.
+TEST_F(BinnedTableTest, VersionSixBinnedTablesReadWithoutViewLimits) {
+    const fs::path path = saved_binned_table();
+    std::vector<char> bytes = bytes_of(path);
+    const auto [at, size] = bins_section_of(bytes);
+    const size_t choices = binned_.layout().choice_count(), first = size - 12 * choices;
+    std::vector<char> section(bytes.begin() + static_cast<std::ptrdiff_t>(at),
+                              bytes.begin() + static_cast<std::ptrdiff_t>(at + first));
+    for (size_t i = 0; i < choices; ++i) {
+        const auto choice = bytes.begin() + static_cast<std::ptrdiff_t>(at + first + 12 * i);
+        section.insert(section.end(), choice, choice + 8);
+    }
+    bytes.resize(at);
+    bytes.insert(bytes.end(), section.begin(), section.end());
+    bytes.resize(bytes.size() + 8);
+    const auto old_size = static_cast<uint32_t>(section.size());
+    const uint32_t version = 6;
+    const uint64_t total = bytes.size();
+    std::memcpy(bytes.data() + bins_size_at(bytes), &old_size, sizeof old_size);
+    std::memcpy(bytes.data() + kVersionAt, &version, sizeof version);
+    std::memcpy(bytes.data() + kTotalSizeAt, &total, sizeof total);
+    reseal(bytes);
+    reseal_bins(bytes);
+    write_bytes(path, bytes);
+    Table table = read_table(path);
+    EXPECT_EQ(table.version, 6u);
+    ASSERT_TRUE(table.bins);
+    BinLayout expected = binned_.layout();
+    for (BinChoice& c : expected.choices) c.min_view_cos = 0;
+    expect_same_layout(*table.bins, expected);
 }
 
 TEST_F(BinnedTableTest, ImplausibleBinsSectionSizesAreRejectedBeforeReading) {

@@ -195,5 +195,21 @@ TEST(BinnedEstimator, SmoothGgxIsNeverWorseThanPlainBalanceMisOnASunnyMap) {
         }
 }
 
+TEST(BinnedEstimator, GlossyLobesSeenAtGrazingViewsAreNeverWorseThanPlainBalanceMisInAStudio) {
+    // Seen at 85 degrees, a glossy lobe reaches towards the normal, far off the mirror
+    // direction about which a glossy bin's density is shaped: without the bins' view
+    // limits, GGX 0.1 had 5.6x and Phong 20 2.6x the exact variance of plain balance MIS
+    // at one of these points, where a softbox lies off the mirror direction.
+    const EnvMap plain = load_plain("studio.exr");
+    const BinnedEnvMap binned = build_bins(EnvMap(plain));
+    for (const Bsdf& bsdf : {Bsdf::ggx(0.1f), Bsdf::phong(20)})
+        for (const ShadingPoint& p : sphere_points(16, 85)) {
+            const double bins = exact_variance(binned, Technique::parse("mis-balance-bins"), {}, bsdf, p, 1);
+            const double mis = exact_variance(plain, Technique::parse("mis-balance"), {}, bsdf, p, 1);
+            EXPECT_LE(bins, 1.02 * mis) << bsdf.name() << " normal " << p.normal.x << "," << p.normal.y << ","
+                                        << p.normal.z;
+        }
+}
+
 }  // namespace
 }  // namespace envmis

@@ -296,10 +296,15 @@ void BinnedEnvMap::check_layout() const {
     if (layout.choices.size() != layout.choice_count())
         throw std::invalid_argument("bin layout: " + std::to_string(layout.choices.size()) + " choices for " +
                                     std::to_string(layout.choice_count()) + " bins");
-    for (const BinChoice& c : layout.choices)
+    for (size_t i = 0; i < layout.choices.size(); ++i) {
+        const BinChoice& c = layout.choices[i];
         if (!(std::isfinite(c.alpha) && c.threshold >= 0 && std::isfinite(c.threshold) &&
               detail::on_histogram_edge(c.threshold)))
             throw std::invalid_argument("bin layout: invalid alpha or threshold");
+        const bool limited = layout.class_of(i) > 0 && !c.plain();
+        if (!(c.min_view_cos >= 0 && c.min_view_cos <= (limited ? 1 : 0)))
+            throw std::invalid_argument("bin layout: a view limit outside [0, 1], or not 0 for a diffuse or plain bin");
+    }
 }
 
 void BinnedEnvMap::build(const detail::Geometries* given, StopFlag stop) {
@@ -310,8 +315,8 @@ void BinnedEnvMap::build(const detail::Geometries* given, StopFlag stop) {
     const std::vector<std::vector<float>> masses = detail::bin_masses(plain_, grid, geometries, layout_, stop);
     column_edges_ = grid.column_edges;
     row_edges_ = grid.row_edges;
-    plain_bins_.clear();
-    for (const BinChoice& c : layout_.choices) plain_bins_.push_back(c.plain() ? 1 : 0);
+    min_view_cos_.clear();
+    for (const BinChoice& c : layout_.choices) min_view_cos_.push_back(c.plain() ? 2.0f : c.min_view_cos);
     const size_t cells = size_t{grid.cw} * grid.ch;
     cell_start_.resize(cells * masses.size());
     cell_guide_.resize(cells * masses.size());
@@ -356,7 +361,7 @@ BinnedEnvMapView BinnedEnvMap::view() const noexcept {
             rows_guide_.data(),
             column_edges_.data(),
             row_edges_.data(),
-            plain_bins_.data(),
+            min_view_cos_.data(),
             layout_.cell_columns,
             layout_.cell_rows,
             classes(),
@@ -379,7 +384,7 @@ bool BinnedEnvMap::complete(uint32_t lobe) const noexcept {
 size_t BinnedEnvMap::bytes() const noexcept {
     return (cell_start_.size() + rows_start_.size()) * sizeof(uint32_t) +
            (cell_guide_.size() + rows_guide_.size()) * sizeof(uint16_t) +
-           (column_edges_.size() + row_edges_.size()) * sizeof(uint32_t) + plain_bins_.size();
+           (column_edges_.size() + row_edges_.size()) * sizeof(uint32_t) + min_view_cos_.size() * sizeof(float);
 }
 
 namespace {
@@ -391,7 +396,7 @@ struct Located {
     Vec2 uv;
 };
 
-Located locate(const BinnedEnvMapView& env, uint32_t lobe, Vec3 axis, float choice, Vec3 direction) noexcept {
+Located locate(const BinnedEnvMapView& env, uint32_t lobe, LobeAxis axis, float choice, Vec3 direction) noexcept {
     const Located at{env.bin(axis, lobe, choice), env.plain.uv_of(direction)};
     const Distribution2DView& d = env.plain.distribution;
     const uint32_t x = detail::cell_of(at.uv.x, d.w), y = detail::cell_of(at.uv.y, d.h);
@@ -411,12 +416,13 @@ Located locate(const BinnedEnvMapView& env, uint32_t lobe, Vec3 axis, float choi
 // and its data prefetched 32 directions before its pdf is computed from them, so that
 // the misses of 32 directions are in flight at once. Bit-identical to BinView::lookup,
 // whose functions it calls.
-void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axes, const float* choices,
+void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes, const float* choices,
                  DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
     detail::pipelined<32>(
         0, n,
         [&](uint32_t i) noexcept {
-            return locate(env, lobe, {axes.x[i], axes.y[i], axes.z[i]}, choices[i], {in.x[i], in.y[i], in.z[i]});
+            return locate(env, lobe, {{axes.x[i], axes.y[i], axes.z[i]}, axes.view_cos[i]}, choices[i],
+                          {in.x[i], in.y[i], in.z[i]});
         },
         [&](const Located& l, uint32_t i) noexcept {
             const Rgb c = env.plain.eval_uv(l.uv);
@@ -429,7 +435,7 @@ void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axe
 // stage prefetching what the next loads, so that the misses of a block's samples overlap
 // instead of each sample waiting on its chain of dependent loads. The stages are the
 // single call's own functions, so the results are bit-identical to it.
-void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axes, const float* choices, PointArrays in,
+void sample_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes, const float* choices, PointArrays in,
                  SampleArrays out, uint32_t n) noexcept {
     constexpr uint32_t kBlock = 16;
     BinView bins[kBlock];
@@ -440,7 +446,7 @@ void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axe
         const uint32_t m = std::min(kBlock, n - first);
         for (uint32_t j = 0; j < m; ++j) {
             const uint32_t i = first + j;
-            bins[j] = env.bin({axes.x[i], axes.y[i], axes.z[i]}, lobe, choices[i]);
+            bins[j] = env.bin({{axes.x[i], axes.y[i], axes.z[i]}, axes.view_cos[i]}, lobe, choices[i]);
             if (bins[j].plain) continue;
             const CdfView& c = bins[j].cells;
             const uint32_t k = c.bucket(in.x[i]);

@@ -55,6 +55,8 @@ constexpr uint32_t kBlock = 256;
 struct Block {
     float x[kBlock], y[kBlock], z[kBlock];
     DirectionArrays arrays() const noexcept { return {x, y, z}; }
+    // As lobe axes, with the view cosines of [first, ...) of `axes` (a rotation keeps them).
+    LobeAxisArrays axes(LobeAxisArrays axes, uint32_t first) const noexcept { return {x, y, z, axes.view_cos + first}; }
 };
 
 // Directions [first, first + count) of `in` into the map's frame.
@@ -91,23 +93,24 @@ void sample_many(const Rotated<EnvMapView>& env, PointArrays in, SampleArrays ou
     to_world(env.rotation, out, n);
 }
 
-void lookup_many(const RotatedBinned& env, uint32_t lobe, DirectionArrays axes, const float* choices,
-                 DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
+void lookup_many(const RotatedBinned& env, uint32_t lobe, LobeAxisArrays axes, const float* choices, DirectionArrays in,
+                 LookupArrays out, uint32_t n) noexcept {
     Block local_axes, local;
     for (uint32_t first = 0; first < n; first += kBlock) {
         const uint32_t count = std::min(kBlock, n - first);
-        to_local(env.rotation, axes, first, count, local_axes);
+        to_local(env.rotation, {axes.x, axes.y, axes.z}, first, count, local_axes);
         to_local(env.rotation, in, first, count, local);
-        lookup_many(*env.map, lobe, local_axes.arrays(), choices + first, local.arrays(), offset(out, first), count);
+        lookup_many(*env.map, lobe, local_axes.axes(axes, first), choices + first, local.arrays(), offset(out, first),
+                    count);
     }
 }
 
-void sample_many(const RotatedBinned& env, uint32_t lobe, DirectionArrays axes, const float* choices, PointArrays in,
+void sample_many(const RotatedBinned& env, uint32_t lobe, LobeAxisArrays axes, const float* choices, PointArrays in,
                  SampleArrays out, uint32_t n) noexcept {
     Block local_axes;
     for (uint32_t first = 0; first < n; first += kBlock) {
         const uint32_t count = std::min(kBlock, n - first);
-        to_local(env.rotation, axes, first, count, local_axes);
+        to_local(env.rotation, {axes.x, axes.y, axes.z}, first, count, local_axes);
         SampleArrays part{out.x + first,
                           out.y + first,
                           out.z + first,
@@ -117,7 +120,8 @@ void sample_many(const RotatedBinned& env, uint32_t lobe, DirectionArrays axes, 
                           out.b + first,
                           out.u ? out.u + first : nullptr,
                           out.v ? out.v + first : nullptr};
-        sample_many(*env.map, lobe, local_axes.arrays(), choices + first, {in.x + first, in.y + first}, part, count);
+        sample_many(*env.map, lobe, local_axes.axes(axes, first), choices + first, {in.x + first, in.y + first}, part,
+                    count);
     }
     to_world(env.rotation, out, n);
 }

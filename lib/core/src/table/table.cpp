@@ -289,11 +289,17 @@ BinLayout parse_bins(std::span<const std::byte> section, uint64_t digest, const 
         layout.lobe_exponents.push_back(e);
     }
     layout.choices.resize(layout.choice_count());
-    for (BinChoice& choice : layout.choices) {
+    for (size_t i = 0; i < layout.choices.size(); ++i) {
+        BinChoice& choice = layout.choices[i];
         choice.alpha = in.take<float>("bin alpha");
         choice.threshold = in.take<float>("bin threshold");
         if (!std::isfinite(choice.alpha) || !std::isfinite(choice.threshold) || choice.threshold < 0)
             in.fail("bins section: a bin's alpha or threshold is not finite, or its threshold is negative");
+        if (header.version < 7) continue;  // every view samples the bin's own density
+        choice.min_view_cos = in.take<float>("bin view limit");
+        const bool limited = layout.class_of(i) > 0 && !choice.plain();
+        if (!(choice.min_view_cos >= 0 && choice.min_view_cos <= (limited ? 1 : 0)))
+            in.fail("bins section: a bin's view limit is not in [0, 1], or not 0 for a diffuse or plain bin");
     }
     return layout;
 }

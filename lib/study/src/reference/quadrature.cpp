@@ -177,14 +177,13 @@ double exact_variance(const BinnedEnvMap& binned, Technique technique, Allocatio
         throw std::invalid_argument("exact_variance: " + technique.name() + " does not sample a binned map");
     const BinnedEnvMapView view = binned.view();
     const uint32_t lobe = binned.lobe_class(bsdf.phong_exponent());
-    const Vec3 axis = lobe_axis(lobe, point.normal, point.wo);
     // Each pick gives an unbiased estimator, so the variance is the weights' mixture of
     // the picks' (no spread of means between picks to add).
-    const BinBlend blend = normal_blend(to_canonical(binned.plain().options().axes, axis), view.side(lobe));
+    const BinBlend blend = view.blend(lobe_axis(lobe, point.normal, point.wo), lobe);
     double variance = 0;
     for (int k = 0; k < 4; ++k) {
         if (!(blend.weight[k] > 0)) continue;
-        const BinView bin = view.bin_at(view.class_bin(lobe, blend.bin[k]));
+        const BinView bin = view.bin_at(blend.bin[k], blend.view_cos);
         variance += blend.weight[k] * exact_variance_with(
                                           binned.plain(), [&](Vec2 uv) { return bin.pdf_uv(uv); }, technique,
                                           allocation, bsdf, point, subdivisions, stop);

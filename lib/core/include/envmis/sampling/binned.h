@@ -51,6 +51,13 @@
 // BinChoice) elsewhere, so that each bin holds what is predicted best at equal time. A
 // plain bin samples and weighs through the plain map's functions, at their cost (and the
 // study's batch paths take the plain map's SIMD kernels when every lane's bin is plain).
+// A glossy bin's density is shaped about the mirror direction, but a lobe seen
+// obliquely reaches towards the normal: each compensated glossy bin also records the
+// most oblique view at which the choice predicts it beats the plain density (Phong and
+// GGX lobes seen at 45 to 85 degrees, BinChoice::min_view_cos); seen more obliquely it
+// samples the plain density. Without the limits, GGX 0.1 seen at 85 degrees has 5.6x the
+// variance of plain balance MIS at a point of studio.exr; with them, 1.04x at worst on
+// the 14 shared maps (exact; docs/performance.md).
 // docs/table-format.md defines every quantity
 // (centres, radii, bounds, thresholds, the choice, the blend) so that a bin's density
 // can be recomputed independently.
@@ -158,6 +165,7 @@ struct BinBlend {
     uint32_t bin[4];  // (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1), wrapped
     float weight[4];  // (1 - wa)(1 - wb), wa (1 - wb), (1 - wa) wb, wa wb
     float wa = 0, wb = 0;
+    float view_cos = 1;  // LobeAxis::view_cos of the shading point
 };
 ENVMIS_HD inline BinBlend normal_blend(Vec3 n, uint32_t g) noexcept {
     const BlendSquare q = blend_square(n, g);
@@ -225,15 +233,31 @@ inline float ggx_lobe_exponent(float a) noexcept {
     return a >= kGgxDiffuseRoughness ? 0.0f : a > 0 ? (2 / (a * a) - 2) / 4 : 1e5f;
 }
 
-// The direction that picks a shading point's bin: the normal for the diffuse class (0),
-// whose lobe is the cosine about it; for glossy classes the mirror direction of the
-// view (wo, towards the viewer) about the normal, which their lobes follow. A glossy
-// bin is a lobe about its centre, as its alpha was chosen: indexed by the normal, a
-// Phong-200 surface seen at grazing view on rooitou_park keeps 1.03x the variance of
-// plain balance MIS (its lobe near the bin's horizon), 0.29x by the mirror direction.
-ENVMIS_HD inline Vec3 lobe_axis(uint32_t lobe, Vec3 normal, Vec3 wo) noexcept {
-    return lobe == 0 ? normal : normal * (2 * dot(normal, wo)) - wo;
+// What picks a shading point's bin: the direction (`axis`) and, for a glossy class, how
+// obliquely the lobe is seen (`view_cos`, the cosine of the view to the normal; 1 is
+// head-on). The axis is the normal for the diffuse class (0), whose lobe is the cosine
+// about it; for glossy classes the mirror direction of the view (wo, towards the viewer)
+// about the normal, which their lobes follow. A glossy bin is a lobe about its centre, as
+// its alpha was chosen: indexed by the normal, a Phong-200 surface seen at grazing view
+// on rooitou_park keeps 1.03x the variance of plain balance MIS (its lobe near the bin's
+// horizon), 0.29x by the mirror direction. Seen obliquely, a glossy lobe reaches towards
+// the normal, away from the axis about which the bin's density is shaped: below its
+// BinChoice::min_view_cos a bin samples the plain density instead.
+struct LobeAxis {
+    Vec3 axis;
+    float view_cos = 1;
+};
+ENVMIS_HD inline LobeAxis lobe_axis(uint32_t lobe, Vec3 normal, Vec3 wo) noexcept {
+    const float c = dot(normal, wo);
+    return lobe == 0 ? LobeAxis{normal, 1} : LobeAxis{normal * (2 * c) - wo, c};
 }
+// The same for n shading points, one array per coordinate: lobe_axis's results (the
+// view cosines too: a constructor, so that none is left out by accident).
+struct LobeAxisArrays {
+    const float *x, *y, *z, *view_cos;
+    ENVMIS_HD LobeAxisArrays(const float* ax, const float* ay, const float* az, const float* cos) noexcept
+        : x(ax), y(ay), z(az), view_cos(cos) {}
+};
 
 // The diffuse class's default g for glossy classes of g: 2 g - 1 (at most 64), so that its
 // bin centres include the glossy ones and fall halfway between them too. Lambert variance
@@ -270,6 +294,10 @@ struct BinnedOptions {
 struct BinChoice {
     float alpha = 0;
     float threshold = 0;  // alpha E_b / pi, as applied (rounded to a histogram edge)
+    // A glossy bin seen with a view cosine (LobeAxis::view_cos) below this samples the
+    // plain density (in [0, 1]; 0 for the diffuse class and plain choices): where the
+    // choice predicts its density loses to the plain one at some oblique view.
+    float min_view_cos = 0;
     bool plain() const noexcept { return alpha < 0; }
 };
 
@@ -343,32 +371,37 @@ struct BinnedEnvMapView {
     const uint16_t* rows_guide = nullptr;
     const uint32_t* column_edges = nullptr;  // cells_w + 1 texel columns
     const uint32_t* row_edges = nullptr;     // cells_h + 1 texel rows
-    const uint8_t* plain_bins = nullptr;     // per (class, bin): 1 for a plain choice
+    // Per (class, bin): the least view cosine at which the bin samples its own density
+    // (BinChoice::min_view_cos; above 1 for a plain choice, which never does).
+    const float* min_view_cos = nullptr;
     uint32_t cells_w = 0, cells_h = 0, classes = 0;
     uint32_t bins_per_side = 0, bins = 0;                  // of each glossy class (1 and up)
     uint32_t diffuse_bins_per_side = 0, diffuse_bins = 0;  // of the diffuse class (0)
 
     // The density a shading point samples in lobe class `lobe`: among the bins around
-    // `axis` (world frame; lobe_axis), the one a uniform `choice` in [0,1) picks
-    // (normal_blend). A renderer draws `choice` once per shading point and keeps the
+    // `at.axis` (world frame; lobe_axis), the one a uniform `choice` in [0,1) picks
+    // (normal_blend), or the plain density where the view is more oblique than that
+    // bin's limit. A renderer draws `choice` once per shading point and keeps the
     // returned view for its light samples and its BSDF samples' MIS weights alike.
-    ENVMIS_HD BinView bin(Vec3 axis, uint32_t lobe, float choice) const noexcept {
-        return bin_at(class_bin(lobe, pick_bin(to_canonical(plain.axes, axis), side(lobe), choice)));
+    ENVMIS_HD BinView bin(LobeAxis at, uint32_t lobe, float choice) const noexcept {
+        return bin_at(class_bin(lobe, pick_bin(to_canonical(plain.axes, at.axis), side(lobe), choice)), at.view_cos);
     }
     // The same in two steps, for a shading point that draws several choices: the bins
-    // around `axis` (their indices among all, class_bin) with their weights, and the
+    // around `at.axis` (their indices among all, class_bin) with their weights, and the
     // one a choice picks among them.
-    ENVMIS_HD BinBlend blend(Vec3 axis, uint32_t lobe) const noexcept {
-        BinBlend b = normal_blend(to_canonical(plain.axes, axis), side(lobe));
+    ENVMIS_HD BinBlend blend(LobeAxis at, uint32_t lobe) const noexcept {
+        BinBlend b = normal_blend(to_canonical(plain.axes, at.axis), side(lobe));
         for (uint32_t& k : b.bin) k = class_bin(lobe, k);
+        b.view_cos = at.view_cos;
         return b;
     }
     ENVMIS_HD BinView bin(const BinBlend& blend, float choice) const noexcept {
-        return bin_at(pick_bin(blend, choice));
+        return bin_at(pick_bin(blend, choice), blend.view_cos);
     }
-    // The bin whose square holds `axis`, without blending (for showing one bin's density).
+    // The bin whose square holds `axis`, without blending, seen head-on (for showing one
+    // bin's density).
     ENVMIS_HD BinView nearest_bin(Vec3 axis, uint32_t lobe) const noexcept {
-        return bin_at(class_bin(lobe, normal_bin(to_canonical(plain.axes, axis), side(lobe))));
+        return bin_at(class_bin(lobe, normal_bin(to_canonical(plain.axes, axis), side(lobe))), 1);
     }
     // g of lobe class `lobe`'s grid, and the index of its bin b among all (class-major).
     ENVMIS_HD uint32_t side(uint32_t lobe) const noexcept { return lobe == 0 ? diffuse_bins_per_side : bins_per_side; }
@@ -376,19 +409,20 @@ struct BinnedEnvMapView {
         const uint32_t c = min(lobe, classes - 1);
         return c == 0 ? b : diffuse_bins + (c - 1) * bins + b;
     }
-    ENVMIS_HD BinView bin_at(uint32_t class_bin) const noexcept {
+    // Bin `class_bin` seen with view cosine `view_cos`: its own density, or the plain one.
+    ENVMIS_HD BinView bin_at(uint32_t class_bin, float view_cos) const noexcept {
         const uint32_t cells = cells_w * cells_h;
         const size_t at = size_t{class_bin} * cells;
-        return {this, {cell_start + at, cell_guide + at, cells}, plain_bins[class_bin] != 0};
+        return {this, {cell_start + at, cell_guide + at, cells}, !(view_cos >= min_view_cos[class_bin])};
     }
-    ENVMIS_HD EnvSample sample(Vec3 axis, uint32_t lobe, float choice, Vec2 u) const noexcept {
-        return bin(axis, lobe, choice).sample(u);
+    ENVMIS_HD EnvSample sample(LobeAxis at, uint32_t lobe, float choice, Vec2 u) const noexcept {
+        return bin(at, lobe, choice).sample(u);
     }
-    ENVMIS_HD float pdf(Vec3 axis, uint32_t lobe, float choice, Vec3 direction) const noexcept {
-        return bin(axis, lobe, choice).pdf(direction);
+    ENVMIS_HD float pdf(LobeAxis at, uint32_t lobe, float choice, Vec3 direction) const noexcept {
+        return bin(at, lobe, choice).pdf(direction);
     }
-    ENVMIS_HD EnvMapView::Lookup lookup(Vec3 axis, uint32_t lobe, float choice, Vec3 direction) const noexcept {
-        return bin(axis, lobe, choice).lookup(direction);
+    ENVMIS_HD EnvMapView::Lookup lookup(LobeAxis at, uint32_t lobe, float choice, Vec3 direction) const noexcept {
+        return bin(at, lobe, choice).lookup(direction);
     }
     ENVMIS_HD Rgb eval(Vec3 direction) const noexcept { return plain.eval(direction); }
 
@@ -423,9 +457,9 @@ struct BinnedEnvMapView {
 // Both for n (axis, choice, direction or point) at once, one array per world coordinate:
 // the batch forms of BinnedEnvMapView::lookup and sample, bit-identical to n single
 // calls. Host only; noexcept and allocation-free.
-ENVMIS_CORE_API void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axes, const float* choices,
+ENVMIS_CORE_API void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes, const float* choices,
                                  DirectionArrays in, LookupArrays out, uint32_t n) noexcept;
-ENVMIS_CORE_API void sample_many(const BinnedEnvMapView& env, uint32_t lobe, DirectionArrays axes, const float* choices,
+ENVMIS_CORE_API void sample_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes, const float* choices,
                                  PointArrays in, SampleArrays out, uint32_t n) noexcept;
 
 namespace detail {
@@ -475,7 +509,7 @@ private:
     LargeVector<uint32_t> cell_start_, rows_start_;
     LargeVector<uint16_t> cell_guide_, rows_guide_;
     std::vector<uint32_t> column_edges_, row_edges_;
-    std::vector<uint8_t> plain_bins_;
+    std::vector<float> min_view_cos_;
     double choice_seconds_ = 0;
 };
 

@@ -72,8 +72,8 @@ struct RotatedBinned {
     const BinnedEnvMapView* map = nullptr;  // must outlive this and the bins it returns
     Rotation rotation;
 
-    ENVMIS_HD Rotated<BinView> bin(Vec3 axis, uint32_t lobe, float choice) const noexcept {
-        return {map->bin(rotation.to_local(axis), lobe, choice), rotation};
+    ENVMIS_HD Rotated<BinView> bin(LobeAxis at, uint32_t lobe, float choice) const noexcept {
+        return {map->bin({rotation.to_local(at.axis), at.view_cos}, lobe, choice), rotation};
     }
     ENVMIS_HD Rgb eval(Vec3 direction) const noexcept { return map->eval(rotation.to_local(direction)); }
 };
@@ -84,9 +84,9 @@ struct RotatedBinned {
 ENVMIS_CORE_API void lookup_many(const Rotated<EnvMapView>& env, DirectionArrays in, LookupArrays out,
                                  uint32_t n) noexcept;
 ENVMIS_CORE_API void sample_many(const Rotated<EnvMapView>& env, PointArrays in, SampleArrays out, uint32_t n) noexcept;
-ENVMIS_CORE_API void lookup_many(const RotatedBinned& env, uint32_t lobe, DirectionArrays axes, const float* choices,
+ENVMIS_CORE_API void lookup_many(const RotatedBinned& env, uint32_t lobe, LobeAxisArrays axes, const float* choices,
                                  DirectionArrays in, LookupArrays out, uint32_t n) noexcept;
-ENVMIS_CORE_API void sample_many(const RotatedBinned& env, uint32_t lobe, DirectionArrays axes, const float* choices,
+ENVMIS_CORE_API void sample_many(const RotatedBinned& env, uint32_t lobe, LobeAxisArrays axes, const float* choices,
                                  PointArrays in, SampleArrays out, uint32_t n) noexcept;
 
 }  // namespace envmis

@@ -30,12 +30,13 @@ inline constexpr uint32_t kFlagCompact = 2;  // payload: RGBE radiance only (Tab
 inline constexpr uint32_t kMetadataAlignment = 8;
 // The bins section (BinLayout): four u32 (bins per side g of the glossy classes, cell
 // columns, cell rows, classes C), from version 6 a fifth (the diffuse class's g_d; before,
-// g_d = g), C lobe exponents, then g_d^2 + (C - 1) g^2 (alpha, threshold) pairs, all 4 bytes.
+// g_d = g), C lobe exponents, then g_d^2 + (C - 1) g^2 choices: (alpha, threshold), from
+// version 7 (alpha, threshold, min_view_cos); all 4 bytes.
 inline constexpr uint32_t kMaxBinsPerSide = 64, kMaxCellSide = 4096, kMaxLobeClasses = 8;
 constexpr uint32_t bins_section_size(uint32_t version, uint32_t gd, uint32_t g, uint32_t classes) {
-    return (version >= 6 ? 20 : 16) + 4 * classes + 8 * (gd * gd + (classes - 1) * g * g);
+    return (version >= 6 ? 20 : 16) + 4 * classes + (version >= 7 ? 12 : 8) * (gd * gd + (classes - 1) * g * g);
 }
-inline constexpr uint32_t kMaxBinsSection = bins_section_size(6, kMaxBinsPerSide, kMaxBinsPerSide, kMaxLobeClasses);
+inline constexpr uint32_t kMaxBinsSection = bins_section_size(7, kMaxBinsPerSide, kMaxBinsPerSide, kMaxLobeClasses);
 inline constexpr uint32_t kMinBinsSection = bins_section_size(5, 1, 1, 1);
 
 // RGBE (Ward 1991): three 8-bit mantissas sharing the exponent of the largest channel,

@@ -1,6 +1,6 @@
 // Table files: a built EnvMap saved to disk, readable with envmis::core alone.
 //
-// The format (version 6; versions 1 to 5 are read too) is specified in docs/table-format.md: a fixed preamble (magic,
+// The format (version 7; versions 1 to 6 are read too) is specified in docs/table-format.md: a fixed preamble (magic,
 // version, byte order, total size), a metadata block with the build options and the
 // source's name and content hash, a header checksum, then the payload (the image
 // density q sin(theta) and the RGB radiance, both float32) and a payload checksum, and,
@@ -28,10 +28,10 @@
 
 namespace envmis {
 
-// Every table is written as version 6, with or without bins: version 6 gives the diffuse
-// class of a binned table its own grid of normals (one more field in the bins section),
-// which a version 5 reader would misread; it refuses the newer version instead.
-inline constexpr uint32_t kTableVersion = 6;
+// Every table is written as version 7, with or without bins: version 7 gives each bin a
+// view limit (BinChoice::min_view_cos, one more field per choice in the bins section),
+// which a version 6 reader would misread; it refuses the newer version instead.
+inline constexpr uint32_t kTableVersion = 7;
 
 // Where a table's map came from.
 struct TableSource {
