@@ -351,13 +351,29 @@ std::string header_line(const Setup& s, size_t points_done) {
     return header.str();
 }
 
+// The bins a run builds, not the flag: --bins 0 builds kDefaultStudyBins where a -bins
+// technique runs (the flag as given where it is refused: the run reports that).
+uint32_t bins_built(const CompareArgs& a) {
+    try {
+        std::vector<Technique> techniques = ComparisonOptions{}.techniques;
+        if (!split_list(a.techniques).empty()) {
+            techniques.clear();
+            for (const std::string& t : split_list(a.techniques)) techniques.push_back(Technique::parse(t));
+        }
+        const uint32_t g = bins_per_side(a.bins, techniques);
+        return g * g;
+    } catch (const std::invalid_argument&) {
+        return a.bins;
+    }
+}
+
 // Every flag that changes the numbers compare writes, or which files it writes, spelled
 // canonically: recorded in the JSON's inputs ("options"), so that library mode can tell
 // whether a map's results are what the same flags would give now. --threads, which
 // changes only the timings, is left out.
 std::string options_text(const CompareArgs& a) {
     std::ostringstream text;
-    text << "bsdf=" << a.bsdfs << " techniques=" << a.techniques << " bins=" << a.bins << " spp=" << a.spp
+    text << "bsdf=" << a.bsdfs << " techniques=" << a.techniques << " bins=" << bins_built(a) << " spp=" << a.spp
          << " env-samples=" << a.env_samples << " bsdf-samples=" << a.bsdf_samples << " seed=" << a.seed
          << " normal=" << a.normal << " view=" << a.view << " points=" << a.points;
     if (a.view_angle != 0) text << " view-angle=" << a.view_angle;

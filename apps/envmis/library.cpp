@@ -191,7 +191,7 @@ nlohmann::json run_one(const LibraryItem& item, const MapJob& job, MemoryGate& g
         start = std::chrono::steady_clock::now();
         std::error_code ec;
         const uintmax_t bytes = fs::file_size(item.input, ec);
-        if (!ec) entry["bytes"] = bytes;
+        if (!ec) entry["input_bytes"] = bytes;
         try {
             hash = io::hash_file(item.input, &interrupted());
         } catch (const io::ImageError&) {

@@ -209,6 +209,21 @@ TEST_F(Library, JobsOutsideOneTo1024AreRefused) {
     }
 }
 
+// "input_bytes" is the input file's size; the options name the bins built, 121 where a
+// -bins technique runs without --bins.
+TEST_F(Library, TheSummaryGivesEachInputsSizeAndTheOptionsTheBinsBuilt) {
+    make_maps(false);
+    const Result r = envmis({"compare", "maps", "--out-dir", "out", "--spp", "16", "--points", "2", "--bsdf", "lambert",
+                             "--techniques", "mis-balance,mis-balance-bins"});
+    ASSERT_EQ(r.exit_code, 0) << r;
+    for (const json& entry : summary("out/summary.json")["results"])
+        EXPECT_EQ(entry["input_bytes"].get<uintmax_t>(), fs::file_size(file(entry["input"].get<std::string>())));
+    for (const std::string& stem : kStems) {
+        const std::string options = json::parse(read_file(file("out/" + stem + ".json")))["inputs"]["options"];
+        EXPECT_NE(options.find(" bins=121 "), std::string::npos) << options;
+    }
+}
+
 TEST_F(Library, CompareWritesEachMapsJsonAndASummaryAndSkipsThemOnTheSecondRun) {
     make_maps(false);
     const Result r = envmis(with({"compare", "maps", "--out-dir", "out", "--jobs", "2"}, kStudy));
