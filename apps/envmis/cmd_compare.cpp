@@ -108,7 +108,11 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
     sub.add_option("--bsdf-samples", args.bsdf_samples, "BSDF samples per MIS estimate (0 to 65536)")
         ->capture_default_str()
         ->check(in_range(uint32_t{0}, kMaxStudySamples));
-    sub.add_option("--seed", args.seed, "Random seed")->capture_default_str()->check(any_seed());
+    sub.add_option("--seed", args.seed,
+                   "Random seed; each (point, technique) draws its own stream from it, so a technique's "
+                   "numbers do not depend on which others run")
+        ->capture_default_str()
+        ->check(any_seed());
     sub.add_option("--threads", args.threads,
                    "Worker threads, 1 to 1024, at most 4 per usable core (more are reduced to that, with a "
                    "note; default: the cores the CPU affinity and cgroup quota allow); results do not depend on it")

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "envmis/build/env_map.h"
 #include "envmis/study/comparison/comparison.h"
+#include "maps.h"
 
 namespace envmis {
 namespace {
@@ -36,6 +38,34 @@ TEST(SpherePoints, AViewAngleTiltsEveryViewByItTowardsAzimuthsThatTurn) {
     }
     EXPECT_THROW(sphere_points(4, 90), std::invalid_argument);
     EXPECT_THROW(sphere_points(4, -1), std::invalid_argument);
+}
+
+// Each technique's random stream depends on the seed, the point and the technique only:
+// its numbers are bit-identical whichever others run beside it.
+TEST(Compare, ATechniquesNumbersAreTheSameWhicheverOthersRun) {
+    EnvMapOptions uncompensated;
+    uncompensated.compensation.enabled = false;
+    const EnvMap plain = build_env_map(test::sun_sky_map(64, 32), uncompensated);
+    const std::vector<Bsdf> bsdfs = {Bsdf::lambert(), Bsdf::phong(50)};
+    const CompensatedMaps compensated = compensated_maps(plain, std::vector<float>{1.0f, 1.0f});
+    const std::vector<ShadingPoint> points = sphere_points(3);
+    const auto run = [&](std::initializer_list<const char*> names) {
+        ComparisonOptions options;
+        options.bsdfs = bsdfs;
+        options.techniques.clear();
+        for (const char* name : names) options.techniques.push_back(Technique::parse(name));
+        options.spp = 256;
+        return compare({plain, compensated, points, options});
+    };
+    const Comparison alone = run({"mis-balance"});
+    for (const Comparison& with : {run({"env", "mis-balance"}), run({"bsdf", "mis-balance-comp", "mis-balance"})})
+        for (size_t b = 0; b < bsdfs.size(); ++b) {
+            const TechniqueStats& a = *alone.bsdfs[b].find("mis-balance");
+            const TechniqueStats& w = *with.bsdfs[b].find("mis-balance");
+            EXPECT_EQ(a.mean, w.mean) << bsdfs[b].name();
+            EXPECT_EQ(a.variance, w.variance) << bsdfs[b].name();
+            EXPECT_EQ(a.point_variances, w.point_variances) << bsdfs[b].name();
+        }
 }
 
 }  // namespace

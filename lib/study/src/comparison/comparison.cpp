@@ -10,6 +10,7 @@
 #include "envmis/build/bins.h"
 #include "envmis/build/env_map.h"
 #include "envmis/cpu.h"
+#include "envmis/math/hash.h"
 #include "envmis/study/shading/frame.h"
 #include "envmis/study/statistics/statistics.h"
 
@@ -126,6 +127,15 @@ std::vector<double> exact_point_variances(const StudyInputs& inputs, const Techn
 
 namespace {
 
+// A cell's random stream, from the point's index and the technique's name rather than
+// its place in the list, so that a technique's numbers are the same whichever others run
+// beside it; the BSDFs at a point share it, so that one differing only in albedo gives
+// estimates in exact proportion.
+uint64_t cell_stream(size_t point, const Technique& technique) {
+    const std::string key = std::to_string(point) + "/" + technique.name();
+    return hash64(std::as_bytes(std::span(key.data(), key.size())));
+}
+
 // The cells of a run over `done` points: one per (point, BSDF, technique), and the
 // reference of each (point, BSDF).
 struct CellTable {
@@ -219,7 +229,7 @@ Comparison compare_one(const EnvMap& plain, const EnvMap& compensated, const Bin
                 const size_t b = job / nt, t = job % nt;
                 const double reference = references[done * nb + b];
                 Cell& cell = cells[first + job];
-                Pcg32 rng(options.seed, (done * nb + b) * nt + t);
+                Pcg32 rng(options.seed, cell_stream(done, options.techniques[t]));
                 PointState state;
                 Rgb chunk[kChunk];
                 for (uint64_t begin = 0; begin < options.spp; begin += kChunk) {
