@@ -89,9 +89,9 @@ inline void exercise_bins(Table&& table) {
     float sum = 0;
     for (float s : {0.0f, 0.37f, kOneMinusEpsilon})
         for (uint32_t lobe = 0; lobe < binned.classes(); ++lobe) {
-            const Vec3 n = octahedral_normal(s, 1 - s);
-            const EnvSample x = view.sample(n, lobe, s, {s, 0.61f});
-            sum += x.pdf + view.pdf(n, lobe, s, x.direction);
+            const LobeAxis at{octahedral_normal(s, 1 - s), s};  // views head-on to edge-on
+            const EnvSample x = view.sample(at, lobe, s, {s, 0.61f});
+            sum += x.pdf + view.pdf(at, lobe, s, x.direction);
         }
     sink = sum;
 }
