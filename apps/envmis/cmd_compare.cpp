@@ -201,6 +201,14 @@ uint32_t threads_of(const CompareArgs& args) {
     return threads;
 }
 
+// The techniques --techniques names (empty: the default list). Throws std::invalid_argument
+// for an unknown one.
+std::vector<Technique> named_techniques(const CompareArgs& args) {
+    std::vector<Technique> named;
+    for (const std::string& t : split_list(args.techniques)) named.push_back(Technique::parse(t));
+    return named;
+}
+
 // The study the flags ask for, all but its fixed alpha, which the map may set
 // (load_plain); `requested` the techniques named (empty: the default).
 CompareRequest compare_request(const CompareArgs& args, std::vector<Technique>& requested) {
@@ -211,7 +219,7 @@ CompareRequest compare_request(const CompareArgs& args, std::vector<Technique>& 
     options.bsdfs.clear();
     for (const std::string& b : split_list(args.bsdfs)) options.bsdfs.push_back(Bsdf::parse(b));
     if (options.bsdfs.empty()) throw UsageError("--bsdf '" + args.bsdfs + "': expected at least one BSDF");
-    for (const std::string& t : split_list(args.techniques)) requested.push_back(Technique::parse(t));
+    requested = named_techniques(args);
     if (!requested.empty()) options.techniques = requested;
     options.allocation = {args.env_samples, args.bsdf_samples};
     options.threads = threads_of(args);
@@ -359,11 +367,8 @@ std::string header_line(const Setup& s, size_t points_done) {
 // technique runs (the flag as given where it is refused: the run reports that).
 uint32_t bins_built(const CompareArgs& a) {
     try {
-        std::vector<Technique> techniques = ComparisonOptions{}.techniques;
-        if (!split_list(a.techniques).empty()) {
-            techniques.clear();
-            for (const std::string& t : split_list(a.techniques)) techniques.push_back(Technique::parse(t));
-        }
+        std::vector<Technique> techniques = named_techniques(a);
+        if (techniques.empty()) techniques = ComparisonOptions::default_techniques();
         const uint32_t g = bins_per_side(a.bins, techniques);
         return g * g;
     } catch (const std::invalid_argument&) {

@@ -274,34 +274,33 @@ py::array_t<float, py::array::c_style> normals_for(const py::object& normals, co
 }
 
 // Picks among the bins around each normal: float32 (n,) in [0, 1).
-py::array_t<float, py::array::c_style> choices_for(const py::object& choices, const char* where, py::ssize_t n) {
-    auto array = float_array(choices, where, "choices", {-1});
+// One float32 per normal, each in [0, 1) or, with `closed`, [0, 1]; `name` in the messages.
+py::array_t<float, py::array::c_style> unit_values(const py::object& values, const char* where, const char* name,
+                                                   py::ssize_t n, bool closed) {
+    auto array = float_array(values, where, name, {-1});
     if (array.shape(0) != n)
-        throw std::invalid_argument(std::string(where) + ": choices must be a float32 array of shape (N,) with N = " +
-                                    std::to_string(n) + ", one per normal; got " + std::to_string(array.shape(0)));
-    for (py::ssize_t i = 0; i < n; ++i)
-        if (!(array.data()[i] >= 0.0f && array.data()[i] < 1.0f))
-            throw std::invalid_argument(std::string(where) + ": choices[" + std::to_string(i) +
-                                        "] = " + std::to_string(array.data()[i]) + " is outside [0, 1)");
+        throw std::invalid_argument(std::string(where) + ": " + name +
+                                    " must be a float32 array of shape (N,) with N = " + std::to_string(n) +
+                                    ", one per normal; got " + std::to_string(array.shape(0)));
+    for (py::ssize_t i = 0; i < n; ++i) {
+        const float x = array.data()[i];
+        if (!(x >= 0.0f && (closed ? x <= 1.0f : x < 1.0f)))
+            throw std::invalid_argument(std::string(where) + ": " + name + "[" + std::to_string(i) +
+                                        "] = " + std::to_string(x) + " is outside [0, 1" + (closed ? "]" : ")"));
+    }
     return array;
+}
+
+py::array_t<float, py::array::c_style> choices_for(const py::object& choices, const char* where, py::ssize_t n) {
+    return unit_values(choices, where, "choices", n, false);
 }
 
 // Each point's view cosine (LobeAxis::view_cos): in [0, 1]; 1 (head-on) where None.
 py::array_t<float, py::array::c_style> view_cos_for(const py::object& view_cos, const char* where, py::ssize_t n) {
-    if (view_cos.is_none()) {
-        py::array_t<float, py::array::c_style> ones(n);
-        std::fill_n(ones.mutable_data(), n, 1.0f);
-        return ones;
-    }
-    auto array = float_array(view_cos, where, "view_cos", {-1});
-    if (array.shape(0) != n)
-        throw std::invalid_argument(std::string(where) + ": view_cos must be a float32 array of shape (N,) with N = " +
-                                    std::to_string(n) + ", one per normal; got " + std::to_string(array.shape(0)));
-    for (py::ssize_t i = 0; i < n; ++i)
-        if (!(array.data()[i] >= 0.0f && array.data()[i] <= 1.0f))
-            throw std::invalid_argument(std::string(where) + ": view_cos[" + std::to_string(i) +
-                                        "] = " + std::to_string(array.data()[i]) + " is outside [0, 1]");
-    return array;
+    if (!view_cos.is_none()) return unit_values(view_cos, where, "view_cos", n, true);
+    py::array_t<float, py::array::c_style> ones(n);
+    std::fill_n(ones.mutable_data(), n, 1.0f);
+    return ones;
 }
 
 uint32_t lobe_of(const BinnedEnvMap& map, uint32_t lobe, const char* where) {

@@ -362,8 +362,8 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
                 // lobe does not: a candidate must do for both. GGX at the bin's centre only:
                 // its lobe covers the whole hemisphere, the choice's dearest, and weighing
                 // it at the 9 normals changed no figure measured (docs/performance-log.md).
+                const Vec3 centre = bin_centre(b, g);
                 if (glossy && ggx_a > 0) {
-                    const Vec3 centre = bin_centre(b, g);
                     std::vector<double> ggx(count, 0);
                     add(ggx_lobe_seen(nodes, {centre, centre}, ggx_a), 1, ggx);
                     for (size_t j = 0; j < count; ++j) log_ratio[j] = std::max(log_ratio[j], ggx[j]);
@@ -373,10 +373,8 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
                 choice = log_ratio[best] < -std::log(options.cost) - 1e-6
                              ? BinChoice{alphas[best], thresholds[glossy][b * count + best]}
                              : BinChoice{-1, 0};
-                if (glossy && !choice.plain()) {
-                    const Lobes lobes{exponent, ggx_a};
-                    choice.min_view_cos = view_limit(nodes, hist.total_l, plain_p, p[best], bin_centre(b, g), lobes);
-                }
+                if (glossy && !choice.plain())
+                    choice.min_view_cos = view_limit(nodes, hist.total_l, plain_p, p[best], centre, {exponent, ggx_a});
             }
         });
     }

@@ -255,8 +255,8 @@ ENVMIS_HD inline LobeAxis lobe_axis(uint32_t lobe, Vec3 normal, Vec3 wo) noexcep
 // view cosines too: a constructor, so that none is left out by accident).
 struct LobeAxisArrays {
     const float *x, *y, *z, *view_cos;
-    ENVMIS_HD LobeAxisArrays(const float* ax, const float* ay, const float* az, const float* cos) noexcept
-        : x(ax), y(ay), z(az), view_cos(cos) {}
+    ENVMIS_HD LobeAxisArrays(const float* ax, const float* ay, const float* az, const float* cosines) noexcept
+        : x(ax), y(ay), z(az), view_cos(cosines) {}
 };
 
 // The diffuse class's default g for glossy classes of g: 2 g - 1 (at most 64), so that its
