@@ -301,8 +301,7 @@ void BinnedEnvMap::check_layout() const {
         if (!(std::isfinite(c.alpha) && c.threshold >= 0 && std::isfinite(c.threshold) &&
               detail::on_histogram_edge(c.threshold)))
             throw std::invalid_argument("bin layout: invalid alpha or threshold");
-        const bool limited = layout.class_of(i) > 0 && !c.plain();
-        if (!(c.min_view_cos >= 0 && c.min_view_cos <= (limited ? 1 : 0)))
+        if (!layout.view_limit_valid(i))
             throw std::invalid_argument("bin layout: a view limit outside [0, 1], or not 0 for a diffuse or plain bin");
     }
 }

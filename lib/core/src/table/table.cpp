@@ -297,8 +297,7 @@ BinLayout parse_bins(std::span<const std::byte> section, uint64_t digest, const 
             in.fail("bins section: a bin's alpha or threshold is not finite, or its threshold is negative");
         if (header.version < 7) continue;  // every view samples the bin's own density
         choice.min_view_cos = in.take<float>("bin view limit");
-        const bool limited = layout.class_of(i) > 0 && !choice.plain();
-        if (!(choice.min_view_cos >= 0 && choice.min_view_cos <= (limited ? 1 : 0)))
+        if (!layout.view_limit_valid(i))
             in.fail("bins section: a bin's view limit is not in [0, 1], or not 0 for a diffuse or plain bin");
     }
     return layout;

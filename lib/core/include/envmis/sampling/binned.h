@@ -317,6 +317,11 @@ struct BinLayout {
                             size_t{c - 1} * bins_per_side * bins_per_side;
     }
     size_t choice_count() const noexcept { return first(classes()); }
+    // Choice i's view limit in its range: [0, 1] for a compensated glossy bin, 0 otherwise.
+    bool view_limit_valid(size_t i) const noexcept {
+        const float c = choices[i].min_view_cos;
+        return c >= 0 && c <= (class_of(i) > 0 && !choices[i].plain() ? 1 : 0);
+    }
     uint32_t class_of(size_t class_bin) const noexcept {
         const size_t d = size_t{diffuse_bins_per_side} * diffuse_bins_per_side;
         return class_bin < d ? 0 : 1 + static_cast<uint32_t>((class_bin - d) / (size_t{bins_per_side} * bins_per_side));
