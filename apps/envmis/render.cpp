@@ -7,7 +7,10 @@
 #include <thread>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "cli.h"
+#include "envmis/build/atomic_file.h"
 #include "envmis/io/image_io.h"
 #include "envmis/pictures/picture.h"
 
@@ -20,10 +23,21 @@ struct Scene {
     uint32_t w, h, spheres;
     float radius;
 
+    // The sphere whose cell holds pixel column x.
+    uint32_t sphere_of(uint32_t x) const {
+        return std::min(spheres - 1, static_cast<uint32_t>((x + 0.5f) * spheres / static_cast<float>(w)));
+    }
+    // The first pixel column of sphere i's cell (i = spheres: the width).
+    uint32_t cell_begin(uint32_t i) const {
+        uint32_t x = 0;
+        while (x < w && sphere_of(x) < i) ++x;
+        return x;
+    }
+
     // The shading point seen through pixel (x, y), or false for the background.
     bool point(uint32_t x, uint32_t y, ShadingPoint& p, uint32_t& sphere) const {
         const float cell = static_cast<float>(w) / spheres;
-        sphere = std::min(spheres - 1, static_cast<uint32_t>((x + 0.5f) / cell));
+        sphere = sphere_of(x);
         const float dx = ((x + 0.5f) - (sphere + 0.5f) * cell) / radius, dz = (0.5f * h - (y + 0.5f)) / radius;
         const float r2 = dx * dx + dz * dz;
         if (r2 >= 1) return false;
@@ -57,33 +71,32 @@ RgbImage render(const Scene& scene, const DirectLightingEstimator& estimator, co
     return image;
 }
 
-// Per-pixel squared error relative to the reference, in luminance; 0 off the spheres.
-std::vector<float> relative_squared_error(const RgbImage& image, const RgbImage& reference, double& mean) {
-    std::vector<float> error(image.pixels.size());
-    double sum = 0;
-    size_t counted = 0;
-    for (size_t i = 0; i < error.size(); ++i) {
-        const float r = luminance(reference.pixels[i], {});
-        if (!(r > 0)) continue;
-        const float d = luminance(image.pixels[i], {}) - r;
-        error[i] = d * d / (r * r);
-        sum += error[i], ++counted;
-    }
-    mean = counted ? sum / static_cast<double>(counted) : 0;
-    return error;
+// Per-pixel squared error relative to the reference, in luminance (0 off the spheres),
+// and its mean over each sphere's pixels (relMSE).
+struct RelativeError {
+    std::vector<float> pixels;
+    std::vector<double> sphere_means;
+};
+RelativeError relative_squared_error(const RgbImage& image, const RgbImage& reference, const Scene& scene) {
+    RelativeError e{std::vector<float>(image.pixels.size()), std::vector<double>(scene.spheres)};
+    std::vector<size_t> counted(scene.spheres);
+    for (uint32_t y = 0; y < scene.h; ++y)
+        for (uint32_t x = 0; x < scene.w; ++x) {
+            const size_t i = size_t{y} * scene.w + x;
+            const float r = luminance(reference.pixels[i], {});
+            if (!(r > 0)) continue;
+            const float d = luminance(image.pixels[i], {}) - r;
+            e.pixels[i] = d * d / (r * r);
+            e.sphere_means[scene.sphere_of(x)] += e.pixels[i], ++counted[scene.sphere_of(x)];
+        }
+    for (uint32_t k = 0; k < scene.spheres; ++k)
+        e.sphere_means[k] = counted[k] ? e.sphere_means[k] / static_cast<double>(counted[k]) : 0.0;
+    return e;
 }
 
 io::Image8 crop(const io::Image8& image, uint32_t x0, uint32_t width) {
     io::Image8 out = pictures::make_image(width, image.height, {});
     pictures::blit(out, image, -static_cast<int>(x0), 0);
-    return out;
-}
-
-io::Image8 stack(const io::Image8& top, const io::Image8& bottom) {
-    io::Image8 out = pictures::make_image(std::max(top.width, bottom.width), top.height + bottom.height,
-                                          pictures::Style{}.background);
-    pictures::blit(out, top, 0, 0);
-    pictures::blit(out, bottom, 0, static_cast<int>(top.height));
     return out;
 }
 
@@ -126,30 +139,105 @@ std::string caption_text(const std::string& map_name, const ComparisonOptions& o
     return caption;
 }
 
-// The montage: the tone-mapped renders on top, their relative squared errors below;
-// writes each panel's PNG on the way.
-io::Image8 write_panels(const std::filesystem::path& folder, const RgbImage& reference,
-                        const std::vector<std::pair<std::string, RgbImage>>& renders, const io::Image8& shown,
-                        uint32_t reference_spp, const std::string& caption) {
+// The montage's widest: a technique column per sphere side, so that a comparison of 11
+// techniques stays about a screen wide.
+constexpr int kMontageWidth = 2000;
+
+// The montage's grid: a column per technique (the reference first), for each BSDF a row
+// of renders and under it a row of their errors, so that every error map sits under the
+// render it measures. Sphere cells are the renders' own pixels, scaled down only where
+// the grid would be wider than kMontageWidth.
+struct MontageGrid {
+    const Scene& scene;
+    std::vector<std::string> bsdfs;
+    double scale = 1;
+
+    MontageGrid(const Scene& scene, std::vector<std::string> bsdf_names, size_t columns, const pictures::Style& style)
+        : scene(scene), bsdfs(std::move(bsdf_names)) {
+        int label = 0;
+        for (const std::string& b : bsdfs) label = std::max(label, pictures::text_width(b, style.text_scale));
+        const double room = kMontageWidth - 2 * style.margin - label - static_cast<int>(columns) * style.gap;
+        scale = std::min(1.0, room / (static_cast<double>(columns) * scene.cell_begin(1)));
+    }
+
+    // Sphere i's cell of a picture whose panel for this column starts at x0.
+    io::Image8 cell(const io::Image8& picture, uint32_t x0, uint32_t i) const {
+        const uint32_t begin = scene.cell_begin(i), width = scene.cell_begin(i + 1) - begin;
+        const io::Image8 cut = crop(picture, x0 + begin, width);
+        if (scale == 1) return cut;
+        const auto side = [&](uint32_t n) { return std::max(1u, static_cast<uint32_t>(n * scale)); };
+        return pictures::resize(cut, side(width), side(scene.h));
+    }
+};
+
+// Where the montage put each cell, with each sphere's relMSE: montage.json, for scripts
+// and the test that reads the layout.
+nlohmann::json layout_json(const pictures::GridFigure& figure, const pictures::Grid& grid,
+                           const std::vector<std::string>& bsdfs, const std::vector<std::vector<double>>& relmse,
+                           const std::string& caption) {
+    nlohmann::json j{{"caption", caption},
+                     {"size", {figure.image.width, figure.image.height}},
+                     {"bsdfs", bsdfs},
+                     {"columns", grid.columns},
+                     {"cells", nlohmann::json::array()}};
+    const size_t columns = grid.columns.size();
+    const auto rect = [&](size_t row, size_t column) {
+        const pictures::Rect r = figure.cells[row * columns + column];
+        return nlohmann::json{r.x, r.y, r.width, r.height};
+    };
+    for (size_t b = 0; b < bsdfs.size(); ++b)
+        for (size_t c = 0; c < columns; ++c) {
+            nlohmann::json cell{{"column", grid.columns[c]}, {"bsdf", bsdfs[b]}, {"render", rect(2 * b, c)}};
+            if (c > 0) cell["error"] = rect(2 * b + 1, c), cell["relmse"] = relmse[c - 1][b];
+            j["cells"].push_back(std::move(cell));
+        }
+    return j;
+}
+
+// Writes each panel's PNG, then the montage (montage.png) and its layout (montage.json).
+void write_panels(const std::filesystem::path& folder, const Scene& scene, const RgbImage& reference,
+                  const std::vector<std::pair<std::string, RgbImage>>& renders, const io::Image8& shown,
+                  const ComparisonOptions& options, uint32_t reference_spp, const std::string& caption) {
     const uint32_t w = reference.width, h = reference.height;
-    std::vector<pictures::Panel> top = {{crop(shown, 0, w), "reference (" + std::to_string(reference_spp) + " spp)"}};
-    io::write_png(folder / "reference.png", top[0].image);
+    io::write_png(folder / "reference.png", crop(shown, 0, w));
     // A fixed scale: a few pixels hit by a rare bright sample would otherwise stretch it
     // over many decades and leave the typical errors indistinguishable.
     const pictures::ColourScale scale{1e-4f, 10.0f, true};
-    std::vector<pictures::Panel> bottom;
+    std::vector<io::Image8> errors;
+    std::vector<std::vector<double>> relmse;
     for (uint32_t i = 0; i < renders.size(); ++i) {
-        top.push_back({crop(shown, (i + 1) * w, w), renders[i].first});
-        io::write_png(folder / (renders[i].first + ".png"), top.back().image);
-        double mean_error = 0;
-        const std::vector<float> error = relative_squared_error(renders[i].second, reference, mean_error);
-        char title[96];
-        std::snprintf(title, sizeof title, "%s relMSE %.3g", renders[i].first.c_str(), mean_error);
-        bottom.push_back({pictures::false_colour(error, w, h, scale), title, true});
-        io::write_png(folder / (renders[i].first + "-relmse.png"), bottom.back().image);
+        io::write_png(folder / (renders[i].first + ".png"), crop(shown, (i + 1) * w, w));
+        const RelativeError error = relative_squared_error(renders[i].second, reference, scene);
+        errors.push_back(pictures::false_colour(error.pixels, w, h, scale));
+        relmse.push_back(error.sphere_means);
+        io::write_png(folder / (renders[i].first + "-relmse.png"), errors.back());
     }
-    const io::Image8 bar = pictures::colour_bar(scale, "per-pixel relative squared error", std::min(4u * w, 1600u));
-    return stack(pictures::montage(top, caption), pictures::montage(bottom, "", &bar));
+
+    const pictures::Style style;
+    pictures::Grid grid{{"reference (" + std::to_string(reference_spp) + " spp)"}, {}, {}};
+    for (const auto& r : renders) grid.columns.push_back(r.first);
+    std::vector<std::string> bsdfs;
+    for (const Bsdf& b : options.bsdfs) bsdfs.push_back(b.name());
+    const MontageGrid layout(scene, bsdfs, grid.columns.size(), style);
+    for (uint32_t b = 0; b < bsdfs.size(); ++b) {
+        grid.rows.push_back(bsdfs[b]);
+        for (uint32_t c = 0; c < grid.columns.size(); ++c) grid.cells.push_back({layout.cell(shown, c * w, b), ""});
+        grid.rows.push_back("error");
+        grid.cells.push_back({});
+        for (uint32_t i = 0; i < renders.size(); ++i) {
+            char text[32];
+            std::snprintf(text, sizeof text, "%.3g", relmse[i][b]);
+            grid.cells.push_back({layout.cell(errors[i], 0, b), text});
+        }
+    }
+    const io::Image8 bar =
+        pictures::colour_bar(scale, "error rows: per-pixel relative squared error; under each sphere its mean (relMSE)",
+                             std::min(4u * w, 1600u), pictures::Orientation::horizontal, style);
+    const pictures::GridFigure figure = pictures::grid(grid, caption, &bar, style);
+    io::write_png(folder / "montage.png", figure.image);
+    write_file_atomically(folder / "montage.json", [&](std::ostream& out) {
+        out << layout_json(figure, grid, bsdfs, relmse, caption).dump(2) << "\n";
+    });
 }
 
 }  // namespace
@@ -175,12 +263,9 @@ std::filesystem::path render_comparison(const StudyInputs& inputs, const RenderO
         io::write_exr(folder / (t.name() + ".exr"), renders.back().second);
     }
     const io::Image8 shown = tonemap_together(reference, renders, inputs.plain.options().luma);
-    const io::Image8 montage =
-        write_panels(folder, reference, renders, shown, render_options.reference_spp,
-                     caption_text(map_name, options, render_options.spp, compensated.options().compensation.alpha));
-    const std::filesystem::path path = folder / "montage.png";
-    io::write_png(path, montage);
-    return path;
+    write_panels(folder, scene, reference, renders, shown, options, render_options.reference_spp,
+                 caption_text(map_name, options, render_options.spp, compensated.options().compensation.alpha));
+    return folder / "montage.png";
 }
 
 }  // namespace envmis::cli

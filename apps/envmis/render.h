@@ -23,7 +23,8 @@ struct RenderOptions {
 
 // Renders every technique of inputs.options, every sphere sampling the first map of
 // inputs.compensated (inputs.points are not used: the pixels are the points), and writes
-// reference.{exr,png}, <technique>.{exr,png}, <technique>-relmse.png and montage.png into
+// reference.{exr,png}, <technique>.{exr,png}, <technique>-relmse.png, montage.png and
+// montage.json (where each cell lies, and each sphere's relMSE) into
 // `folder` (created if missing). At control.stop (checked every pixel) it throws
 // Interrupted: the pictures written by then are whole, the one under way and the
 // montage are not written. Returns the montage's path. Cost: pixels x (spp x techniques + reference_spp)

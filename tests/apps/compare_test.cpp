@@ -202,5 +202,79 @@ TEST(Compare, BinsTechniquesAreReportedWithTheirExactRatios) {
     fs::remove_all(dir);
 }
 
+// The montage is a grid read through its layout (montage.json): each technique's column
+// holds, for every BSDF, the sphere of that technique's own render and, directly under it,
+// the sphere of that technique's own error map, pixel for pixel as in their PNGs.
+TEST(Compare, TheMontagesErrorMapsLieUnderTheRendersOfTheirOwnTechnique) {
+    const fs::path dir = small_map_folder("envmis_compare_montage_test");
+    const CliRun r = run_compare(dir,
+                                 "--points 1 --spp 4 --bsdf lambert,phong:20 --techniques env,bsdf,mis-balance "
+                                 "--images out --image 64x32 --image-spp 2 --reference-spp 8");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const nlohmann::json layout = nlohmann::json::parse(std::ifstream(dir / "out/montage.json"));
+    const RgbImage montage = io::load_image(dir / "out/montage.png").image;
+    const auto picture = [&](const std::string& name) { return io::load_image(dir / "out" / name).image; };
+    const std::vector<std::string> bsdfs{"lambert", "phong:20"};
+    EXPECT_EQ(layout["bsdfs"].get<std::vector<std::string>>(), bsdfs);
+    EXPECT_EQ(layout["columns"].size(), 4u);
+    // The cell at `rect` shows sphere b (32 pixels wide) of `source` exactly.
+    const auto shows = [&](const nlohmann::json& rect, const RgbImage& source, int b) {
+        const int x0 = rect[0], y0 = rect[1], w = rect[2], h = rect[3];
+        if (w != 32 || h != 32) return false;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                if (const Rgb m = montage.at(x0 + x, y0 + y), p = source.at(32 * b + x, y);
+                    m.r != p.r || m.g != p.g || m.b != p.b)
+                    return false;
+        return true;
+    };
+    size_t checked = 0;
+    for (const nlohmann::json& cell : layout["cells"]) {
+        const std::string column = cell["column"];
+        const int b = cell["bsdf"] == "lambert" ? 0 : 1;
+        if (column.starts_with("reference")) {
+            EXPECT_TRUE(shows(cell["render"], picture("reference.png"), b)) << cell;
+            continue;
+        }
+        EXPECT_TRUE(shows(cell["render"], picture(column + ".png"), b)) << cell;
+        EXPECT_TRUE(shows(cell["error"], picture(column + "-relmse.png"), b)) << cell;
+        EXPECT_EQ(cell["error"][0], cell["render"][0]) << cell;
+        EXPECT_GT(cell["error"][1].get<int>(), cell["render"][1].get<int>() + 32) << cell;
+        EXPECT_GE(cell["relmse"].get<double>(), 0.0);
+        ++checked;
+    }
+    EXPECT_EQ(checked, 3u * bsdfs.size());
+    fs::remove_all(dir);
+}
+
+// The README's montage (docs/images/montage.png, made by scripts/readme_pictures.sh) is
+// stale when the comparison it shows has other techniques or BSDFs than a default run has
+// now, or when the montage's layout has changed: its montage.json, written beside it by
+// the same run, is compared with a default run's here.
+TEST(Compare, TheReadmesMontageShowsTheDefaultTechniquesInTheCurrentLayout) {
+    const fs::path dir = small_map_folder("envmis_compare_readme_montage_test");
+    const CliRun r = run_compare(dir, "--points 1 --spp 1 --images out --image 48x16 --image-spp 1 --reference-spp 1");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const fs::path docs = fs::path(ENVMIS_DATA_DIR) / ".." / "docs" / "images";
+    const nlohmann::json now = nlohmann::json::parse(std::ifstream(dir / "out/montage.json"));
+    const nlohmann::json shown = nlohmann::json::parse(std::ifstream(docs / "montage.json"), nullptr, false);
+    const std::string remedy = "docs/images/montage.png is stale: run bash scripts/readme_pictures.sh";
+    ASSERT_FALSE(shown.is_discarded()) << remedy;
+    EXPECT_EQ(shown["bsdfs"], now["bsdfs"]) << remedy;
+    EXPECT_EQ(shown["columns"].size(), now["columns"].size()) << remedy;
+    for (size_t c = 1; c < now["columns"].size() && c < shown["columns"].size(); ++c)
+        EXPECT_EQ(shown["columns"][c], now["columns"][c]) << remedy;
+    ASSERT_EQ(shown["cells"].size(), now["cells"].size()) << remedy;
+    for (size_t i = 0; i < now["cells"].size(); ++i) {
+        std::vector<std::string> keys_now, keys_shown;
+        for (const auto& [key, value] : now["cells"][i].items()) keys_now.push_back(key);
+        for (const auto& [key, value] : shown["cells"][i].items()) keys_shown.push_back(key);
+        EXPECT_EQ(keys_shown, keys_now) << remedy;
+    }
+    const io::ImageSize size = io::read_image_size(docs / "montage.png");
+    EXPECT_EQ(shown["size"], nlohmann::json({size.width, size.height})) << "montage.json is not montage.png's";
+    fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace envmis

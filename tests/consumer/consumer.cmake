@@ -79,6 +79,9 @@ if(envmis_readelf)
     COMMAND ${CMAKE_COMMAND} -DSOURCE=${PROJECT_SOURCE_DIR} -DWORK=${envmis_consumer_dir}/shared
       -DCONSUMER=${CMAKE_CURRENT_LIST_DIR} -DCXX=${CMAKE_CXX_COMPILER} -DGENERATOR=${CMAKE_GENERATOR}
       -DCONFIG=$<CONFIG> -DREADELF=${envmis_readelf} -P ${CMAKE_CURRENT_LIST_DIR}/shared.cmake)
-  set_tests_properties(consumer.shared PROPERTIES LABELS consumer TIMEOUT 900)
+  # COST: ctest -j starts costlier tests first; on a fresh clone (no CTestCostData.txt yet)
+  # this, the longest test, would otherwise start late and run alone at the end.
+  set_tests_properties(consumer.shared PROPERTIES LABELS consumer TIMEOUT 900 COST 100)
 endif()
-set_tests_properties(consumer.clean consumer.install PROPERTIES LABELS consumer)
+# Early (COST): the examples' and consumers' chains of fixtures start from the install.
+set_tests_properties(consumer.clean consumer.install PROPERTIES LABELS consumer COST 90)

@@ -21,7 +21,7 @@ execute_process(COMMAND ${CMAKE_COMMAND} -S ${SOURCE} -B ${WORK}/envmis -G ${GEN
     -DCMAKE_CXX_COMPILER=${CXX} -DBUILD_SHARED_LIBS=ON -DENVMIS_BUILD_IO=OFF -DENVMIS_BUILD_TESTS=OFF
     -DENVMIS_BUILD_PYTHON=OFF ${hidden}
   COMMAND_ERROR_IS_FATAL ANY)
-execute_process(COMMAND ${CMAKE_COMMAND} --build ${WORK}/envmis --target envmis_core envmis_build
+execute_process(COMMAND ${CMAKE_COMMAND} --build ${WORK}/envmis --target envmis_core envmis_build --parallel 2
   COMMAND_ERROR_IS_FATAL ANY)
 foreach(component core build)
   execute_process(COMMAND ${CMAKE_COMMAND} --install ${WORK}/envmis --prefix ${WORK}/prefix --component ${component}

@@ -34,7 +34,7 @@ add_test(NAME examples.build
     --build-options -DCMAKE_PREFIX_PATH=${envmis_consumer_prefix} -DCMAKE_BUILD_TYPE=$<CONFIG>
       -DCMAKE_CXX_COMPILER=${CMAKE_CXX_COMPILER} -DCMAKE_COMPILE_WARNING_AS_ERROR=ON)
 set_tests_properties(examples.build PROPERTIES
-  FIXTURES_REQUIRED envmis_installed FIXTURES_SETUP envmis_examples_built TIMEOUT 600)
+  FIXTURES_REQUIRED envmis_installed FIXTURES_SETUP envmis_examples_built TIMEOUT 600 COST 80)
 
 add_test(NAME examples.work COMMAND ${CMAKE_COMMAND} -E make_directory ${envmis_examples_work})
 set_tests_properties(examples.work PROPERTIES FIXTURES_SETUP envmis_examples_work)

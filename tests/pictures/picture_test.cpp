@@ -389,5 +389,52 @@ TEST(Montage, NoPanels) {
     EXPECT_EQ(empty.height, 32u);
 }
 
+TEST(Grid, EachCellsPictureLiesWhereItsRectSaysInItsRowAndColumn) {
+    Style style;
+    style.margin = 10, style.gap = 6, style.text_scale = 1;
+    Grid g{{"one", "two", "three"}, {"a", "bb"}, {}};
+    for (int i = 0; i < 6; ++i) g.cells.push_back({checker(20 + 4 * (i % 3), 16), i >= 3 ? "cap" : ""});
+    g.cells[4].image = {};  // a blank cell
+    const GridFigure f = grid(g, "caption", nullptr, style);
+    ASSERT_EQ(f.cells.size(), 6u);
+    for (size_t i = 0; i < 6; ++i) {
+        const Rect r = f.cells[i];
+        if (i == 4) {
+            EXPECT_EQ(r.width, 0);
+            continue;
+        }
+        EXPECT_EQ(r.width, int(g.cells[i].image.width));
+        for (int y : {0, r.height - 1})
+            for (int x : {0, r.width - 1})
+                EXPECT_EQ(pixel(f.image, r.x + x, r.y + y), pixel(g.cells[i].image, x, y)) << "cell " << i;
+    }
+    // Cells of a row share their top edge, cells of a column their centre; columns are
+    // as wide as the widest picture (28) plus the gap.
+    EXPECT_EQ(f.cells[0].y, f.cells[2].y);
+    EXPECT_EQ(f.cells[3].y, f.cells[5].y);
+    EXPECT_GT(f.cells[3].y, f.cells[0].y + 16);
+    EXPECT_EQ(f.cells[0].x + f.cells[0].width / 2, f.cells[3].x + f.cells[3].width / 2);
+    EXPECT_EQ(f.cells[1].x + f.cells[1].width / 2 - (f.cells[0].x + f.cells[0].width / 2), 28 + 6);
+    // The captioned second row is one text line higher than the first.
+    const int th = text_height(1);
+    EXPECT_EQ(int(f.image.height), f.cells[3].y + 16 + th + 1 + 10);
+}
+
+TEST(Grid, LongColumnTitlesBreakAfterHyphensToFitTheirColumn) {
+    Style style;
+    style.margin = 10, style.gap = 6, style.text_scale = 1;
+    // 40 pixels hold 6 characters: "mis-" / "optim" ... each line within its column.
+    const Grid g{{"mis-optimal-bins", "env"}, {"r"}, {{checker(40, 10), ""}, {checker(40, 10), ""}}};
+    const GridFigure f = grid(g, "", nullptr, style);
+    const int th = text_height(1), line = th + 1;
+    EXPECT_EQ(f.cells[0].y, 10 + 3 * line);  // "mis-", "optimal-" cut to "optima", "bins"
+    Image8 titles = make_image(f.image.width, 3 * line - 1, style.background);  // without the frames
+    blit(titles, f.image, 0, -10);
+    const Box box = changed_box(titles, style.background);
+    EXPECT_GE(box.x0, f.cells[0].x);
+    EXPECT_LE(box.x1, f.cells[1].x + 40);
+    EXPECT_THROW(grid(Grid{{"a"}, {"r", "s"}, {{checker(4, 4), ""}}}, ""), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace envmis::pictures

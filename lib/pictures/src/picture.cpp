@@ -9,6 +9,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace envmis::pictures {
@@ -357,6 +359,39 @@ Image8 colour_bar(const ColourScale& scale, std::string_view label, uint32_t len
     return bar;
 }
 
+namespace {
+
+// The longest start of `text` that fits in `width` pixels at `scale`.
+std::string_view cut_to_width(std::string_view text, int width, int scale) {
+    const int fitting = (width + (kGlyphAdvance - kGlyphWidth) * scale) / (kGlyphAdvance * scale);
+    return text.substr(0, static_cast<size_t>(std::max(fitting, 0)));
+}
+
+// Greedy line breaks after each '-' and at spaces (dropped), each line at most `width`
+// pixels wide at `scale`; a piece too wide alone is cut.
+std::vector<std::string> wrap_to_width(std::string_view text, int width, int scale) {
+    std::vector<std::string> lines;
+    std::string line;
+    for (size_t i = 0; i < text.size();) {
+        const size_t end = std::min(text.find_first_of("- ", i), text.size() - 1) + 1;
+        std::string piece(text.substr(i, end - i));
+        i = end;
+        const bool space = piece.back() == ' ';
+        if (space) piece.pop_back();
+        if (!line.empty() && text_width(line + piece, scale) > width) lines.push_back(std::exchange(line, {}));
+        line += piece;
+        if (space && !line.empty()) line += ' ';
+    }
+    if (!line.empty()) lines.push_back(line);
+    for (std::string& l : lines) {
+        while (!l.empty() && l.back() == ' ') l.pop_back();
+        l = std::string(cut_to_width(l, width, scale));
+    }
+    return lines;
+}
+
+}  // namespace
+
 Image8 montage(std::span<const Panel> panels, std::string_view caption, const Image8* colour_bar, const Style& style) {
     const int s = style.text_scale, th = text_height(s), margin = style.margin, gap = style.gap;
     int row_width = 0, row_height = 0, keyed_begin = -1, keyed_end = 0;
@@ -386,8 +421,7 @@ Image8 montage(std::span<const Panel> panels, std::string_view caption, const Im
         const int w = static_cast<int>(p.image.width);
         fill_rect(out, x - 1, top - 1, w + 2, static_cast<int>(p.image.height) + 2, style.frame);
         blit(out, p.image, x, top);
-        const auto fitting = static_cast<size_t>((w + (kGlyphAdvance - kGlyphWidth) * s) / (kGlyphAdvance * s));
-        const std::string_view title = std::string_view(p.title).substr(0, fitting);
+        const std::string_view title = cut_to_width(p.title, w, s);
         draw_text(out, x + (w - text_width(title, s)) / 2, top - th - s, title, style.text, s);
         x += w + gap;
     }
@@ -396,6 +430,69 @@ Image8 montage(std::span<const Panel> panels, std::string_view caption, const Im
     else if (colour_bar)
         blit(out, *colour_bar, margin + clamp((keyed_begin + keyed_end - bar_width) / 2, 0, content_width - bar_width),
              top + row_height + gap);
+    return out;
+}
+
+GridFigure grid(const Grid& grid, std::string_view caption, const Image8* colour_bar, const Style& style) {
+    const size_t columns = grid.columns.size(), rows = grid.rows.size();
+    if (grid.cells.size() != rows * columns)
+        throw std::invalid_argument("grid: " + std::to_string(grid.cells.size()) + " cells for " +
+                                    std::to_string(rows) + " rows x " + std::to_string(columns) + " columns");
+    const int s = style.text_scale, th = text_height(s), line = th + s, margin = style.margin, gap = style.gap;
+    int cell_w = 0, cell_h = 0, label_w = 0;
+    for (const GridCell& c : grid.cells)
+        cell_w = std::max(cell_w, static_cast<int>(c.image.width)),
+        cell_h = std::max(cell_h, static_cast<int>(c.image.height));
+    for (const std::string& r : grid.rows) label_w = std::max(label_w, text_width(r, s));
+    if (label_w > 0) label_w += gap;
+    std::vector<std::vector<std::string>> titles;
+    size_t title_lines = 0;
+    for (const std::string& c : grid.columns) {
+        titles.push_back(wrap_to_width(c, cell_w, s));
+        title_lines = std::max(title_lines, titles.back().size());
+    }
+    std::vector<int> row_top(rows + 1);
+    const int top = margin + (caption.empty() ? 0 : th + gap) + static_cast<int>(title_lines) * line;
+    row_top[0] = top;
+    for (size_t r = 0; r < rows; ++r) {
+        bool captioned = false;
+        for (size_t c = 0; c < columns; ++c) captioned |= !grid.cells[r * columns + c].caption.empty();
+        row_top[r + 1] = row_top[r] + cell_h + (captioned ? line : 0) + gap;
+    }
+    const int cells_w = columns ? static_cast<int>(columns) * (cell_w + gap) - gap : 0;
+    const int cells_h = rows ? row_top[rows] - gap - top : 0;
+    const int bar_w = colour_bar ? static_cast<int>(colour_bar->width) : 0;
+    const int content_w = std::max({label_w + cells_w, text_width(caption, s), bar_w});
+    const int content_h = cells_h + (colour_bar ? gap + static_cast<int>(colour_bar->height) : 0);
+
+    GridFigure out{make_image(2 * margin + content_w, top + content_h + margin, style.background), {}};
+    draw_text(out.image, margin, margin, caption, style.text, s);
+    const auto column_x = [&](size_t c) { return margin + label_w + static_cast<int>(c) * (cell_w + gap); };
+    for (size_t c = 0; c < columns; ++c)
+        for (size_t k = 0; k < titles[c].size(); ++k)
+            draw_text(out.image, column_x(c) + (cell_w - text_width(titles[c][k], s)) / 2,
+                      top - static_cast<int>(titles[c].size() - k) * line, titles[c][k], style.text, s);
+    for (size_t r = 0; r < rows; ++r) {
+        draw_text(out.image, margin, row_top[r] + (cell_h - th) / 2, grid.rows[r], style.text, s);
+        for (size_t c = 0; c < columns; ++c) {
+            const GridCell& cell = grid.cells[r * columns + c];
+            const int w = static_cast<int>(cell.image.width), h = static_cast<int>(cell.image.height);
+            Rect placed{column_x(c) + (cell_w - w) / 2, row_top[r] + (cell_h - h) / 2, w, h};
+            if (w > 0 && h > 0) {
+                fill_rect(out.image, placed.x - 1, placed.y - 1, w + 2, h + 2, style.frame);
+                blit(out.image, cell.image, placed.x, placed.y);
+            } else {
+                placed.width = placed.height = 0;
+            }
+            out.cells.push_back(placed);
+            const std::string_view text = cut_to_width(cell.caption, cell_w, s);
+            draw_text(out.image, column_x(c) + (cell_w - text_width(text, s)) / 2, row_top[r] + cell_h + s, text,
+                      style.text, s);
+        }
+    }
+    if (colour_bar)
+        blit(out.image, *colour_bar, margin + clamp(label_w + (cells_w - bar_w) / 2, 0, content_w - bar_w),
+             top + cells_h + gap);
     return out;
 }
 

@@ -176,4 +176,41 @@ struct Panel {
 Image8 montage(std::span<const Panel> panels, std::string_view caption, const Image8* colour_bar = nullptr,
                const Style& style = {});
 
+// A cell of a grid(): a picture (an empty one leaves the cell blank) and a caption drawn
+// under it ("" for none).
+struct GridCell {
+    Image8 image;
+    std::string caption;
+};
+
+// Pictures in rows and columns under column titles, beside row titles.
+struct Grid {
+    std::vector<std::string> columns, rows;
+    std::vector<GridCell> cells;  // row-major: rows.size() x columns.size()
+};
+
+// A rectangle of a figure, in its pixels: top-left corner and size.
+struct Rect {
+    int x = 0, y = 0, width = 0, height = 0;
+    friend bool operator==(Rect, Rect) = default;
+};
+
+// A figure and where each cell's picture lies in it, so that a reader (or a test) can
+// find any cell without knowing the layout rules.
+struct GridFigure {
+    Image8 image;
+    std::vector<Rect> cells;  // row-major like Grid::cells; empty cells get width 0
+};
+
+// The grid on the montage's background: a caption line at the top left; every cell as
+// wide as the widest picture and as high as the highest, pictures centred in their cells
+// and framed; a gap between cells. A column's title is centred above it, broken after '-'
+// and at spaces onto as many lines as the widest column needs (a piece too long for the
+// column alone is cut); a row's title is left of its cells, vertically centred. A row with
+// a caption gets one text line under its cells, each caption centred and cut to its cell.
+// A wide colour bar goes below, centred under the cells as far as the figure allows.
+// Throws std::invalid_argument if cells.size() is not rows x columns.
+GridFigure grid(const Grid& grid, std::string_view caption, const Image8* colour_bar = nullptr,
+                const Style& style = {});
+
 }  // namespace envmis::pictures
