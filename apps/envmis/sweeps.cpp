@@ -124,13 +124,15 @@ pictures::LinePlot alpha_sweep_plot(const AlphaSweep& sweep, const std::string& 
         {},
         true};
     for (size_t b = 0; !sweep.alphas.empty() && b < sweep.comparisons.front().bsdfs.size(); ++b) {
-        pictures::Series series{sweep.comparisons.front().bsdfs[b].bsdf.name(), {}, {}};
+        pictures::Series series{
+            sweep.comparisons.front().bsdfs[b].bsdf.name(), {}, {}, static_cast<int>(sweep.best(b))};
         for (size_t i = 0; i < sweep.alphas.size(); ++i) {
             series.x.push_back(sweep.alphas[i]);
             series.y.push_back(sweep.ratio(i, b));
         }
         plot.series.push_back(std::move(series));
     }
+    plot.best_label = "best alpha";
     return plot;
 }
 
@@ -170,14 +172,17 @@ pictures::LinePlot allocation_plot(const AllocationSweep& sweep, const std::stri
     const Comparison& first = sweep.comparisons.front();
     for (size_t b = 0; b < first.bsdfs.size(); ++b)
         for (size_t t = 0; t < first.bsdfs[b].techniques.size(); ++t) {
-            pictures::Series series{
-                first.bsdfs[b].bsdf.name() + " " + first.bsdfs[b].techniques[t].technique.name(), {}, {}};
+            pictures::Series series{first.bsdfs[b].bsdf.name() + " " + first.bsdfs[b].techniques[t].technique.name(),
+                                    {},
+                                    {},
+                                    static_cast<int>(sweep.best(b, t))};
             for (size_t i = 0; i < sweep.allocations.size(); ++i) {
                 series.x.push_back(sweep.allocations[i].env);
                 series.y.push_back(sweep.comparisons[i].bsdfs[b].techniques[t].efficiency);
             }
             plot.series.push_back(std::move(series));
         }
+    plot.best_label = "best split (highest efficiency)";
     return plot;
 }
 

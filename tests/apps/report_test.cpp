@@ -80,6 +80,10 @@ TEST_F(Report, SummarisesCasesWithGeometricMeansAndNamesTheBestMisTechnique) {
     ASSERT_EQ(run(a.string() + " " + b.string() + " -o " + (dir_ / "r.md").string() + " --command 'bash x.sh'"), 0);
     const std::string md = read(dir_ / "r.md");
     EXPECT_NE(md.find("Made by `bash x.sh`"), std::string::npos);
+    // The techniques' columns are code: `bsdf` (a technique) is not the BSDF column.
+    EXPECT_NE(md.find("| map | BSDF | `bsdf` | `mis-optimal` | `mis-balance-comp` | `mis-optimal-comp` |"),
+              std::string::npos)
+        << md;
     EXPECT_NE(md.find("| a | lambert | 0.010 | 0.500 | 0.800 |"), std::string::npos) << md;
     // sqrt(0.5 * 0.8) = 0.632, sqrt(0.8 * 0.2) = 0.4: compensation wins; bsdf is not a candidate.
     // mis-optimal-comp, measured on one map only, is no candidate either.

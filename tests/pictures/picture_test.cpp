@@ -183,6 +183,9 @@ TEST(Ticks, DecadesOnLogScales) {
     EXPECT_EQ(long_range.front(), 1e-6f);
     EXPECT_EQ(scale_ticks({0.3f, 2, true}), (std::vector<float>{0.5f, 1, 2}));
     EXPECT_GE(scale_ticks({1.1f, 1.9f, true}).size(), 2u);
+    // Short ranges get at least three labels: finer round steps where 1-2-5 gives two.
+    EXPECT_EQ(scale_ticks({0.35f, 1.2f, true}), (std::vector<float>{0.4f, 0.6f, 0.8f, 1}));
+    EXPECT_EQ(scale_ticks({2e7f, 2e9f, true}), (std::vector<float>{3e7f, 1e8f, 3e8f, 1e9f}));
 }
 
 TEST(Ticks, RoundStepsOnLinearScales) {

@@ -95,7 +95,7 @@ void expect_only_inside_or_legend(const Image8& image, Rgb8 colour) {
 }
 
 Series series(std::vector<double> x, std::vector<double> y, std::string name = "s") {
-    return {std::move(name), std::move(x), std::move(y)};
+    return {std::move(name), std::move(x), std::move(y), -1};
 }
 
 LinePlot line_plot(std::vector<Series> series, bool log = false) {
@@ -141,8 +141,8 @@ Bar bar(const Image8& image, Rgb8 colour) {
     return tallest;
 }
 
-TEST(Palette, AtLeastEightColoursApartFromEachOtherAndFromWhite) {
-    ASSERT_GE(kPlotPalette.size(), 8u);
+TEST(Palette, TwentyColoursApartFromEachOtherFromWhiteAndFromInk) {
+    ASSERT_GE(kPlotPalette.size(), 20u);  // the comparison's 17 techniques each get their own
     const auto distance = [](Rgb8 a, Rgb8 b) {
         return std::abs(a.r - b.r) + std::abs(a.g - b.g) + std::abs(a.b - b.b);
     };
@@ -252,11 +252,52 @@ TEST(LinePlot, LegendShowsEachNamedSeriesInItsColourBelowTheAxes) {
 
 TEST(LinePlot, SeriesTakeThePaletteColoursInTurn) {
     LinePlot plot;
-    for (int i = 0; i < 10; ++i) plot.series.push_back(series({}, {}, ""));
-    plot.series.push_back(series({0, 1}, {0, 1}, "eleventh"));
+    for (int i = 0; i < 20; ++i) plot.series.push_back(series({}, {}, ""));
+    plot.series.push_back(series({0, 1}, {0, 1}, "twenty-first"));
     const Image8 image = draw(plot);
     EXPECT_FALSE(pixels_of(image, kPlotPalette[0]).empty());
     for (size_t i = 1; i < kPlotPalette.size(); ++i) EXPECT_TRUE(pixels_of(image, kPlotPalette[i]).empty()) << i;
+}
+
+// A series's best point (an allocation sweep's best split, an alpha sweep's best alpha) is
+// ringed in ink, centred on its marker, and the legend says what the ring means.
+TEST(LinePlot, TheBestPointIsRingedAndTheLegendSaysWhatTheRingMeans) {
+    LinePlot plot = line_plot({series({0, 1, 2}, {1, 3, 2})});
+    const Image8 plain = draw(plot);
+    plot.series[0].best = 1;
+    plot.best_label = "best split";
+    const Image8 ringed = draw(plot);
+    const Area area = plot_area(ringed);
+    double sx = 0, sy = 0;
+    int inside_changed = 0, legend_changed = 0;
+    for (uint32_t y = 0; y < ringed.height; ++y)
+        for (uint32_t x = 0; x < ringed.width; ++x)
+            if (pixel(ringed, x, y) != pixel(plain, x, y)) {
+                if (inside({int(x), int(y)}, area))
+                    sx += x, sy += y, ++inside_changed;
+                else if (int(y) > area.y1)
+                    ++legend_changed;
+                else
+                    ADD_FAILURE() << "changed outside the plot area and legend at " << x << "," << y;
+            }
+    ASSERT_GT(inside_changed, 40);
+    EXPECT_GT(legend_changed, 40);
+    // The ring's centre is the middle point's: mid-plot across, at the top (y = 3).
+    EXPECT_NEAR(sx / inside_changed, (area.x0 + area.x1) / 2.0, 2);
+    EXPECT_LT(sy / inside_changed - area.y0, (area.y1 - area.y0) / 8.0);
+}
+
+// Sample counts are whole numbers: their axis is labelled at 1, 2, 3, not at 1.5 and 2.5.
+TEST(LinePlot, WholeNumberXValuesAreLabelledAtWholeNumbersOnly) {
+    const auto x_ticks = [](std::vector<double> x) {
+        const Image8 image = draw(line_plot({series(x, {1, 2, 3})}));
+        const Area area = plot_area(image);
+        int ticks = 0;
+        for (int x = area.x0 - 1; x <= area.x1; ++x) ticks += pixel(image, x, area.y1 + 3) == kPlotInk;
+        return ticks;
+    };
+    EXPECT_EQ(x_ticks({1, 2, 3}), 3);
+    EXPECT_GT(x_ticks({1, 2, 3.5}), 3);
 }
 
 TEST(LinePlot, TitleAndLabelsAreWrittenAroundThePlotArea) {

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -105,20 +106,32 @@ std::vector<float> linear_ticks(double lo, double hi, int max_ticks) {
     return thin(std::move(ticks), max_ticks);
 }
 
-std::vector<float> log_ticks(double lo, double hi, int max_ticks) {
+// The values m x 10^e in [lo, hi] for every mantissa m of `mantissas`, ascending.
+std::vector<float> mantissa_ticks(double lo, double hi, std::span<const double> mantissas) {
     const double slack = 1e-6;
-    const int first = static_cast<int>(std::ceil(std::log10(lo) - slack));
-    const int last = static_cast<int>(std::floor(std::log10(hi) + slack));
     std::vector<float> ticks;
-    if (last > first) {
-        for (int e = first; e <= last; ++e) ticks.push_back(static_cast<float>(std::pow(10.0, e)));
-        return thin(std::move(ticks), max_ticks);
-    }
-    // Less than two decades apart: 1-2-5 steps, or a linear scale within one decade.
-    for (int e = first - 1; e <= last; ++e)
-        for (double m : {1.0, 2.0, 5.0})
+    for (int e = static_cast<int>(std::floor(std::log10(lo))) - 1; e <= static_cast<int>(std::ceil(std::log10(hi)));
+         ++e)
+        for (double m : mantissas)
             if (const double v = m * std::pow(10.0, e); v >= lo * (1 - slack) && v <= hi * (1 + slack))
                 ticks.push_back(static_cast<float>(v));
+    return ticks;
+}
+
+// Powers of ten where there are three or more; else the coarsest round steps that give
+// three to max_ticks ticks (1-2-5, 1-3, 1-2-4-6-8, every digit); else the 1-2-5 ticks
+// thinned, or a linear scale within one decade.
+std::vector<float> log_ticks(double lo, double hi, int max_ticks) {
+    static constexpr double decades[] = {1}, one_two_five[] = {1, 2, 5}, one_three[] = {1, 3}, even[] = {1, 2, 4, 6, 8},
+                            digits[] = {1, 2, 3, 4, 5, 6, 7, 8, 9};
+    if (std::vector<float> ticks = mantissa_ticks(lo, hi, decades); ticks.size() >= 3)
+        return thin(std::move(ticks), max_ticks);
+    for (std::span<const double> steps : {std::span<const double>(one_two_five), std::span<const double>(one_three),
+                                          std::span<const double>(even), std::span<const double>(digits)})
+        if (std::vector<float> ticks = mantissa_ticks(lo, hi, steps);
+            ticks.size() >= 3 && ticks.size() <= static_cast<size_t>(max_ticks))
+            return ticks;
+    std::vector<float> ticks = mantissa_ticks(lo, hi, one_two_five);
     return ticks.size() >= 2 ? thin(std::move(ticks), max_ticks) : linear_ticks(lo, hi, max_ticks);
 }
 

@@ -16,7 +16,7 @@ constexpr int kScale = 2;  // font pixel size of all text
 constexpr int kMargin = 12, kGap = 8;
 constexpr int kTick = 5, kMinorTick = 3;
 constexpr int kMinPlotSide = 32, kMaxSide = 16384;
-constexpr int kMarkerRadius = 4;
+constexpr int kMarkerRadius = 4, kRingRadius = 9;
 constexpr int kLegendPad = 8, kLegendSpacing = 24, kLegendKeyGap = 6, kLegendLine = 28;
 constexpr double kPadding = 0.05;  // of an axis's span, so that markers at the extremes stay whole
 constexpr Rgb8 kBackground{255, 255, 255}, kGrid{226, 226, 226}, kLegendFrame{170, 170, 170};
@@ -155,6 +155,14 @@ void draw_marker(Image8& image, const Area& clip, int x, int y, Marker marker, R
             fill_clipped(image, clip, x - half, y + dy, 2 * half + 1, 1, colour);
 }
 
+// A 2-pixel ring of radius kRingRadius around (x, y): the mark of a series's best point.
+void draw_ring(Image8& image, const Area& clip, int x, int y, Rgb8 colour) {
+    for (int dy = -kRingRadius - 1; dy <= kRingRadius + 1; ++dy)
+        for (int dx = -kRingRadius - 1; dx <= kRingRadius + 1; ++dx)
+            if (std::abs(std::sqrt(double(dx * dx + dy * dy)) - kRingRadius) <= 1.0)
+                fill_clipped(image, clip, x + dx, y + dy, 1, 1, colour);
+}
+
 // Bresenham's line, stepping one pixel at a time along its longer axis so that it has no
 // gaps, 2 pixels wide.
 void draw_line(Image8& image, const Area& clip, int xa, int ya, int xb, int yb, Rgb8 colour) {
@@ -172,9 +180,12 @@ struct LegendEntry {
     std::string_view name;
     Rgb8 colour;
     std::optional<Marker> marker;  // a line with this marker; none: a bar's swatch
+    bool ring = false;             // a ring alone (the best points' mark)
 };
 
-int key_width(const LegendEntry& entry) { return entry.marker ? kLegendLine : text_height(kScale) - 4; }
+int key_width(const LegendEntry& entry) {
+    return entry.ring ? 2 * kRingRadius + 3 : entry.marker ? kLegendLine : text_height(kScale) - 4;
+}
 int entry_width(const LegendEntry& entry) { return key_width(entry) + kLegendKeyGap + text_width(entry.name, kScale); }
 int legend_row_height() { return text_height(kScale) + kGap / 2; }
 
@@ -213,7 +224,9 @@ struct Legend {
             for (size_t i : row) {
                 const LegendEntry& e = entries[i];
                 const int middle = y + cap / 2;
-                if (e.marker) {
+                if (e.ring) {
+                    draw_ring(image, everywhere, x + key_width(e) / 2, middle, e.colour);
+                } else if (e.marker) {
                     fill_rect(image, x, middle - 1, kLegendLine, 2, e.colour);
                     draw_marker(image, everywhere, x + kLegendLine / 2, middle, *e.marker, e.colour);
                 } else {
@@ -306,8 +319,12 @@ Image8 draw(const LinePlot& plot) {
 
     const auto marker = [](size_t i) { return static_cast<Marker>(i % 4); };
     std::vector<LegendEntry> entries;
-    for (size_t i = 0; i < plot.series.size(); ++i)
+    bool marked = false;
+    for (size_t i = 0; i < plot.series.size(); ++i) {
         if (!plot.series[i].name.empty()) entries.push_back({plot.series[i].name, colour(i), marker(i)});
+        marked |= plot.series[i].best >= 0 && static_cast<size_t>(plot.series[i].best) < plot.series[i].x.size();
+    }
+    if (marked && !plot.best_label.empty()) entries.push_back({plot.best_label, kPlotInk, std::nullopt, true});
     // Room for half a tick label centred at the right end of the axis.
     const int right_room = kMargin + text_width("0.000", kScale) / 2;
     Chart chart =
@@ -315,8 +332,13 @@ Image8 draw(const LinePlot& plot) {
     Image8& image = chart.image;
     const Area& area = chart.area;
 
-    const auto ticks =
+    auto ticks =
         labelled_ticks(x, area.width(), 80, [](const std::string& label) { return text_width(label, kScale); });
+    if (!plot.log_x && std::all_of(xs.begin(), xs.end(), [](double v) { return v == std::round(v); }))
+        std::erase_if(ticks, [&](const Tick& t) {
+            const double v = x.lo + t.position * (x.hi - x.lo);
+            return std::abs(v - std::round(v)) > 1e-6 * std::max(1.0, std::abs(v));
+        });
     for (const Tick& t : ticks) {
         const int column = area.column(t.position);
         fill_clipped(image, area, column, area.y0, 1, area.height(), kGrid);
@@ -336,6 +358,8 @@ Image8 draw(const LinePlot& plot) {
                           colour(k));
         for (const auto& p : points)
             if (p) draw_marker(image, area, p->first, p->second, marker(k), colour(k));
+        if (s.best >= 0 && static_cast<size_t>(s.best) < points.size() && points[s.best])
+            draw_ring(image, area, points[s.best]->first, points[s.best]->second, kPlotInk);
     }
     return image;
 }

@@ -272,10 +272,11 @@ void write_intro(std::ostream& out, const std::vector<json>& runs, const std::st
 }
 
 // Summary: one row per case, one column per technique, the geometric mean row and the
-// MIS technique that gains most.
+// MIS technique that gains most. Technique names are code (`bsdf`, BSDF sampling), so
+// that none reads as the case's BSDF column.
 void write_summary(std::ostream& out, const std::vector<std::string>& techniques, const std::vector<Case>& cases) {
-    out << "## Variance relative to balance MIS\n\n| map | bsdf |";
-    for (const std::string& t : techniques) out << " " << t << " |";
+    out << "## Variance relative to balance MIS\n\n| map | BSDF |";
+    for (const std::string& t : techniques) out << " `" << t << "` |";
     out << "\n|---|---|";
     for (size_t i = 0; i < techniques.size(); ++i) out << "---:|";
     out << "\n";

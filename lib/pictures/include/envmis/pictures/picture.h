@@ -111,8 +111,9 @@ inline ColourScale shared_log_scale(std::initializer_list<std::span<const float>
 }
 
 // Round values inside the scale to label it with, at most `max_ticks` of them, ascending:
-// powers of ten (every k-th decade on long ranges) or 1-2-5 steps on a log scale,
-// multiples of 1, 2 or 5 times a power of ten on a linear one.
+// on a log scale, powers of ten (every k-th decade on long ranges) where there are three,
+// else the coarsest of 1-2-5, 1-3, 1-2-4-6-8 and 1-to-9 steps that gives three (0.4, 0.6,
+// 0.8, 1 over 0.35 to 1.2); multiples of 1, 2 or 5 times a power of ten on a linear one.
 std::vector<float> scale_ticks(const ColourScale& scale, int max_ticks = 6);
 // A short label for a tick: "0.01", "0.5", "1", "100", "1000", but "1e-3", "2.5e4"
 // outside [0.01, 9999].

@@ -23,18 +23,15 @@
 
 namespace envmis::pictures {
 
-// Series and bars take their colours in turn from this palette (Tableau 10), series i
-// colour i mod 10: ten hues of similar weight that stay apart on white.
-inline constexpr std::array<Rgb8, 10> kPlotPalette{{{31, 119, 180},
-                                                    {255, 127, 14},
-                                                    {44, 160, 44},
-                                                    {214, 39, 40},
-                                                    {148, 103, 189},
-                                                    {140, 86, 75},
-                                                    {227, 119, 194},
-                                                    {127, 127, 127},
-                                                    {188, 189, 34},
-                                                    {23, 190, 207}}};
+// Series and bars take their colours in turn from this palette, series i colour i mod 20:
+// Tableau 10's hues first, then Tableau 20's light tints of them where those stay apart
+// (three darker hues replace the tints too close to another colour), so that a chart of up
+// to 20 techniques gives each its own colour.
+inline constexpr std::array<Rgb8, 20> kPlotPalette{{{31, 119, 180},  {255, 127, 14},  {44, 160, 44},   {214, 39, 40},
+                                                    {148, 103, 189}, {140, 86, 75},   {227, 119, 194}, {127, 127, 127},
+                                                    {188, 189, 34},  {23, 190, 207},  {174, 199, 232}, {255, 187, 120},
+                                                    {152, 223, 138}, {255, 152, 150}, {197, 176, 213}, {196, 156, 148},
+                                                    {128, 0, 64},    {90, 60, 20},    {219, 219, 141}, {0, 110, 110}}};
 // The frame, ticks and all text.
 inline constexpr Rgb8 kPlotInk{0, 0, 0};
 // A bar chart's dashed reference line.
@@ -45,6 +42,7 @@ inline constexpr Rgb8 kPlotReference{70, 70, 70};
 struct Series {
     std::string name;  // legend entry; unnamed series are left out of the legend
     std::vector<double> x, y;
+    int best = -1;  // a point to mark (a ring around its marker, see LinePlot::best_label); -1: none
 };
 
 struct LinePlot {
@@ -53,7 +51,11 @@ struct LinePlot {
     bool log_y = false;          // log10 axes, labelled at powers of ten
     bool log_x = false;
     uint32_t width = 720, height = 440;  // of the whole picture, in pixels
+    // The legend's entry for the rings of Series::best ("best split"), when one is marked.
+    std::string best_label = "best";
 };
+// Where every x is a whole number (sample counts), the x axis is labelled at whole numbers
+// only.
 
 // Throws std::invalid_argument when there is no series, or none has a point, when a
 // series's x and y differ in length, or when the picture is too small to leave a plot
