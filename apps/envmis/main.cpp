@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
     std::signal(SIGXFSZ, SIG_IGN);
     CLI::App app{"envmis: importance sampling of HDR environment maps, with and without MIS compensation"};
     app.require_subcommand(1);
-    app.set_version_flag("--version", "envmis 0.1.0");
+    app.set_version_flag("--version", "envmis " ENVMIS_VERSION);
     // A usage error is one line, naming the flag: "envmis: -n: Value -5 not in range 1 to ...".
     app.failure_message(
         [](const CLI::App*, const CLI::Error& e) { return "envmis: " + printable(e.what()) + " (see --help)\n"; });

@@ -7,4 +7,5 @@ radiance is linear RGB in the map's working colour space.
 """
 
 from ._maps import *  # noqa: F401,F403
+from ._maps import __version__  # noqa: F401
 from ._study import *  # noqa: F401,F403

@@ -14,6 +14,7 @@ import numpy.typing as npt
 from ._maps import BinnedEnvMap, EnvMap
 
 _F32 = npt.NDArray[np.float32]
+_In = npt.ArrayLike  # real numbers of the documented shape; converted to float32 (a copy) unless it is C-contiguous float32
 _F64 = npt.NDArray[np.float64]
 BsdfLike = Union[str, "Bsdf"]
 TechniqueLike = Union[str, "Technique"]
@@ -50,11 +51,11 @@ class Bsdf:
     @property
     def alpha(self) -> float:
         """GGX's roughness (0 for the others)."""
-    def eval(self, wo: _F32, wi: _F32) -> _F32:
+    def eval(self, wo: _In, wi: _In) -> _F32:
         """float32 (N, 3) RGB f(wo, wi) cos(theta_i) for float32 (N, 3) local unit vectors."""
-    def pdf(self, wo: _F32, wi: _F32) -> _F32:
+    def pdf(self, wo: _In, wi: _In) -> _F32:
         """float32 (N,): solid-angle density (1/sr) of sample(wo) at wi, over the whole sphere."""
-    def sample(self, wo: _F32, u: _F32) -> tuple[_F32, _F32, _F32]:
+    def sample(self, wo: _In, u: _In) -> tuple[_F32, _F32, _F32]:
         """(wi (N, 3), pdf (N,), value (N, 3) = eval(wo, wi)) for wo (N, 3) and u (N, 2) in [0, 1)^2
         (every value 0 <= u < 1, NaN not: ValueError naming the first that is not)."""
     def __eq__(self, other: object) -> bool: ...
@@ -117,8 +118,8 @@ def compare(
     techniques: Optional[Techniques] = None,
     spp: int = 1024,
     points: int = 16,
-    normals: Optional[_F32] = None,
-    views: Optional[_F32] = None,
+    normals: Optional[_In] = None,
+    views: Optional[_In] = None,
     seed: int = 1,
     threads: int = 0,
     alpha: Union[None, float, Literal["auto"]] = None,
@@ -144,8 +145,8 @@ def exact_variances(
     bsdfs: Bsdfs = ("lambert", "phong:50", "ggx:0.1"),
     *,
     points: int = 16,
-    normals: Optional[_F32] = None,
-    views: Optional[_F32] = None,
+    normals: Optional[_In] = None,
+    views: Optional[_In] = None,
     env_samples: int = 1,
     bsdf_samples: int = 1,
     subdivisions: int = 1,
@@ -158,8 +159,8 @@ def choose_alpha(
     *,
     bsdfs: Bsdfs = ("lambert", "phong:50", "ggx:0.1"),
     points: int = 16,
-    normals: Optional[_F32] = None,
-    views: Optional[_F32] = None,
+    normals: Optional[_In] = None,
+    views: Optional[_In] = None,
     candidates: Optional[Sequence[float]] = None,
     env_samples: int = 1,
     bsdf_samples: int = 1,

@@ -262,26 +262,25 @@ py::array_t<float> lookup_plain(const EnvMap& map, const py::object& directions_
     return out;
 }
 
-// Normals for n points: float32 (n, 3), n the length of the other argument.
+// Normals for n points: (n, 3), n the length of the other argument, as float32.
 py::array_t<float, py::array::c_style> normals_for(const py::object& normals, const char* where, py::ssize_t n,
                                                    const char* other) {
     auto array = float_array(normals, where, "normals", {-1, 3});
     if (array.shape(0) != n)
         throw std::invalid_argument(
-            std::string(where) + ": normals must be a float32 array of shape (N, 3) with N = " + std::to_string(n) +
+            std::string(where) + ": normals must be an array of shape (N, 3) with N = " + std::to_string(n) +
             ", the length of " + other + "; got " + std::to_string(array.shape(0)) + " normals");
     return array;
 }
 
 // Picks among the bins around each normal: float32 (n,) in [0, 1).
-// One float32 per normal, each in [0, 1) or, with `closed`, [0, 1]; `name` in the messages.
+// One value per normal (as float32), each in [0, 1) or, with `closed`, [0, 1]; `name` in the messages.
 py::array_t<float, py::array::c_style> unit_values(const py::object& values, const char* where, const char* name,
                                                    py::ssize_t n, bool closed) {
     auto array = float_array(values, where, name, {-1});
     if (array.shape(0) != n)
-        throw std::invalid_argument(std::string(where) + ": " + name +
-                                    " must be a float32 array of shape (N,) with N = " + std::to_string(n) +
-                                    ", one per normal; got " + std::to_string(array.shape(0)));
+        throw std::invalid_argument(std::string(where) + ": " + name + " must be an array of shape (N,) with N = " +
+                                    std::to_string(n) + ", one per normal; got " + std::to_string(array.shape(0)));
     for (py::ssize_t i = 0; i < n; ++i) {
         const float x = array.data()[i];
         if (!(x >= 0.0f && (closed ? x <= 1.0f : x < 1.0f)))
@@ -539,6 +538,7 @@ PYBIND11_MODULE(_maps, m) {
                                                        py::arg("module") = "envmis._maps");
     samples.attr("__doc__") = docs::kSamples;
     m.attr("Samples") = samples;
+    m.attr("__version__") = ENVMIS_VERSION;
     bind_envmap(m);
     bind_binned(m);
     bind_functions(m);

@@ -10,9 +10,13 @@ Units and measures throughout: directions are unit vectors (float32, x, y, z) in
 map's world frame (its `axes`, z up by default); pdfs are densities per steradian of
 solid angle; radiance is linear RGB in the map's working colour space; image points uv
 are in [0, 1)^2 with u along the columns (azimuth for equirect) and v down the rows
-(v = 0 at the top, the +up pole). Every array in is float32 and C-contiguous; other
-dtypes are refused, never converted (a float64 direction rounded to float32 is another
-direction).)";
+(v = 0 at the top, the +up pole). Arrays in may be any array-like of real numbers (NumPy
+arrays of any integer or float dtype and strides, lists, tuples); the C++ library takes
+float32, so other dtypes and strided views are converted into a float32 copy (a float64
+value is rounded to float32: pass float32 to sample exactly what you hold), and a single
+vector where (N, k) is expected counts as one row. Outputs (out=) are never converted:
+they must be writeable C-contiguous float32 arrays of the exact shape. The version is
+envmis.__version__.)";
 
 inline constexpr const char* kImageError =
     "An image that cannot be read (missing, not an image, truncated, unknown colour space); "
@@ -48,7 +52,8 @@ radiance: float32 (H, W, 3), linear RGB in `colorspace` (default: the working sp
     and negative channel values are replaced by 0 and counted in stats["bad_pixels"].
 compensate, alpha, axes, mapping, working_space: as envmis.load(); alpha defaults to 1.
 The map's source is {"name": "array", "content_hash": hash64 of the array's bytes, ...}.
-Raises ValueError for an array of another dtype or shape, an empty one, invalid options,
+radiance of another dtype or strides is converted to float32 on the way (one more copy).
+Raises ValueError for an array of another shape or of non-real values, an empty one, invalid options,
 or pixels whose power overflows float32 (the message says by how much to scale them).
 Cost: O(H W), parallel over rows.)";
 

@@ -20,44 +20,65 @@ namespace envmis::python {
 
 namespace py = pybind11;
 
-// A C-contiguous float32 array. `shape` lists the expected extents, -1 for any
-// ("(N, 3)" is {-1, 3}), named in the message by `symbols` in turn ("HW": "(H, W, 3)"). Throws ValueError
-// (std::invalid_argument) otherwise: "envmis.EnvMap.sample: u must be a float32 array of shape (N, 2); got a float64
-// array of shape (10, 2)". Arrays of another dtype are never converted silently: a float64 array of directions rounded
-// to float32 would give other samples than the caller's values.
+namespace detail {
+
+// "(N, 3)" for {-1, 3}: each -1 named by the next of `symbols`.
+inline std::string shape_text(std::initializer_list<py::ssize_t> shape, std::string_view symbols) {
+    std::string text = "(";
+    size_t symbol = 0;
+    for (const py::ssize_t extent : shape) {
+        if (text.size() > 1) text += ", ";
+        text += extent < 0 ? std::string(1, symbols.at(symbol++)) : std::to_string(extent);
+    }
+    return text + (shape.size() == 1 ? ",)" : ")");
+}
+
+// "a float64 array of shape (10, 2)", or "a <class 'list'>" for what is not an array.
+inline std::string given_text(const py::handle& object) {
+    if (!py::isinstance<py::array>(object)) return "a " + py::str(py::type::of(object)).cast<std::string>();
+    const auto array = py::reinterpret_borrow<py::array>(object);
+    std::string shape = "(";
+    for (py::ssize_t d = 0; d < array.ndim(); ++d) shape += (d ? ", " : "") + std::to_string(array.shape(d));
+    shape += array.ndim() == 1 ? ",)" : ")";
+    return "a " + py::str(array.dtype()).cast<std::string>() + " array of shape " + shape;
+}
+
+inline bool has_shape(const py::array& array, std::initializer_list<py::ssize_t> shape) {
+    bool fits = array.ndim() == static_cast<py::ssize_t>(shape.size());
+    for (size_t d = 0; fits && d < shape.size(); ++d)
+        fits = shape.begin()[d] < 0 || array.shape(static_cast<py::ssize_t>(d)) == shape.begin()[d];
+    return fits;
+}
+
+}  // namespace detail
+
+// An input argument: any array-like of real numbers (a NumPy array of any integer or
+// floating dtype and any strides, a list, a tuple: what np.asarray takes) of `shape`,
+// whose extents are listed with -1 for any ("(N, 3)" is {-1, 3}, named in messages by
+// `symbols` in turn), as a C-contiguous float32 array: the argument itself where it is
+// one already, else a converted copy, its values rounded to float32 as the C++ API takes
+// them. Where the shape is (N, k), a single vector of k values is one row (N = 1).
+// Throws ValueError (std::invalid_argument) otherwise, naming the argument, the expected
+// shape and what was given: "envmis.EnvMap.sample: u must be an array of real numbers of
+// shape (N, 2); got a float32 array of shape (10, 3)". Booleans, complex numbers and
+// strings are refused rather than cast.
 inline py::array_t<float, py::array::c_style> float_array(const py::handle& object, const char* where, const char* name,
                                                           std::initializer_list<py::ssize_t> shape,
                                                           std::string_view symbols = "NM") {
-    std::string expected = "(";
-    size_t symbol = 0;
-    for (const py::ssize_t extent : shape) {
-        if (expected.size() > 1) expected += ", ";
-        expected += extent < 0 ? std::string(1, symbols.at(symbol++)) : std::to_string(extent);
-    }
-    expected += shape.size() == 1 ? ",)" : ")";
-    auto fail = [&](const std::string& given) {
-        throw std::invalid_argument(std::string(where) + ": " + name + " must be a float32 array of shape " + expected +
-                                    "; got " + given);
+    auto fail = [&](const py::handle& given) {
+        throw std::invalid_argument(std::string(where) + ": " + name + " must be an array of real numbers of shape " +
+                                    detail::shape_text(shape, symbols) + "; got " + detail::given_text(given));
     };
-    if (!py::isinstance<py::array>(object)) fail(std::string("a ") + py::str(py::type::of(object)).cast<std::string>());
-    const auto array = py::reinterpret_borrow<py::array>(object);
-    std::string given = "(";
-    for (py::ssize_t d = 0; d < array.ndim(); ++d) {
-        if (d) given += ", ";
-        given += std::to_string(array.shape(d));
-    }
-    given += array.ndim() == 1 ? ",)" : ")";
-    const std::string dtype = py::str(array.dtype()).cast<std::string>();
-    bool fits = array.dtype().equal(py::dtype::of<float>()) && array.ndim() == static_cast<py::ssize_t>(shape.size());
-    for (size_t d = 0; fits && d < shape.size(); ++d) {
-        const py::ssize_t extent = shape.begin()[d];
-        fits = extent < 0 || array.shape(static_cast<py::ssize_t>(d)) == extent;
-    }
-    if (!fits) fail("a " + dtype + " array of shape " + given);
-    if (!(array.flags() & py::array::c_style))
-        fail("a non-contiguous " + dtype + " array of shape " + given +
-             " (np.ascontiguousarray makes a contiguous copy)");
-    return py::reinterpret_borrow<py::array_t<float, py::array::c_style>>(array);
+    py::array array = py::isinstance<py::array>(object) ? py::reinterpret_borrow<py::array>(object)
+                                                         : py::array::ensure(object);
+    if (!array) fail(object);
+    if (const char kind = array.dtype().kind(); kind != 'f' && kind != 'i' && kind != 'u')
+        fail(py::isinstance<py::array>(object) ? py::handle(array) : object);
+    if (shape.size() == 2 && shape.begin()[0] < 0 && array.ndim() == 1 && array.shape(0) == shape.begin()[1])
+        array = array.reshape({py::ssize_t{1}, shape.begin()[1]});
+    if (!detail::has_shape(array, shape)) fail(array);
+    using Converted = py::array_t<float, py::array::c_style | py::array::forcecast>;
+    return py::reinterpret_steal<py::array_t<float, py::array::c_style>>(Converted::ensure(array).release());
 }
 
 // Throws ValueError unless every value of `u`, a C-contiguous float32 (N, 2) array, is in
@@ -90,14 +111,24 @@ inline void check_unit_points(const py::array_t<float, py::array::c_style>& u, c
     }
 }
 
-// An output argument: as float_array, and writeable (a read-only array, a view of a
-// map's radiance say, raises ValueError naming it rather than NumPy's unnamed message).
+// An output argument (out=): a C-contiguous float32 array of `shape` exactly, never
+// converted (the results must land in the caller's array), and writeable. Throws
+// ValueError naming it otherwise ("out.uv must be a float32 array of shape (100, 2); got a
+// float32 array of shape (99, 2)"; "... is not writeable" for a view of a map's radiance).
 inline py::array_t<float, py::array::c_style> writeable_float_array(const py::handle& object, const char* where,
                                                                     const char* name,
                                                                     std::initializer_list<py::ssize_t> shape) {
-    auto array = float_array(object, where, name, shape);
+    const auto fail = [&](const std::string& why) {
+        throw std::invalid_argument(std::string(where) + ": " + name + " must be a float32 array of shape " +
+                                    detail::shape_text(shape, "NM") + "; got " + why);
+    };
+    if (!py::isinstance<py::array>(object)) fail(detail::given_text(object));
+    const auto array = py::reinterpret_borrow<py::array>(object);
+    if (!array.dtype().equal(py::dtype::of<float>()) || !detail::has_shape(array, shape))
+        fail(detail::given_text(array));
+    if (!(array.flags() & py::array::c_style)) fail("a non-contiguous " + detail::given_text(array).substr(2));
     if (!array.writeable()) throw std::invalid_argument(std::string(where) + ": " + name + " is not writeable");
-    return array;
+    return py::reinterpret_borrow<py::array_t<float, py::array::c_style>>(array);
 }
 
 // A new float32 array of `shape`, C-contiguous, uninitialised: an output to fill.

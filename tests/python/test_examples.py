@@ -59,3 +59,23 @@ def test_an_example_given_a_missing_map_fails_with_one_clear_line(tmp_path, scri
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(script + ": ") and "missing.hdr" in lines[0], result.stderr
     assert not (tmp_path / "out.png").exists()
+
+
+def test_the_readmes_python_snippet_run_as_written_saves_a_picture_of_the_sun_and_the_sky(tmp_path):
+    with open(os.path.join(SOURCE, "README.md"), encoding="utf-8") as f:
+        readme = f.read()
+    snippet = re.search(r"## Python\n.*?```python\n(.*?)```", readme, re.S).group(1)
+    os.symlink(os.path.join(SOURCE, "data"), tmp_path / "data")  # its paths are relative to the checkout
+    env = dict(os.environ, MPLBACKEND="Agg", OCIO=os.path.join(SOURCE, "data", "ocio", "config.ocio"))
+    result = subprocess.run([sys.executable, "-c", snippet], cwd=tmp_path, capture_output=True, text=True, env=env,
+                            timeout=120)
+    assert result.returncode == 0, result.stderr
+    import matplotlib.image
+    import numpy as np
+    picture = (matplotlib.image.imread(tmp_path / "samples.png")[..., :3] * 255).astype(int)
+    # The histogram's own colours, left of where a colour bar would be: a linear scale on a
+    # sunny map draws nearly every bin in the darkest colour (3 distinct colours, measured),
+    # a log scale the sky's gradations and the horizon too (45).
+    axes = picture[:, : int(0.7 * picture.shape[1])].reshape(-1, 3)
+    coloured = axes[axes.max(axis=1) - axes.min(axis=1) > 40]
+    assert len(np.unique(coloured // 8, axis=0)) >= 20

@@ -263,28 +263,60 @@ def test_nan_infinite_and_negative_pixels_are_replaced_and_counted():
 @pytest.mark.parametrize(
     "u, given",
     [
-        (np.zeros((10, 2), np.float64), "a float64 array of shape (10, 2)"),
         (np.zeros((10, 3), np.float32), "a float32 array of shape (10, 3)"),
         (np.zeros(10, np.float32), "a float32 array of shape (10,)"),
-        (np.zeros((2, 10), np.float32).T, "a non-contiguous float32 array of shape (10, 2)"),
-        ([[0.5, 0.5]], "a <class 'list'>"),
+        (np.zeros((10, 2), complex), "a complex128 array of shape (10, 2)"),
+        (np.zeros((10, 2), bool), "a bool array of shape (10, 2)"),
+        ([[0.5, 0.5, 0.5]], "a float64 array of shape (1, 3)"),
+        ("points", "a <class 'str'>"),
+        (None, "a <class 'NoneType'>"),
     ],
 )
-def test_points_of_another_dtype_or_shape_are_rejected_with_a_clear_message(small_maps, u, given):
+def test_points_of_another_shape_or_of_non_real_values_are_rejected_with_a_clear_message(small_maps, u, given):
     with pytest.raises(ValueError) as error:
         small_maps["plain"].sample(u)
-    assert str(error.value).startswith(
-        f"envmis.EnvMap.sample: u must be a float32 array of shape (N, 2); got {given}"
-    )
+    assert str(error.value) == f"envmis.EnvMap.sample: u must be an array of real numbers of shape (N, 2); got {given}"
 
 
 def test_directions_and_radiance_of_another_shape_are_rejected(small_maps):
-    with pytest.raises(ValueError, match=r"envmis.EnvMap.pdf: directions must be a float32 array of shape \(N, 3\)"):
+    with pytest.raises(ValueError, match=r"envmis.EnvMap.pdf: directions must be an array of real numbers of shape \(N, 3\)"):
         small_maps["plain"].pdf(np.zeros((4, 2), np.float32))
-    with pytest.raises(ValueError, match=r"envmis.EnvMap.eval: directions .* got a float64"):
-        small_maps["plain"].eval(np.zeros((4, 3)))
-    with pytest.raises(ValueError, match=r"envmis.EnvMap: radiance must be a float32 array of shape \(H, W, 3\); got a float32 array of shape \(8, 16, 4\)"):
+    with pytest.raises(ValueError, match=r"envmis.EnvMap.eval: directions .* got a complex128"):
+        small_maps["plain"].eval(np.zeros((4, 3), complex))
+    with pytest.raises(ValueError, match=r"envmis.EnvMap: radiance must be an array of real numbers of shape \(H, W, 3\); got a float32 array of shape \(8, 16, 4\)"):
         envmis.EnvMap(np.zeros((8, 16, 4), np.float32))
+
+
+def test_float64_lists_strided_views_and_single_vectors_give_the_results_of_float32_arrays(small_maps):
+    # Values that float32 holds exactly, so that the conversion changes nothing.
+    u = envmis.uniform_points(64, seed=2)
+    env = small_maps["compensated"]
+    expected = env.sample(u)
+    wide = np.zeros((64, 4), np.float32)
+    wide[:, ::2] = u
+    for given in (u.astype(np.float64), u.tolist(), wide[:, ::2], np.asfortranarray(u)):
+        got = env.sample(given)
+        for a, b in zip(got, expected):
+            assert np.array_equal(a, b)
+    d = expected.direction
+    assert np.array_equal(env.pdf(d.astype(np.float64)), env.pdf(d))
+    assert np.array_equal(env.eval(d[::-1][::-1].tolist()), env.eval(d))
+    assert np.array_equal(env.pdf(d[5]), env.pdf(d[5:6]))  # a single (3,) direction is one row
+    assert env.pdf(tuple(float(x) for x in d[5])).shape == (1,)
+    radiance = np.random.default_rng(1).random((8, 16, 3)).astype(np.float32)
+    built32, built64 = envmis.EnvMap(radiance), envmis.EnvMap(radiance.astype(np.float64))
+    assert np.array_equal(built32.density, built64.density)
+    assert np.array_equal(envmis.EnvMap(radiance[::-1][::-1]).density, built32.density)
+    # out= is never converted: results must land in the caller's float32 arrays.
+    out = env.sample(u)
+    with pytest.raises(ValueError, match=r"out.pdf must be a float32 array of shape \(64,\); got a float64"):
+        env.sample(u, out=out._replace(pdf=np.zeros(64)))
+
+
+@needs_cli
+def test_the_version_is_the_projects():
+    assert envmis.__version__ == subprocess.run([CLI, "--version"], capture_output=True, text=True,
+                                               check=True).stdout.split()[-1]
 
 
 def test_directions_and_normals_that_are_not_finite_or_zero_give_nan_and_the_others_do_not():
@@ -322,11 +354,13 @@ def test_a_binned_map_samples_with_the_pdf_it_reports_and_checks_its_normals():
     plain = binned.plain
     assert isinstance(plain, envmis.EnvMap) and not plain.compensated and plain.width == binned.width
     u = envmis.uniform_points(4, seed=1)
-    with pytest.raises(ValueError, match=r"normals must be a float32 array of shape \(N, 3\) with N = 4"):
+    with pytest.raises(ValueError, match=r"normals must be an array of shape \(N, 3\) with N = 4"):
         binned.sample(u, normals[:3], choices[:4])
-    with pytest.raises(ValueError, match=r"normals must be a float32 array of shape \(N, 3\); got a float64"):
-        binned.pdf(np.zeros((4, 3), np.float32), np.zeros((4, 3)), choices[:4])
-    with pytest.raises(ValueError, match=r"choices must be a float32 array of shape \(N,\) with N = 4"):
+    with pytest.raises(ValueError, match=r"normals must be an array of real numbers of shape \(N, 3\); got a float32 array of shape \(4, 2\)"):
+        binned.pdf(np.zeros((4, 3), np.float32), np.zeros((4, 2), np.float32), choices[:4])
+    assert np.array_equal(binned.pdf(s.direction[:4], normals[:4].astype(np.float64), choices[:4].tolist(), lobe),
+                          binned.pdf(s.direction[:4], normals[:4], choices[:4], lobe))
+    with pytest.raises(ValueError, match=r"choices must be an array of shape \(N,\) with N = 4"):
         binned.sample(u, normals[:4], choices[:3])
     with pytest.raises(ValueError, match=r"choices"):
         binned.sample(u, normals[:4], np.full(4, 1.0, np.float32))
@@ -351,7 +385,7 @@ def test_glossy_bins_seen_obliquely_sample_and_weigh_by_their_view_cosines():
     s = binned.sample(u, normals, choices, 1, view_cos=view_cos)
     agree = np.abs(binned.pdf(s.direction, normals, choices, 1, view_cos=view_cos) / s.pdf - 1) < 1e-4
     assert np.mean(agree) > 0.995
-    with pytest.raises(ValueError, match=r"view_cos must be a float32 array of shape \(N,\) with N = 2000"):
+    with pytest.raises(ValueError, match=r"view_cos must be an array of shape \(N,\) with N = 2000"):
         binned.sample(u, normals, choices, 1, view_cos=view_cos[:3])
     with pytest.raises(ValueError, match=r"view_cos\[0\] = 1.5.* is outside \[0, 1\]"):
         binned.pdf(s.direction, normals, choices, 1, view_cos=np.full(2000, 1.5, np.float32))

@@ -251,9 +251,10 @@ def test_a_count_out_of_range_is_refused_with_a_clear_message(env, arguments, me
 
 
 @pytest.mark.parametrize("normals, views, message", [
-    (np.zeros((4, 3)), None, "normals must be a float32 array of shape (N, 3); got a float64 array of shape (4, 3)"),
-    (np.ones((4, 2), np.float32), None, "normals must be a float32 array of shape (N, 3); got a float32 array of "
-                                        "shape (4, 2)"),
+    (np.zeros((4, 3), complex), None, "normals must be an array of real numbers of shape (N, 3); got a complex128 "
+                                      "array of shape (4, 3)"),
+    (np.ones((4, 2), np.float32), None, "normals must be an array of real numbers of shape (N, 3); got a float32 "
+                                        "array of shape (4, 2)"),
     (np.full((2, 3), 0.5, np.float32), None, "normals[0] must be a unit vector; got length 0.866025"),
     (envmis.sphere_points(4), envmis.sphere_points(3), "views must have as many rows as normals (4); got 3"),
     (None, envmis.sphere_points(4), "views needs normals"),
