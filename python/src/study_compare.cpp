@@ -154,7 +154,8 @@ the map's radiance units) on every BSDF at every shading point, spp estimates ea
 every technique spending env_samples + bsdf_samples samples per estimate (equal sample
 count). Each BSDF samples its own compensated map (alpha). The same arguments and seed
 give the same records as `envmis compare MAP --json` (every key but the measured
-timings ns_per_estimate and efficiency), whatever the number of threads.
+timings ns_per_estimate, efficiency and efficiency_ratio_vs_mis), whatever the number of
+threads.
 
 map: an envmis.EnvMap; its radiance is studied (rebuilt without compensation where it
   has some); its own compensation strength is only the default of alpha.
@@ -195,8 +196,9 @@ records: compare --json's "results": a dict per BSDF and technique (in that orde
   bsdf, technique, alpha, estimates, mean, reference (luminance of L_o, the map's
   radiance units), variance (of ONE estimate, radiance units squared, mean over
   points), std_error, rel_mse, ns_per_estimate, efficiency, variance_ratio_vs_mis
-  (geometric mean over points of variance / that of mis-balance),
-  variance_ratio_log_std_error, ill_conditioned_points, point_variances and
+  (geometric mean over points of variance / that of mis-balance), variance_ratio_worst
+  (the largest of those per-point ratios), efficiency_ratio_vs_mis (at equal time, > 1
+  better), variance_ratio_log_std_error, ill_conditioned_points, point_variances and
   point_variance_rel_se (per point, in point order). A non-finite value is None, as in
   the JSON file.
 inputs: compare --json's "inputs" (map, width, height, alpha, alpha_auto, bsdf_alpha,

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -199,6 +200,52 @@ TEST(Compare, BinsTechniquesAreReportedWithTheirExactRatios) {
         EXPECT_DOUBLE_EQ(*std::max_element(points.begin(), points.end()), bins["worst"].get<double>());
         EXPECT_FALSE(results["exact"][bsdf].contains("mis-optimal-bins")) << "optimal MIS has no exact variance";
     }
+    fs::remove_all(dir);
+}
+
+// The table's columns tell one story: per-point ratios to mis-balance first (their
+// geometric mean, the worst point, the same at equal time), each defined in --help; the
+// lines under it compare the normal-aware and the global table against mis-balance.
+TEST(Compare, TheHeadlineColumnsArePerPointRatiosToMisBalanceAndHelpDefinesEveryColumn) {
+    const fs::path dir = small_map_folder("envmis_compare_columns_test");
+    const CliRun r = run_compare(dir,
+                                 "--bins 16 --points 5 --spp 256 --bsdf lambert,phong:20 --json r.json "
+                                 "--techniques mis-balance,mis-balance-comp,mis-balance-bins");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const size_t begin = r.out.find("\nbsdf ") + 1;
+    const std::string header = r.out.substr(begin, r.out.find('\n', begin) - begin);
+    const CliRun help = run_compare(dir, "--help");
+    std::istringstream headings(header);
+    std::vector<std::string> columns(std::istream_iterator<std::string>(headings), {});
+    ASSERT_EQ(columns.size(), 10u) << header;
+    EXPECT_EQ(columns[2], "var/mis");
+    for (size_t i = 2; i < columns.size(); ++i)
+        EXPECT_NE(help.out.find("\n  " + columns[i] + " "), std::string::npos) << columns[i] << " undefined in --help";
+
+    const nlohmann::json results = nlohmann::json::parse(std::ifstream(dir / "r.json"))["results"];
+    for (size_t b = 0; b < 2; ++b) {
+        const nlohmann::json& mis = results[3 * b];
+        ASSERT_EQ(mis["technique"], "mis-balance");
+        EXPECT_EQ(mis["variance_ratio_worst"].get<double>(), 1.0);
+        EXPECT_EQ(mis["efficiency_ratio_vs_mis"].get<double>(), 1.0);
+        for (size_t t = 1; t < 3; ++t) {
+            const nlohmann::json& s = results[3 * b + t];
+            const auto v = s["point_variances"].get<std::vector<double>>();
+            const auto v_mis = mis["point_variances"].get<std::vector<double>>();
+            double worst = 0, log_sum = 0;
+            for (size_t p = 0; p < v.size(); ++p)
+                worst = std::max(worst, v[p] / v_mis[p]), log_sum += std::log(v[p] / v_mis[p]);
+            const double ratio = s["variance_ratio_vs_mis"];
+            EXPECT_NEAR(ratio, std::exp(log_sum / v.size()), 1e-9 * ratio);
+            EXPECT_NEAR(s["variance_ratio_worst"].get<double>(), worst, 1e-9 * worst);
+            const double equal_time =
+                mis["ns_per_estimate"].get<double>() / (ratio * s["ns_per_estimate"].get<double>());
+            EXPECT_NEAR(s["efficiency_ratio_vs_mis"].get<double>(), equal_time, 1e-9 * equal_time);
+        }
+    }
+    EXPECT_NE(r.out.find("lambert: against mis-balance, the normal-aware table (mis-balance-bins) "), std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("; the global compensated table (mis-balance-comp) "), std::string::npos) << r.out;
     fs::remove_all(dir);
 }
 

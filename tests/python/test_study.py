@@ -18,7 +18,7 @@ import pytest
 import envmis
 
 CLI = os.environ.get("ENVMIS_CLI", "")
-TIMING_KEYS = {"ns_per_estimate", "efficiency"}
+TIMING_KEYS = {"ns_per_estimate", "efficiency", "efficiency_ratio_vs_mis"}
 STUDY_BSDFS = "lambert,phong:20,ggx:0.2"
 STUDY_TECHNIQUES = "env,bsdf,mis-balance,mis-power,mis-balance-comp,mis-optimal-comp,one-sample,mis-balance-bins"
 

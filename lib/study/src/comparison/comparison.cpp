@@ -30,7 +30,6 @@ constexpr uint64_t kChunksPerStopCheck = 64;
 struct Cell {
     RunningStats estimates, squared_relative_error;
     RunningStats batches[kBatches];
-    double seconds = 0;
     bool ill_conditioned = false;  // optimal MIS ended on balance weights
 };
 
@@ -127,6 +126,13 @@ std::vector<double> exact_point_variances(const StudyInputs& inputs, const Techn
 
 namespace {
 
+// The middle value (the upper of the two middle ones for an even count); 0 for none.
+double median(std::vector<double> values) {
+    if (values.empty()) return 0;
+    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+    return values[values.size() / 2];
+}
+
 // A cell's random stream, from the point's index and the technique's name rather than
 // its place in the list, so that a technique's numbers are the same whichever others run
 // beside it; the BSDFs at a point share it, so that one differing only in albedo gives
@@ -136,11 +142,46 @@ uint64_t cell_stream(size_t point, const Technique& technique) {
     return hash64(std::as_bytes(std::span(key.data(), key.size())));
 }
 
-// The cells of a run over `done` points: one per (point, BSDF, technique), and the
-// reference of each (point, BSDF).
+// The timing: kTimingRounds rounds over up to kTimedPoints of the run's points, at each
+// (round, point, BSDF) every technique in turn for kTimedEstimates estimates, on one
+// thread once the run's cells are done (cells timed while they share the cores with
+// each other vary by +-20% from run to run).
+constexpr size_t kTimedPoints = 8, kTimingRounds = 5;
+constexpr uint64_t kTimedEstimates = 256;
+
+// Each technique's seconds per estimate on each BSDF, [b * nt + t]: the median over its
+// rounds and points; all 0 once `stop` is set (checked every round).
+std::vector<double> timed_seconds(const std::vector<DirectLightingEstimator>& estimators,
+                                  std::span<const ShadingPoint> points, const ComparisonOptions& options,
+                                  const std::atomic<bool>* stop) {
+    const size_t nb = options.bsdfs.size(), nt = estimators.size(), np = std::min(points.size(), kTimedPoints);
+    std::vector<std::vector<double>> samples(nb * nt);
+    Rgb chunk[kChunk];
+    for (size_t round = 0; round < kTimingRounds; ++round) {
+        if (stop && stop->load()) return std::vector<double>(nb * nt);
+        for (size_t p = 0; p < np; ++p)
+            for (size_t b = 0; b < nb; ++b)
+                for (size_t t = 0; t < nt; ++t) {
+                    Pcg32 rng(options.seed + round, cell_stream(p, options.techniques[t]));
+                    PointState state;
+                    const auto start = std::chrono::steady_clock::now();
+                    for (uint64_t done = 0; done < kTimedEstimates; done += kChunk)
+                        estimators[t].estimate(points[p], options.bsdfs[b], rng, state, {chunk, kChunk});
+                    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+                    samples[b * nt + t].push_back(elapsed.count() / kTimedEstimates);
+                }
+    }
+    std::vector<double> seconds;
+    for (const std::vector<double>& s : samples) seconds.push_back(median(s));
+    return seconds;
+}
+
+// The cells of a run over `done` points: one per (point, BSDF, technique), the
+// reference of each (point, BSDF) and each (BSDF, technique)'s timed seconds per estimate.
 struct CellTable {
     const std::vector<Cell>& cells;
     const std::vector<double>& references;
+    const std::vector<double>& seconds;
     size_t done, nb, nt;
     const Cell& at(size_t p, size_t b, size_t t) const { return cells[(p * nb + b) * nt + t]; }
 };
@@ -153,7 +194,7 @@ TechniqueStats technique_stats(const CellTable& table, size_t b, size_t t, size_
     TechniqueStats s;
     s.technique = technique;
     RunningStats rel;
-    double seconds = 0, variance_sum = 0, log_ratio = 0, log_ratio_se2 = 0;
+    double variance_sum = 0, log_ratio = 0, log_ratio_se2 = 0;
     size_t ratios = 0;
     for (size_t p = 0; p < done; ++p) {
         const Cell& c = table.at(p, b, t);
@@ -162,7 +203,6 @@ TechniqueStats technique_stats(const CellTable& table, size_t b, size_t t, size_
         s.variance += c.estimates.variance() / done;
         variance_sum += c.estimates.variance() / c.estimates.count();
         rel.merge(c.squared_relative_error);
-        seconds += c.seconds;
         s.estimates += c.estimates.count();
         s.ill_conditioned_points += c.ill_conditioned;
         s.point_variances.push_back(c.estimates.variance());
@@ -173,14 +213,19 @@ TechniqueStats technique_stats(const CellTable& table, size_t b, size_t t, size_
             if (v > 0 && v_mis > 0) {
                 log_ratio += std::log(v / v_mis), ++ratios;
                 log_ratio_se2 += square(relative_standard_error(c)) + square(relative_standard_error(mis));
+                s.variance_ratio_worst = std::max(s.variance_ratio_worst, v / v_mis);
             }
         }
     }
     s.std_error = std::sqrt(variance_sum) / done;
     s.rel_mse = rel.mean();
-    s.ns_per_estimate = 1e9 * seconds / static_cast<double>(s.estimates);
-    s.efficiency = s.variance > 0 ? 1 / (s.variance * seconds / static_cast<double>(s.estimates)) : 0;
+    const double seconds = table.seconds[b * nt + t];
+    s.ns_per_estimate = 1e9 * seconds;
+    s.efficiency = s.variance > 0 && seconds > 0 ? 1 / (s.variance * seconds) : 0;
     s.variance_ratio_vs_mis = t == mis_index ? 1.0 : (ratios ? std::exp(log_ratio / ratios) : 0);
+    if (t == mis_index) s.variance_ratio_worst = 1.0;
+    if (mis_index < nt && s.variance_ratio_vs_mis > 0 && seconds > 0)
+        s.efficiency_ratio_vs_mis = table.seconds[b * nt + mis_index] / (s.variance_ratio_vs_mis * seconds);
     s.variance_ratio_log_std_error = ratios ? std::sqrt(log_ratio_se2) / static_cast<double>(ratios) : 0;
     return s;
 }
@@ -236,9 +281,7 @@ Comparison compare_one(const EnvMap& plain, const EnvMap& compensated, const Bin
                     if (begin % (kChunk * kChunksPerStopCheck) == 0 && stop && stop->load(std::memory_order_relaxed))
                         return;
                     const uint64_t count = std::min<uint64_t>(kChunk, options.spp - begin);
-                    const auto start = std::chrono::steady_clock::now();
                     estimators[t].estimate(point, options.bsdfs[b], rng, state, {chunk, count});
-                    cell.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
                     for (uint64_t i = begin; i < begin + count; ++i) {
                         const double x = luminance(chunk[i - begin], luma);
                         cell.estimates.add(x);
@@ -267,7 +310,8 @@ Comparison compare_one(const EnvMap& plain, const EnvMap& compensated, const Bin
 
     Comparison result{{}, done, points.size()};
     if (done == 0) return result;
-    const CellTable table{cells, references, done, nb, nt};
+    const std::vector<double> seconds = timed_seconds(estimators, points.first(done), options, stop);
+    const CellTable table{cells, references, seconds, done, nb, nt};
     size_t mis_index = nt;
     for (size_t t = 0; t < nt; ++t)
         if (options.techniques[t] == Technique::parse("mis-balance")) mis_index = t;

@@ -17,13 +17,22 @@
 namespace envmis {
 
 // A figure of TechniqueStats by key: mean, reference, variance, std_error, rel_mse,
-// ns_per_estimate, efficiency, variance_ratio_vs_mis, variance_ratio_log_std_error.
+// ns_per_estimate, efficiency, variance_ratio_vs_mis, variance_ratio_worst,
+// efficiency_ratio_vs_mis, variance_ratio_log_std_error.
 // Throws std::invalid_argument for another key.
 double stats_figure(const TechniqueStats& stats, std::string_view key);
 
 // The figures of compare's table and CSV, and those of the sweeps' tables, JSON and CSV.
-inline constexpr const char* kCompareFigures[] = {"mean",    "reference",       "variance",   "std_error",
-                                                  "rel_mse", "ns_per_estimate", "efficiency", "variance_ratio_vs_mis"};
+inline constexpr const char* kCompareFigures[] = {"mean",
+                                                  "reference",
+                                                  "variance",
+                                                  "std_error",
+                                                  "rel_mse",
+                                                  "ns_per_estimate",
+                                                  "efficiency",
+                                                  "variance_ratio_vs_mis",
+                                                  "variance_ratio_worst",
+                                                  "efficiency_ratio_vs_mis"};
 inline constexpr const char* kSweepFigures[] = {"variance", "variance_ratio_vs_mis", "ns_per_estimate", "efficiency"};
 
 // A column of a text table: the figure's key, its heading, its width (0: none) and its
@@ -36,7 +45,8 @@ struct StatsColumn {
     bool dash = false;
 };
 
-// The columns of compare's table (kCompareFigures, as compare has always printed them).
+// The columns of compare's table: var/mis, worst, eff/mis, mean, std_error, reference,
+// rel_mse, ns/est.
 std::span<const StatsColumn> compare_columns();
 
 // One value as a cell of `column`: formatted, right-aligned to its width.

@@ -47,10 +47,26 @@ struct ComparisonOptions {
     static std::vector<Technique> default_techniques();
 };
 
+// A technique's figures on one BSDF over the shading points. Each point is its own case
+// (a bright normal's variance would otherwise swamp the others), so the headline figures
+// are per-point ratios to mis-balance, summarised by their geometric mean; 0 where they
+// are undefined (no mis-balance in the run, a variance of 0).
 struct TechniqueStats {
     Technique technique;
+    // mean and reference: the estimates' mean and the quadrature reference (luminance of
+    // the reflected radiance, the map's units), averaged over points; std_error the mean's
+    // standard error; variance the variance of one estimate, averaged over points;
+    // rel_mse the mean over estimates of ((estimate - reference) / reference)^2, the
+    // relative mean squared error of one estimate (its bias included).
     double mean = 0, reference = 0, variance = 0, std_error = 0, rel_mse = 0;
-    double ns_per_estimate = 0, efficiency = 0, variance_ratio_vs_mis = 0;
+    // ns_per_estimate: time per estimate, timed apart from the run on one thread, the
+    // techniques interleaved at each of up to 8 of the points, 5 rounds of 256 estimates,
+    // the median (0 in a run stopped early); efficiency: 1 / (variance x that time in s).
+    double ns_per_estimate = 0, efficiency = 0;
+    // Per point: variance / mis-balance's, geometric mean and worst (largest) over points;
+    // efficiency_ratio_vs_mis: at equal time, mis-balance's time per estimate /
+    // (variance_ratio_vs_mis x this technique's): > 1 is better.
+    double variance_ratio_vs_mis = 0, variance_ratio_worst = 0, efficiency_ratio_vs_mis = 0;
     uint64_t estimates = 0;
     double variance_ratio_log_std_error = 0;
     // Optimal MIS: points whose linear system stayed singular, so that their estimates
