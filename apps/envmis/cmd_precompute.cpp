@@ -138,21 +138,29 @@ nlohmann::json precompute_one(const PrecomputeArgs& args, const LibraryItem& ite
         throw std::runtime_error(item.input.string() + ": is already a table; give an image");
     }
     check_map_memory(item.input, args.compact ? kCompactPeak : kFullPeak);
+    // A line per stage ("reading   0%", then "reading 100%" as the next starts), the
+    // table's writing last.
     std::optional<Progress> progress;
-    if (show_progress && args.bins != 0) progress.emplace("building bins", 1);
-    BuiltMap built = build_map(item.input, precompute_request(args), &interrupted());
-    progress.reset();
+    const auto next_stage = [&](std::string_view stage) {
+        if (!show_progress) return;
+        if (progress) progress->update(1);
+        progress.emplace(std::string(stage), 1);
+    };
+    BuiltMap built = build_map(item.input, precompute_request(args), &interrupted(), next_stage);
     for (const std::string& notice : built.notices) notes << "note: " << printable(notice) << "\n";
     const LoadedMap loaded = loaded_map(built);
     const BinnedEnvMap* binned = built.binned ? &*built.binned : nullptr;
     const EnvMap& map = binned ? binned->plain() : loaded.map;
     const TableEncoding encoding = args.compact ? TableEncoding::compact : TableEncoding::full;
+    next_stage("writing");
     const auto start = std::chrono::steady_clock::now();
     if (binned)
         write_table(item.output, *binned, loaded.source, encoding, &interrupted());
     else
         write_table(item.output, map, loaded.source, encoding, &interrupted());
     const double write_ms = milliseconds_since(start);
+    if (progress) progress->update(1);
+    progress.reset();
     print_precompute(out, args, item, loaded, map, binned, built.bins_ms, write_ms);
     nlohmann::json details = table_details(loaded, map, write_ms);
     if (binned) details["bins_build_ms"] = built.bins_ms;

@@ -38,7 +38,10 @@ EnvMapOptions map_options(const BuildRequest& r, LumaCoefficients luma) {
 // The map of loaded pixels into `built`; what EnvMap refuses in them (their power
 // overflowing float) is the source's fault and names it.
 void build_pixels(RgbImage image, const BuildRequest& r, LumaCoefficients luma, const std::string& name, StopFlag stop,
-                  BuiltMap& built) {
+                  const StageCallback& on_stage, BuiltMap& built) {
+    const auto stage = [&](std::string_view name) {
+        if (on_stage) on_stage(name);
+    };
     EnvMapOptions options = map_options(r, luma);
     if (options.mapping == Mapping::equal_area && image.width != image.height)
         throw std::invalid_argument(name + ": an equal-area map must be square, this one is " +
@@ -50,9 +53,11 @@ void build_pixels(RgbImage image, const BuildRequest& r, LumaCoefficients luma, 
         // With bins the texels keep the plain density; the compensation goes into the bins.
         if (r.bins != 0) options.compensation.enabled = false;
         if (r.bins == 0 && r.alpha_auto && r.compensate) {
+            stage("choosing alpha");
             built.alpha_choice = choose_alpha(image, options);
             options.compensation.alpha = built.alpha_choice->alpha;
         }
+        stage("building");
         const auto start = std::chrono::steady_clock::now();
         EnvMap map = build_env_map(std::move(image), options, stop);
         built.build_ms = milliseconds_since(start);
@@ -60,6 +65,7 @@ void build_pixels(RgbImage image, const BuildRequest& r, LumaCoefficients luma, 
             built.map = std::move(map);
             return;
         }
+        stage("building bins");
         const auto bins_start = std::chrono::steady_clock::now();
         built.binned.emplace(build_bins(std::move(map), binned_options(r), stop));
         built.bins_ms = milliseconds_since(bins_start);
@@ -206,14 +212,16 @@ BinnedOptions binned_options(const BuildRequest& r) {
     return o;
 }
 
-BuiltMap build_map(const std::filesystem::path& path, const BuildRequest& r, StopFlag stop) {
+BuiltMap build_map(const std::filesystem::path& path, const BuildRequest& r, StopFlag stop,
+                   const StageCallback& on_stage) {
     check(r);
+    if (on_stage) on_stage("reading");
     const auto start = std::chrono::steady_clock::now();
     io::LoadedImage image = io::load_image(path, {r.colorspace, r.working_space, stop});
     BuiltMap built;
     built.load_ms = milliseconds_since(start);
     built.notices = std::move(image.notices);
-    build_pixels(std::move(image.image), r, image.luma, path.string(), stop, built);
+    build_pixels(std::move(image.image), r, image.luma, path.string(), stop, on_stage, built);
     built.source = {path.filename().string(), image.content_hash, image.input_colorspace, image.working_colorspace,
                     canonical_options(r)};
     built.format = image.format;
@@ -221,7 +229,7 @@ BuiltMap build_map(const std::filesystem::path& path, const BuildRequest& r, Sto
     return built;
 }
 
-BuiltMap build_map(RgbImage pixels, const BuildRequest& r, StopFlag stop) {
+BuiltMap build_map(RgbImage pixels, const BuildRequest& r, StopFlag stop, const StageCallback& on_stage) {
     check(r);
     const uint64_t hash = hash64(std::as_bytes(std::span<const Rgb>(pixels.pixels)));
     const std::string input = r.colorspace.empty() ? r.working_space : r.colorspace;
@@ -236,7 +244,7 @@ BuiltMap build_map(RgbImage pixels, const BuildRequest& r, StopFlag stop) {
         luma = config.luma(r.working_space);
     }
     BuiltMap built;
-    build_pixels(std::move(pixels), r, luma, "array", stop, built);
+    build_pixels(std::move(pixels), r, luma, "array", stop, on_stage, built);
     built.source = {"array", hash, input, r.working_space, canonical_options(r)};
     built.format = "array";
     return built;

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -89,13 +90,17 @@ struct BuiltMap {
 // std::invalid_argument naming the file; io's load errors as it throws them. Cost: the
 // load, the build (O(texels)), with alpha auto a choice on a 128-wide copy, with bins
 // their build (timings: docs/performance-log.md, 'build_map'). Once `stop` is set the
-// load and builds throw Interrupted.
-BuiltMap build_map(const std::filesystem::path& path, const BuildRequest& request, StopFlag stop = nullptr);
+// load and builds throw Interrupted. `on_stage`, where given, is called as each stage
+// starts, with its name: "reading", "choosing alpha", "building", "building bins".
+using StageCallback = std::function<void(std::string_view stage)>;
+BuiltMap build_map(const std::filesystem::path& path, const BuildRequest& request, StopFlag stop = nullptr,
+                   const StageCallback& on_stage = {});
 
 // The same from pixels in memory: linear RGB in request.colorspace (empty: the working
 // space), converted to the working space where they differ (through the OCIO config,
 // loaded only then); named "array" in errors and the source, hashed (hash64 of the
 // pixels' bytes as given) as the source's content hash.
-BuiltMap build_map(RgbImage pixels, const BuildRequest& request, StopFlag stop = nullptr);
+BuiltMap build_map(RgbImage pixels, const BuildRequest& request, StopFlag stop = nullptr,
+                   const StageCallback& on_stage = {});
 
 }  // namespace envmis
