@@ -7,7 +7,8 @@ geometric mean over every map's points of the exact variance of `mis-balance-bin
 the lower of `mis-balance` and `mis-balance-comp` at that point, and, per map, the same figures:
 the "closer to the limit" and "never worse" figures of docs/performance.md. With them, the
 efficiency of bins over the compensated table: (exact variance x ns/est) of
-`mis-balance-comp` over that of `mis-balance-bins` (ns/est from the run: noisy).
+`mis-balance-comp` over that of `mis-balance-bins` (ns/est as compare times it, apart on one core:
+docs/compare.md; --jobs 1, the default, so that no other map shares the cores).
 
     /usr/bin/python3 scripts/bins_study.py ../shared/data/envmaps --work /tmp/bins-study \
         [--envmis build/apps/envmis] [-- extra compare options, e.g. --view-angle 75]
@@ -83,7 +84,7 @@ def main():
     parser.add_argument("--bsdf", default=BSDFS)
     parser.add_argument("--points", type=int, default=16)
     parser.add_argument("--spp", type=int, default=256)
-    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--jobs", type=int, default=1)
     parser.add_argument("--from-json", action="store_true", help="summarise the JSON already in --work")
     args, extra = parser.parse_known_args()
     extra = [e for e in extra if e != "--"]
