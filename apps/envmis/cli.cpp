@@ -25,6 +25,16 @@
 
 namespace envmis::cli {
 
+void limit_threads(uint32_t threads) { ::setenv("ENVMIS_THREADS", std::to_string(threads).c_str(), 1); }
+
+void add_threads_flag(CLI::App& app) {
+    app.add_option_function<uint32_t>("--threads", limit_threads,
+                                      "Threads of the build's parallel loops, 1 to " + std::to_string(kMaxThreads) +
+                                          " (default: the cores the CPU affinity and cgroup quota allow, as "
+                                          "envmis::usable_cores counts them)")
+        ->check(in_range(uint32_t{1}, kMaxThreads));
+}
+
 void add_map_flags(CLI::App& app, BuildRequest& request) {
     app.add_flag_callback(
         "--no-compensate", [&request] { request.compensate = false; },

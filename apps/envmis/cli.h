@@ -56,6 +56,17 @@ CLI::Validator in_range(T lo, T hi) {
 // A seed flag: any 64-bit unsigned integer, and nothing else.
 inline CLI::Validator any_seed() { return in_range(uint64_t{0}, std::numeric_limits<uint64_t>::max()); }
 
+// The most threads a command may be told to use.
+inline constexpr uint32_t kMaxThreads = 1024;
+
+// Caps the threads of every parallel loop of the libraries this process runs (builds,
+// bins, encodings) at `threads`: sets ENVMIS_THREADS, which envmis::usable_cores reads.
+void limit_threads(uint32_t threads);
+
+// --threads N (1 to kMaxThreads) on a command whose work runs on those loops; given, it
+// limits them (limit_threads) as it is parsed. Default: every usable core.
+void add_threads_flag(CLI::App& app);
+
 // An image size "WxH", each side min_side to max_side (default 1 to kMaxCells1D = 65536),
 // or with `single` also "N" (returned as N x 0). Digits only: no sign, no spaces. Empty
 // where the text is not one.

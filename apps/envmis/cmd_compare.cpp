@@ -115,8 +115,10 @@ void add_study_flags(CLI::App& sub, CompareArgs& args) {
         ->check(any_seed());
     sub.add_option("--threads", args.threads,
                    "Worker threads, 1 to 1024, at most 4 per usable core (more are reduced to that, with a "
-                   "note; default: the cores the CPU affinity and cgroup quota allow); results do not depend on it")
-        ->check(in_range(uint32_t{1}, kMaxStudyThreads));
+                   "note; default: the cores the CPU affinity and cgroup quota allow), the maps' builds' "
+                   "loops included; results do not depend on it")
+        ->check(in_range(uint32_t{1}, kMaxStudyThreads))
+        ->each([](const std::string& threads) { limit_threads(static_cast<uint32_t>(std::stoul(threads))); });
     CLI::Option* normal = sub.add_option("--normal", args.normal, "One shading point with this normal x,y,z")
                               ->check(direction_validator());
     sub.add_option("--view", args.view, "View direction x,y,z for --normal (default: the normal)")

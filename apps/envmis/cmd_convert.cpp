@@ -113,6 +113,7 @@ Subcommand add_convert(CLI::App& app) {
                            "Remap an environment image between equirect and equal-area octahedral (pbrt-v4) mappings, "
                            "conserving power");
     add_convert_flags(*sub, *args);
+    add_threads_flag(*sub);
     return {sub, [args] { run_convert(*args); }};
 }
 

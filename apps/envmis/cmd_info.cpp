@@ -55,6 +55,7 @@ Subcommand add_info(CLI::App& app) {
     CLI::App* sub = app.add_subcommand("info", "Describe a table file, or an HDR map and the sampler it would give");
     sub->add_option("input", args->input, "Table (.envmis) or HDR image")->required();
     add_map_flags(*sub, args->map);
+    add_threads_flag(*sub);
     return {sub, [args] { run_info(*args); }};
 }
 

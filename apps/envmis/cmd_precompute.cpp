@@ -13,6 +13,7 @@
 
 #include "cli.h"
 #include "envmis/build/env_map.h"
+#include "envmis/cpu.h"
 #include "library.h"
 
 namespace envmis::cli {
@@ -119,8 +120,10 @@ void print_precompute(std::ostream& out, const PrecomputeArgs& args, const Libra
     print_summary(out, loaded, map);
     if (binned) print_bins_cost(out, *binned, bins_ms);
     if (args.compact) print_compact_error(out, map);
+    const uint32_t threads = usable_cores();
     out << std::fixed << std::setprecision(1) << "  time          load " << loaded.load_ms << " ms, build "
-        << loaded.build_ms << " ms, write " << write_ms << " ms\n";
+        << loaded.build_ms << " ms, write " << write_ms << " ms (at most " << threads
+        << (threads == 1 ? " thread)\n" : " threads)\n");
 }
 
 // A map's peak resident memory per texel in precompute, above the process's own: a
@@ -231,6 +234,7 @@ Subcommand add_precompute(CLI::App& app) {
     auto args = std::make_shared<PrecomputeArgs>();
     CLI::App* sub = app.add_subcommand("precompute", "Build the sampling table of an HDR map and save it");
     add_precompute_flags(*sub, *args);
+    add_threads_flag(*sub);
     return {sub, [args] { run_precompute(*args); }};
 }
 

@@ -146,6 +146,7 @@ Subcommand add_sample(CLI::App& app) {
         "sample",
         "Draw directions from a map's sampler: CSV u,v,x,y,z,pdf (image point, world direction, solid-angle pdf)");
     add_sample_flags(*sub, *args);
+    add_threads_flag(*sub);
     return {sub, [args] { run_sample(*args); }};
 }
 

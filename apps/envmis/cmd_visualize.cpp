@@ -199,6 +199,7 @@ Subcommand add_visualize(CLI::App& app) {
         "One labelled PNG: the tone-mapped map, its density without and with compensation and, with --normal, the "
         "binned density at that normal (shared scale)");
     add_visualize_flags(*sub, *args);
+    add_threads_flag(*sub);
     return {sub, [args] { run_visualize(*args); }};
 }
 

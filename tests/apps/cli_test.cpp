@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "cli_run.h"
+#include "envmis/cpu.h"
 
 extern char** environ;
 
@@ -512,6 +513,24 @@ TEST_F(Cli, PrecomputeWithBinsWritesABinnedTableThatInfoDescribes) {
         contains(fixed.out, R"(bins +1 \(1 x 1 octahedral grid of normals; the diffuse class 1, 1 x 1\), cells 4 x 2)"))
         << fixed;
     EXPECT_TRUE(contains(fixed.out, R"(bin alphas +diffuse: +1 alpha 0\n)")) << fixed;
+}
+
+// --threads caps the build's loops (as ENVMIS_THREADS does), and precompute says how many
+// it ran on; the default is every usable core, and a bad count is a usage error.
+TEST_F(Cli, ThreadsCapsTheBuildsLoopsAndPrecomputeSaysSo) {
+    write_exr(file("map.exr"), gradient(64, 32));
+    const Result one = envmis({"precompute", "map.exr", "-o", "map.envmis", "--threads", "1", "--bins", "4"});
+    ASSERT_EQ(one.exit_code, 0) << one;
+    EXPECT_TRUE(contains(one.out, R"(write [0-9.]+ ms \(at most 1 thread\))")) << one;
+    const Result every = envmis({"precompute", "map.exr", "-o", "map.envmis"});
+    EXPECT_TRUE(
+        contains(every.out, R"(write [0-9.]+ ms \(at most )" + std::to_string(envmis::usable_cores()) + " thread"))
+        << every;
+    for (const char* command : {"convert", "visualize", "sample", "info"}) {
+        const Result bad = envmis({command, "map.exr", "--threads", "0"});
+        EXPECT_EQ(bad.exit_code, 2) << bad;
+        EXPECT_NE(bad.err.find("--threads"), std::string::npos) << bad;
+    }
 }
 
 // With ENVMIS_PROGRESS=1, precompute reports each stage as it starts and ends, in order:

@@ -120,5 +120,21 @@ TEST(Cpu, UsableCoresFollowTheAffinityMask) {
 }
 #endif
 
+// ENVMIS_THREADS (the commands' --threads) caps the count where it is a whole number from 1
+// to 65536; anything else is ignored.
+TEST(Cpu, UsableCoresStayWithinEnvmisThreads) {
+    const uint32_t cores = usable_cores();
+    const auto with = [](const char* value) {
+        ::setenv("ENVMIS_THREADS", value, 1);
+        const uint32_t n = usable_cores();
+        ::unsetenv("ENVMIS_THREADS");
+        return n;
+    };
+    EXPECT_EQ(with("1"), 1u);
+    EXPECT_EQ(with("65536"), cores);
+    for (const char* ignored : {"0", "", "abc", "2x", "-1", " 1", "65537", "99999999999999999999"})
+        EXPECT_EQ(with(ignored), cores) << "'" << ignored << "'";
+}
+
 }  // namespace
 }  // namespace envmis

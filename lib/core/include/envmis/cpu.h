@@ -34,9 +34,12 @@ ENVMIS_CORE_API const CpuInfo& cpu_info() noexcept;
 ENVMIS_CORE_API std::string cpu_name();
 
 // How many threads this process can run at once: the CPUs its affinity mask allows
-// (taskset, a batch system's binding) and no more than its cgroup's CPU quota (a
-// container's or a Slurm job's limit, rounded up), at least 1. Read on each call (a
-// process may be moved); the default thread count of every envmis command and library.
+// (taskset, a batch system's binding), no more than its cgroup's CPU quota (a
+// container's or a Slurm job's limit, rounded up) and no more than the environment
+// variable ENVMIS_THREADS where that is a whole number from 1 to 65536 (the `--threads`
+// of the envmis commands; a renderer may set it as it would OMP_NUM_THREADS), at least 1.
+// Read on each call (a process may be moved); the thread count of every parallel loop of
+// the libraries (builds, bins, encodings) and the default of every envmis command.
 ENVMIS_CORE_API uint32_t usable_cores() noexcept;
 // The same from a cgroup's limit as written in cpu.max (v2: "QUOTA PERIOD" or "max
 // PERIOD") or v1's cfs_quota_us and cfs_period_us joined by a space: quota / period

@@ -2,6 +2,7 @@
 #include "envmis/cpu.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -175,6 +176,11 @@ uint32_t usable_cores() noexcept {
     } catch (...) {  // allocation failure reading the files: the affinity's count stands
     }
 #endif
+    if (const char* limit = std::getenv("ENVMIS_THREADS")) {
+        char* end = nullptr;
+        const unsigned long n = std::isdigit(static_cast<unsigned char>(*limit)) ? std::strtoul(limit, &end, 10) : 0;
+        if (end && *end == '\0' && n >= 1 && n <= 65536) cores = std::min(cores, static_cast<uint32_t>(n));
+    }
     return cores;
 }
 
