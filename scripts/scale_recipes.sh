@@ -6,8 +6,9 @@
 # another as Slurm would start them (SLURM_ARRAY_TASK_ID, SLURM_CPUS_PER_TASK from the
 # script's #SBATCH line, --export's variables, the --output file, failing where its folder
 # is missing); GNU parallel runs for real, with ":" (this machine) as the only SSH host.
-# Each recipe must leave one JSON per map (two .exr and one .hdr: the list must take both)
-# and a report of them. Exit 0 when every recipe does, 1 naming the first that does not.
+# The slices past MaxArraySize, which the page gives in prose, run as it says with smaller
+# arrays. Each recipe must leave one JSON per map (two .exr and one .hdr: the list must
+# take both) and a report of them. Exit 0 when every recipe does, 1 naming the first that does not.
 # Usage: scripts/scale_recipes.sh [path/to/envmis]   (default build/apps/envmis)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -53,7 +54,7 @@ sbatch() {
     for argument in "$@"; do
         case $argument in
             --array=*) array=${argument#--array=} ;;
-            --export=ALL,*) exports=${argument#--export=ALL,} ;;
+            --export=ALL,*) exports=${argument#--export=ALL,} && exports=${exports//,/ } ;;
             *) script=$argument ;;
         esac
     done

@@ -311,9 +311,9 @@ std::string gain_phrase(double gain, const char* better, const char* worse) {
 
 // What the tables a renderer can load give against balance MIS over the plain map, per
 // BSDF, from the table's headline columns: "lambert: against mis-balance, the normal-aware
-// table (mis-balance-bins) 7.63x lower variance (worst point 1.02x its), 3.10x better at
-// equal time; the global compensated table (mis-balance-comp) 2.23x lower variance, 1.58x
-// better at equal time".
+// table (mis-balance-bins) 7.63x lower variance (worst point 4.17x lower), 3.10x better at
+// equal time; the global compensated table (mis-balance-comp) 2.23x lower variance (worst
+// point 1.04x higher), 1.58x better at equal time".
 std::string verdict(const BsdfComparison& b) {
     if (!b.find("mis-balance")) return b.bsdf.name() + ": no verdict (needs mis-balance)";
     std::string text;
@@ -321,11 +321,10 @@ std::string verdict(const BsdfComparison& b) {
                                            {"mis-balance-comp", "the global compensated table"}}) {
         const TechniqueStats* t = b.find(technique);
         if (!t || !(t->variance_ratio_vs_mis > 0)) continue;
-        char worst[48] = "";
-        if (text.empty())
-            std::snprintf(worst, sizeof worst, " (worst point %.2fx its variance)", t->variance_ratio_worst);
         text += std::string(text.empty() ? "" : "; ") + table + " (" + technique + ") " +
-                gain_phrase(1 / t->variance_ratio_vs_mis, "lower variance", "higher variance") + worst;
+                gain_phrase(1 / t->variance_ratio_vs_mis, "lower variance", "higher variance");
+        if (t->variance_ratio_worst > 0 && std::isfinite(t->variance_ratio_worst))
+            text += " (worst point " + gain_phrase(1 / t->variance_ratio_worst, "lower", "higher") + ")";
         if (t->efficiency_ratio_vs_mis > 0)
             text += ", " + gain_phrase(t->efficiency_ratio_vs_mis, "better", "worse") + " at equal time";
     }
@@ -679,14 +678,13 @@ constexpr const char* kColumnsHelp =
     "  var/mis    variance of one estimate / that of mis-balance at the same point, geometric mean over points\n"
     "             (the headline: below 1 is better)\n"
     "  worst      the largest of those per-point ratios\n"
-    "  eff/mis    efficiency (1 / (variance x time)) / that of mis-balance: var/mis at equal time, above 1 is\n"
-    "             better\n"
+    "  eff/mis    the gain at equal time: mis-balance's ns/est / (var/mis x this ns/est); above 1 is better\n"
     "  mean       mean of the estimates (luminance of the reflected radiance, the map's units), over points\n"
     "  std_error  standard error of that mean\n"
     "  reference  the quadrature reference of the mean\n"
     "  rel_mse    relative mean squared error of one estimate, mean of ((estimate - reference) / reference)^2\n"
     "  ns/est     nanoseconds per estimate, timed apart on one core: each technique in turn at up to 8\n"
-    "             points, 5 rounds of 256 estimates, the median\n"
+    "             points, 5 rounds of up to 256 estimates; per point the median, then the mean\n"
     "The lines below it compare the tables a renderer loads against mis-balance over the plain map: the\n"
     "normal-aware one (mis-balance-bins) and the global compensated one (mis-balance-comp).";
 

@@ -1,5 +1,6 @@
 #include "render.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -139,8 +140,8 @@ std::string caption_text(const std::string& map_name, const ComparisonOptions& o
     return caption;
 }
 
-// The montage's widest: a technique column per sphere side, so that a comparison of 11
-// techniques stays about a screen wide.
+// The montage's widest, so that a comparison of every default technique (12 columns with
+// the reference) stays about a screen wide.
 constexpr int kMontageWidth = 2000;
 
 // The montage's grid: a column per technique (the reference first), for each BSDF a row
@@ -148,16 +149,19 @@ constexpr int kMontageWidth = 2000;
 // render it measures. Sphere cells are the renders' own pixels, scaled down only where
 // the grid would be wider than kMontageWidth.
 struct MontageGrid {
-    const Scene& scene;
-    std::vector<std::string> bsdfs;
+    Scene scene;
     double scale = 1;
 
-    MontageGrid(const Scene& scene, std::vector<std::string> bsdf_names, size_t columns, const pictures::Style& style)
-        : scene(scene), bsdfs(std::move(bsdf_names)) {
-        int label = 0;
-        for (const std::string& b : bsdfs) label = std::max(label, pictures::text_width(b, style.text_scale));
-        const double room = kMontageWidth - 2 * style.margin - label - static_cast<int>(columns) * style.gap;
-        scale = std::min(1.0, room / (static_cast<double>(columns) * scene.cell_begin(1)));
+    // `labels`: the rows' titles.
+    MontageGrid(const Scene& scene, const std::vector<std::string>& labels, size_t columns,
+                const pictures::Style& style)
+        : scene(scene) {
+        int label = 0, cell = 0;
+        for (const std::string& l : labels) label = std::max(label, pictures::text_width(l, style.text_scale));
+        for (uint32_t i = 0; i < scene.spheres; ++i)
+            cell = std::max(cell, static_cast<int>(scene.cell_begin(i + 1) - scene.cell_begin(i)));
+        const int room = kMontageWidth - 2 * style.margin - label - static_cast<int>(columns) * style.gap;
+        scale = std::clamp(static_cast<double>(room) / (static_cast<double>(columns) * cell), 1.0 / cell, 1.0);
     }
 
     // Sphere i's cell of a picture whose panel for this column starts at x0.
@@ -218,7 +222,9 @@ void write_panels(const std::filesystem::path& folder, const Scene& scene, const
     for (const auto& r : renders) grid.columns.push_back(r.first);
     std::vector<std::string> bsdfs;
     for (const Bsdf& b : options.bsdfs) bsdfs.push_back(b.name());
-    const MontageGrid layout(scene, bsdfs, grid.columns.size(), style);
+    std::vector<std::string> labels = bsdfs;
+    labels.push_back("error");
+    const MontageGrid layout(scene, labels, grid.columns.size(), style);
     for (uint32_t b = 0; b < bsdfs.size(); ++b) {
         grid.rows.push_back(bsdfs[b]);
         for (uint32_t c = 0; c < grid.columns.size(); ++c) grid.cells.push_back({layout.cell(shown, c * w, b), ""});

@@ -69,8 +69,8 @@ inline py::array_t<float, py::array::c_style> float_array(const py::handle& obje
         throw std::invalid_argument(std::string(where) + ": " + name + " must be an array of real numbers of shape " +
                                     detail::shape_text(shape, symbols) + "; got " + detail::given_text(given));
     };
-    py::array array = py::isinstance<py::array>(object) ? py::reinterpret_borrow<py::array>(object)
-                                                         : py::array::ensure(object);
+    py::array array =
+        py::isinstance<py::array>(object) ? py::reinterpret_borrow<py::array>(object) : py::array::ensure(object);
     if (!array) fail(object);
     if (const char kind = array.dtype().kind(); kind != 'f' && kind != 'i' && kind != 'u')
         fail(py::isinstance<py::array>(object) ? py::handle(array) : object);
@@ -78,7 +78,10 @@ inline py::array_t<float, py::array::c_style> float_array(const py::handle& obje
         array = array.reshape({py::ssize_t{1}, shape.begin()[1]});
     if (!detail::has_shape(array, shape)) fail(array);
     using Converted = py::array_t<float, py::array::c_style | py::array::forcecast>;
-    return py::reinterpret_steal<py::array_t<float, py::array::c_style>>(Converted::ensure(array).release());
+    Converted converted = Converted::ensure(array);
+    if (!converted)  // NumPy failed (out of memory): pybind11 cleared its error
+        throw std::runtime_error(std::string(where) + ": " + name + ": could not be converted to a float32 array");
+    return py::reinterpret_steal<py::array_t<float, py::array::c_style>>(converted.release());
 }
 
 // Throws ValueError unless every value of `u`, a C-contiguous float32 (N, 2) array, is in

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <string>
 #include <thread>
 #if defined(__linux__)
 #include <sched.h>
@@ -123,6 +124,9 @@ TEST(Cpu, UsableCoresFollowTheAffinityMask) {
 // ENVMIS_THREADS (the commands' --threads) caps the count where it is a whole number from 1
 // to 65536; anything else is ignored.
 TEST(Cpu, UsableCoresStayWithinEnvmisThreads) {
+    const char* inherited = std::getenv("ENVMIS_THREADS");
+    const std::string kept = inherited ? inherited : "";
+    ::unsetenv("ENVMIS_THREADS");
     const uint32_t cores = usable_cores();
     const auto with = [](const char* value) {
         ::setenv("ENVMIS_THREADS", value, 1);
@@ -134,6 +138,7 @@ TEST(Cpu, UsableCoresStayWithinEnvmisThreads) {
     EXPECT_EQ(with("65536"), cores);
     for (const char* ignored : {"0", "", "abc", "2x", "-1", " 1", "65537", "99999999999999999999"})
         EXPECT_EQ(with(ignored), cores) << "'" << ignored << "'";
+    if (inherited) ::setenv("ENVMIS_THREADS", kept.c_str(), 1);
 }
 
 }  // namespace

@@ -37,7 +37,8 @@ ENVMIS_CORE_API std::string cpu_name();
 // (taskset, a batch system's binding), no more than its cgroup's CPU quota (a
 // container's or a Slurm job's limit, rounded up) and no more than the environment
 // variable ENVMIS_THREADS where that is a whole number from 1 to 65536 (the `--threads`
-// of the envmis commands; a renderer may set it as it would OMP_NUM_THREADS), at least 1.
+// of the envmis commands; a renderer may set it as it would OMP_NUM_THREADS, before it
+// starts threads: getenv beside a setenv is a data race), at least 1.
 // Read on each call (a process may be moved); the thread count of every parallel loop of
 // the libraries (builds, bins, encodings) and the default of every envmis command.
 ENVMIS_CORE_API uint32_t usable_cores() noexcept;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <thread>
@@ -142,37 +143,43 @@ uint64_t cell_stream(size_t point, const Technique& technique) {
     return hash64(std::as_bytes(std::span(key.data(), key.size())));
 }
 
-// The timing: kTimingRounds rounds over up to kTimedPoints of the run's points, at each
-// (round, point, BSDF) every technique in turn for kTimedEstimates estimates, on one
-// thread once the run's cells are done (cells timed while they share the cores with
-// each other vary by +-20% from run to run).
+// The timing, on one thread once the run's cells are done (cells timed while they share
+// the cores vary by +-20% from run to run): at up to kTimedPoints of the run's points,
+// spread evenly over them, every technique in turn at each (round, point, BSDF), for
+// the run's spp estimates rounded up to whole chunks but at most kTimedEstimates.
 constexpr size_t kTimedPoints = 8, kTimingRounds = 5;
 constexpr uint64_t kTimedEstimates = 256;
+static_assert(kTimedEstimates % kChunk == 0);
 
-// Each technique's seconds per estimate on each BSDF, [b * nt + t]: the median over its
-// rounds and points; all 0 once `stop` is set (checked every round).
+// Each technique's seconds per estimate on each BSDF, [b * nt + t]: per point the median
+// of its rounds, then the mean over the points (a normal facing the sun costs more than
+// one facing the ground); all 0 once `stop` is set (checked every cell).
 std::vector<double> timed_seconds(const std::vector<DirectLightingEstimator>& estimators,
                                   std::span<const ShadingPoint> points, const ComparisonOptions& options,
                                   const std::atomic<bool>* stop) {
     const size_t nb = options.bsdfs.size(), nt = estimators.size(), np = std::min(points.size(), kTimedPoints);
-    std::vector<std::vector<double>> samples(nb * nt);
+    const uint64_t estimates = std::min(kTimedEstimates, (uint64_t{options.spp} + kChunk - 1) / kChunk * kChunk);
+    std::vector<std::vector<double>> rounds(nb * nt * np);  // [(b * nt + t) * np + i], one value a round
     Rgb chunk[kChunk];
-    for (size_t round = 0; round < kTimingRounds; ++round) {
-        if (stop && stop->load()) return std::vector<double>(nb * nt);
-        for (size_t p = 0; p < np; ++p)
+    for (size_t round = 0; round < kTimingRounds; ++round)
+        for (size_t i = 0; i < np; ++i)
             for (size_t b = 0; b < nb; ++b)
                 for (size_t t = 0; t < nt; ++t) {
+                    if (stop && stop->load()) return std::vector<double>(nb * nt);
+                    const size_t p = i * points.size() / np;
                     Pcg32 rng(options.seed + round, cell_stream(p, options.techniques[t]));
                     PointState state;
                     const auto start = std::chrono::steady_clock::now();
-                    for (uint64_t done = 0; done < kTimedEstimates; done += kChunk)
+                    for (uint64_t done = 0; done < estimates; done += kChunk)
                         estimators[t].estimate(points[p], options.bsdfs[b], rng, state, {chunk, kChunk});
                     const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
-                    samples[b * nt + t].push_back(elapsed.count() / kTimedEstimates);
+                    rounds[(b * nt + t) * np + i].push_back(elapsed.count() / static_cast<double>(estimates));
                 }
+    std::vector<double> seconds(nb * nt);
+    for (size_t c = 0; c < nb * nt; ++c) {
+        for (size_t i = 0; i < np; ++i) seconds[c] += median(rounds[c * np + i]);
+        seconds[c] /= static_cast<double>(np);
     }
-    std::vector<double> seconds;
-    for (const std::vector<double>& s : samples) seconds.push_back(median(s));
     return seconds;
 }
 
@@ -210,6 +217,7 @@ TechniqueStats technique_stats(const CellTable& table, size_t b, size_t t, size_
         if (mis_index < nt && t != mis_index) {
             const Cell& mis = table.at(p, b, mis_index);
             const double v = c.estimates.variance(), v_mis = mis.estimates.variance();
+            if (v > 0 && !(v_mis > 0)) s.variance_ratio_worst = std::numeric_limits<double>::infinity();
             if (v > 0 && v_mis > 0) {
                 log_ratio += std::log(v / v_mis), ++ratios;
                 log_ratio_se2 += square(relative_standard_error(c)) + square(relative_standard_error(mis));

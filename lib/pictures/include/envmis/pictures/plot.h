@@ -45,6 +45,8 @@ struct Series {
     int best = -1;  // a point to mark (a ring around its marker, see LinePlot::best_label); -1: none
 };
 
+// Where every x is a whole number (sample counts), the x axis is labelled at whole numbers
+// only.
 struct LinePlot {
     std::string title, x_label, y_label;
     std::vector<Series> series;  // colours from kPlotPalette; markers cycle through 4 shapes
@@ -54,8 +56,6 @@ struct LinePlot {
     // The legend's entry for the rings of Series::best ("best split"), when one is marked.
     std::string best_label = "best";
 };
-// Where every x is a whole number (sample counts), the x axis is labelled at whole numbers
-// only.
 
 // Throws std::invalid_argument when there is no series, or none has a point, when a
 // series's x and y differ in length, or when the picture is too small to leave a plot

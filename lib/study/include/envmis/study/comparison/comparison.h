@@ -60,10 +60,12 @@ struct TechniqueStats {
     // relative mean squared error of one estimate (its bias included).
     double mean = 0, reference = 0, variance = 0, std_error = 0, rel_mse = 0;
     // ns_per_estimate: time per estimate, timed apart from the run on one thread, the
-    // techniques interleaved at each of up to 8 of the points, 5 rounds of 256 estimates,
-    // the median (0 in a run stopped early); efficiency: 1 / (variance x that time in s).
+    // techniques in turn at up to 8 of the points spread evenly, 5 rounds of up to 256
+    // estimates, per point the median of its rounds, then the mean over the points (0 in a
+    // run stopped early); efficiency: 1 / (variance x that time in seconds).
     double ns_per_estimate = 0, efficiency = 0;
-    // Per point: variance / mis-balance's, geometric mean and worst (largest) over points;
+    // Per point: variance / mis-balance's, geometric mean and worst (largest) over points
+    // (infinite where mis-balance's is 0 and this technique's is not);
     // efficiency_ratio_vs_mis: at equal time, mis-balance's time per estimate /
     // (variance_ratio_vs_mis x this technique's): > 1 is better.
     double variance_ratio_vs_mis = 0, variance_ratio_worst = 0, efficiency_ratio_vs_mis = 0;
