@@ -20,6 +20,7 @@
 #include "envmis/build/env_map.h"
 #include "envmis/build/remap.h"
 #include "envmis/cpu.h"
+#include "envmis/study/statistics/statistics.h"
 #include "pbrt_style.h"
 #include "reference.h"
 
@@ -30,11 +31,6 @@ struct Timing {
     std::string sampler;
     double build_ms = 0, ns_per_sample = 0, ns_per_pdf = 0, bytes_per_texel = 0;
 };
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
 
 // ns per call of `call` over all inputs, once; the results go to a sink the optimiser
 // cannot drop.

@@ -372,13 +372,12 @@ Image8 colour_bar(const ColourScale& scale, std::string_view label, uint32_t len
     return bar;
 }
 
-namespace {
-
-// The longest start of `text` that fits in `width` pixels at `scale`.
 std::string_view cut_to_width(std::string_view text, int width, int scale) {
     const int fitting = (width + (kGlyphAdvance - kGlyphWidth) * scale) / (kGlyphAdvance * scale);
     return text.substr(0, static_cast<size_t>(std::max(fitting, 0)));
 }
+
+namespace {
 
 // Greedy line breaks after each '-' and at spaces (dropped), each line at most `width`
 // pixels wide at `scale`; a piece too wide alone is cut.

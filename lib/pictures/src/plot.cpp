@@ -43,11 +43,8 @@ void outline(Image8& image, int x, int y, int w, int h, Rgb8 colour) {
     fill_rect(image, x + w - 1, y, 1, h, colour);
 }
 
-// The longest start of `text` that fits `width` pixels.
-std::string_view fitted(std::string_view text, int width) {
-    const int fitting = (width + (kGlyphAdvance - kGlyphWidth) * kScale) / (kGlyphAdvance * kScale);
-    return text.substr(0, static_cast<size_t>(std::max(0, fitting)));
-}
+// The longest start of `text` that fits `width` pixels at the plots' text scale.
+std::string_view fitted(std::string_view text, int width) { return cut_to_width(text, width, kScale); }
 
 // Centred on `centre` as far as the image's edges allow.
 void draw_centred(Image8& image, int centre, int y, std::string_view text, Rgb8 colour) {

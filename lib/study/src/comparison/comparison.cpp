@@ -127,13 +127,6 @@ std::vector<double> exact_point_variances(const StudyInputs& inputs, const Techn
 
 namespace {
 
-// The middle value (the upper of the two middle ones for an even count); 0 for none.
-double median(std::vector<double> values) {
-    if (values.empty()) return 0;
-    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-    return values[values.size() / 2];
-}
-
 // A cell's random stream, from the point's index and the technique's name rather than
 // its place in the list, so that a technique's numbers are the same whichever others run
 // beside it; the BSDFs at a point share it, so that one differing only in albedo gives

@@ -133,6 +133,9 @@ const GlyphRows& glyph(char c);
 // scale x scale square) covers; the width has no trailing spacing.
 int text_width(std::string_view text, int scale = 1);
 int text_height(int scale = 1);
+// The longest start of `text` whose box fits in `width` pixels at `scale` (labels cut to
+// their panel or column).
+std::string_view cut_to_width(std::string_view text, int width, int scale = 1);
 // Draws one line of text with the top-left corner of its box at (x, y); nothing outside
 // that box changes.
 void draw_text(Image8& image, int x, int y, std::string_view text, Rgb8 colour, int scale = 1);

@@ -2,8 +2,10 @@
 // partial results, so that parallel runs combine in a fixed order).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 namespace envmis {
 
@@ -33,5 +35,14 @@ private:
     uint64_t n_ = 0;
     double mean_ = 0, m2_ = 0;
 };
+
+// The median of `values` (the mean of the two middle ones for an even count); 0 for none.
+// Robust summaries of timings, where a descheduled run is an outlier.
+inline double median(std::vector<double> values) {
+    if (values.empty()) return 0;
+    std::sort(values.begin(), values.end());
+    const size_t half = values.size() / 2;
+    return values.size() % 2 ? values[half] : 0.5 * (values[half - 1] + values[half]);
+}
 
 }  // namespace envmis
