@@ -124,7 +124,7 @@ CLI::Option* add_cell_columns_flag(CLI::App& app, uint32_t& columns) {
         .add_option(
             "--cell-columns", columns,
             "With --bins: columns of the bins' cell grid (rows: half as many for equirect, as many for equal-area; "
-            "0: width / 32, clamped to 1 to 128)")
+            "0: width / 32, clamped to 1 to 128 and to at most 112 x 56 cells, 79 x 79 for equal-area)")
         ->type_name("N")
         ->check(in_range(uint32_t{0}, kMaxCellColumns));
 }

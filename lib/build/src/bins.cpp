@@ -381,17 +381,28 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
     return choices;
 }
 
+// The default cell columns of a map w texels wide: cells 32 texels wide, at most
+// kMaxDefaultCells of them. Past 4k the cap, not the cells' width, sets the bins'
+// memory: 6 bytes per cell per bin, 683 (class, bin) pairs by default, so 112 x 56
+// cells keep the bins under 5% of an 8k map (a square grid: 79 x 79).
+constexpr uint32_t kMaxDefaultCells = 112 * 56;
+uint32_t default_cell_columns(uint32_t w, bool square) {
+    uint32_t columns = std::clamp(w / 32, 1u, 128u);
+    while (uint64_t{columns} * (square ? columns : std::max(1u, columns / 2)) > kMaxDefaultCells) --columns;
+    return columns;
+}
+
 // The cell grid for the options over `plain`, after the checks every build makes.
 CellGrid grid_for(const EnvMap& plain, const BinnedOptions& options) {
     if (plain.options().compensation.enabled && plain.stats().fallback == DensityFallback::none)
         throw std::invalid_argument("a binned map is built over the plain (uncompensated) map");
     check_options(options);
     const uint32_t w = plain.width(), h = plain.height();
+    const bool square = plain.options().mapping == Mapping::equal_area;
     uint32_t columns = options.cell_columns;
-    if (columns == 0) columns = std::clamp(w / 32, 1u, 128u);
+    if (columns == 0) columns = default_cell_columns(w, square);
     if (columns > 4096)
         throw std::invalid_argument("cell columns must be at most 4096, got " + std::to_string(columns));
-    const bool square = plain.options().mapping == Mapping::equal_area;
     columns = std::min(columns, w);
     const uint32_t rows = std::min(square ? columns : std::max(1u, columns / 2), h);
     check_cells(columns, rows);

@@ -330,6 +330,40 @@ TEST(Binned, TinyBlackAndConstantMapsWork) {
     }
 }
 
+// Bytes the bins of `layout` add to a plain map of h texel rows, as binned.h counts them:
+// 6 per cell per (class, bin), 6 per (cell column, texel row), and the small tables.
+size_t bins_bytes(const BinLayout& layout, uint32_t h) {
+    const size_t cells = size_t{layout.cell_columns} * layout.cell_rows;
+    return layout.choice_count() * (cells * 6 + sizeof(float)) + size_t{layout.cell_columns} * h * 6 +
+           (layout.cell_columns + 1 + layout.cell_rows + 1) * sizeof(uint32_t);
+}
+
+TEST(Binned, TheDefaultCellsAre32TexelsWideAndAtMost112By56SoBinsStayUnderFivePercentOfAn8kMap) {
+    struct Case {
+        uint32_t w, h;
+        Mapping mapping;
+        uint32_t columns, rows;
+    };
+    BinnedOptions fixed;
+    fixed.auto_alpha = false;
+    for (const Case& c : {Case{64, 32, Mapping::equirect, 2, 1}, Case{1024, 512, Mapping::equirect, 32, 16},
+                          Case{4096, 2048, Mapping::equirect, 112, 56}, Case{1024, 1024, Mapping::equal_area, 32, 32},
+                          Case{2560, 2560, Mapping::equal_area, 79, 79}}) {
+        const EnvMap plain = plain_map(test::constant_map(c.w, c.h, {1, 1, 1}), c.mapping);
+        const BinLayout layout = choose_bin_layout(plain, fixed);
+        EXPECT_EQ(layout.cell_columns, c.columns) << c.w << "x" << c.h;
+        EXPECT_EQ(layout.cell_rows, c.rows) << c.w << "x" << c.h;
+        if (c.w <= 1024) {
+            EXPECT_EQ(BinnedEnvMap(plain, layout).bytes(), bins_bytes(layout, c.h)) << c.w << "x" << c.h;
+            continue;
+        }
+        // The same grid at 8k (the cap): a plain map holds 18 bytes a texel (envmap.h).
+        const double texels_8k = c.mapping == Mapping::equirect ? 8192.0 * 4096 : 5793.0 * 5793;
+        const uint32_t rows_8k = c.mapping == Mapping::equirect ? 4096 : 5793;
+        EXPECT_LT(static_cast<double>(bins_bytes(layout, rows_8k)), 0.05 * 18 * texels_8k) << c.w << "x" << c.h;
+    }
+}
+
 // Every sample, pdf and lookup of random (axis, pick, point or direction, class) finite,
 // the pdf >= 0 and the sample's pdf > 0 and equal to the pdf at its point.
 void expect_finite_everywhere(const BinnedEnvMap& map, uint64_t seed, const std::string& what) {

@@ -26,7 +26,7 @@
 // 14 maps: 1.98x, 1.87x, 1.79x).
 //
 // Representation (what keeps it small): the map is cut into a coarse grid of cells
-// (BinLayout; 32 x 16 for a 1k map, at most 128 x 64); each bin holds only
+// (BinLayout; 32 x 16 for a 1k map, at most 112 x 56); each bin holds only
 // the masses of its cells (sum over the cell's texels of q_b times their solid angle), in
 // one 1D CDF over all cells, row-major (two dependent loads to find a cell, where a
 // marginal and a conditional CDF took four). Inside a cell, a texel is picked by the
@@ -270,7 +270,8 @@ struct BinnedOptions {
     // smooth, so its best density follows the normal closely: finer bins pay most there.
     uint32_t diffuse_bins_per_side = 0;
     // Cell grid: columns (rows: half of them for equirect, as many for equal-area).
-    // 0 picks map width / 32, clamped to [1, 128] and to the map's size.
+    // 0 picks map width / 32, clamped to [1, 128], to the map's size and to at most
+    // 112 x 56 cells (79 x 79 square), which keeps the bins under 5% of an 8k map.
     uint32_t cell_columns = 0;
     std::vector<float> lobe_exponents = {0, 20, 200};  // ascending, first 0 (diffuse); 1 to 8
     // Compensation per bin: the candidates auto mode chooses among (finite, >= 0), or,
