@@ -32,27 +32,25 @@ struct Timing {
     double build_ms = 0, ns_per_sample = 0, ns_per_pdf = 0, bytes_per_texel = 0;
 };
 
-// ns per call of `call` over all inputs, once; the results go to a sink the optimiser
-// cannot drop.
+// ns per call of `call` over all inputs, once. Each result is kept whole, as Google
+// Benchmark's DoNotOptimize keeps it: it must exist in memory, every field of it (a
+// sample's direction, pdf and radiance), and nothing further is computed from it. Summing
+// the fields instead put a chain of adds through the stack into the timed loop, which
+// slowed envmis's samples more than the references' (measured: docs/performance-log.md,
+// 'keep_whole'); keeping only part of it let the compiler drop the rest.
+template <class T>
+void keep_whole(T& value) {
+    asm volatile("" : "+m"(value));
+}
 template <class Input, class Call>
 double ns_per_call(const std::vector<Input>& inputs, Call&& call) {
-    volatile float sink = 0;
-    float sum = 0;
     const auto start = std::chrono::steady_clock::now();
-    for (const Input& in : inputs) sum += call(in);
-    sink = sink + sum;
+    for (const Input& in : inputs) {
+        auto result = call(in);
+        keep_whole(result);
+    }
     return milliseconds_since(start) * 1e6 / static_cast<double>(inputs.size());
 }
-
-// What a single sample call hands back, summed: all of it, as sample_many writes all of
-// it. A sum of part of it let the compiler drop the rest (a direction's y and z, two
-// radiance channels) and flattered the single calls (measured: docs/performance-log.md,
-// 'every_output').
-float every_output(const EnvSample& s) {
-    return s.pdf + s.direction.x + s.direction.y + s.direction.z + s.radiance.r + s.radiance.g + s.radiance.b;
-}
-// The same for a single lookup call: what lookup_many writes for a direction.
-float every_output(const EnvMapView::Lookup& l) { return l.pdf + l.radiance.r + l.radiance.g + l.radiance.b; }
 
 // The inputs of sample_many and lookup_many: one array per coordinate, and outputs for
 // a batch of kBatch.
@@ -293,15 +291,13 @@ CallTimes time_calls(const EnvMap& guided, const reference::TextbookEnvMap& text
                      const reference::PbrtStyleEnvMap& pbrt, const BenchPoints& points, int repeats, Progress& progress,
                      int& step) {
     const auto sample_cost = [&](const auto& sampler) {
-        return ns_per_call(points.us, [&](Vec2 u) { return every_output(sampler.sample(u)); });
+        return ns_per_call(points.us, [&](Vec2 u) { return sampler.sample(u); });
     };
     const auto pdf_cost = [&](const auto& sampler) {
         return ns_per_call(points.directions, [&](Vec3 d) { return sampler.pdf(d); });
     };
     const EnvMapView view = guided.view();
-    const auto lookup_cost = [&] {
-        return ns_per_call(points.directions, [&](Vec3 d) { return every_output(view.lookup(d)); });
-    };
+    const auto lookup_cost = [&] { return ns_per_call(points.directions, [&](Vec3 d) { return view.lookup(d); }); };
     BatchInputs batch(points.us, points.directions);
     CallTimes c;
     for (int r = 0; r < repeats; ++r) {
@@ -394,22 +390,19 @@ void time_binned_calls(const EnvMapView (&today)[2], const BinnedEnvMapView& bin
         throw_if_interrupted();
         double t[3][4], lookup[3];
         for (int k = 0; k < 2; ++k) {
-            t[k][0] = ns_per_call(inputs, [&](const Input& in) { return every_output(today[k].sample(in.u)); });
+            t[k][0] = ns_per_call(inputs, [&](const Input& in) { return today[k].sample(in.u); });
             t[k][1] = ns_per_call(inputs, [&](const Input& in) { return today[k].pdf(in.direction); });
             t[k][2] = batch.sample_cost(today[k]);
             t[k][3] = batch.lookup_cost(today[k]);
-            lookup[k] =
-                ns_per_call(inputs, [&](const Input& in) { return every_output(today[k].lookup(in.direction)); });
+            lookup[k] = ns_per_call(inputs, [&](const Input& in) { return today[k].lookup(in.direction); });
         }
-        t[2][0] = ns_per_call(
-            inputs, [&](const Input& in) { return every_output(binned.sample({in.normal}, 0, in.choice, in.u)); });
+        t[2][0] = ns_per_call(inputs, [&](const Input& in) { return binned.sample({in.normal}, 0, in.choice, in.u); });
         t[2][1] =
             ns_per_call(inputs, [&](const Input& in) { return binned.pdf({in.normal}, 0, in.choice, in.direction); });
         t[2][2] = batch.sample_cost(binned, 0);
         t[2][3] = batch.lookup_cost(binned, 0);
-        lookup[2] = ns_per_call(inputs, [&](const Input& in) {
-            return every_output(binned.lookup({in.normal}, 0, in.choice, in.direction));
-        });
+        lookup[2] = ns_per_call(
+            inputs, [&](const Input& in) { return binned.lookup({in.normal}, 0, in.choice, in.direction); });
         pdf_in_bin.push_back(ns_per_call(
             picked, [&](const std::pair<uint32_t, Vec3>& p) { return binned.bin_at(p.first, 1).pdf(p.second); }));
         pdf_in_bin_ratio.push_back(pdf_in_bin.back() / t[kPlain][1]);

@@ -68,16 +68,18 @@ ENVMIS_HD inline F axis_component(const Vec3Of<F>& v, int8_t code) noexcept {
 }
 
 // Both return early for the default frame, which most renderers use: the general
-// permutation takes some thirty instructions and three branches per call.
+// permutation takes some thirty instructions and three branches per call. Always
+// inlined: GCC has left them as calls inside a caller's sampling loop, where the early
+// return then costs a call (measured: docs/performance-log.md, 'keep_whole').
 template <class F = float>
-ENVMIS_HD inline Vec3Of<F> to_world(const Axes& a, const Vec3Of<F>& canonical) noexcept {
+ENVMIS_HD ENVMIS_INLINE Vec3Of<F> to_world(const Axes& a, const Vec3Of<F>& canonical) noexcept {
     if (a.identity()) return canonical;
     return {axis_component<F>(canonical, a.code[0]), axis_component<F>(canonical, a.code[1]),
             axis_component<F>(canonical, a.code[2])};
 }
 
 template <class F = float>
-ENVMIS_HD inline Vec3Of<F> to_canonical(const Axes& a, const Vec3Of<F>& world) noexcept {
+ENVMIS_HD ENVMIS_INLINE Vec3Of<F> to_canonical(const Axes& a, const Vec3Of<F>& world) noexcept {
     if (a.identity()) return world;
     F c[3] = {world.x, world.y, world.z};
     for (int i = 0; i < 3; ++i) {

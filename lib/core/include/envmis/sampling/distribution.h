@@ -114,7 +114,7 @@ struct CdfView : CdfTable {
     }
     // The cell holding unit t if it is one of cells c - 1 to c + 1 (those in the CDF): the
     // last of them whose start is <= t, when the next cell's start is > t. False otherwise.
-    ENVMIS_HD bool find_near(uint32_t c, uint32_t t, uint32_t& cell) const noexcept {
+    ENVMIS_HD ENVMIS_INLINE bool find_near(uint32_t c, uint32_t t, uint32_t& cell) const noexcept {
         const uint32_t lo = c > 0 ? c - 1 : 0, hi = min(c + 1, n - 1);
         if (start[lo] > t || (hi + 1 < n && start[hi + 1] <= t)) return false;
         cell = lo + (lo < hi && start[lo + 1] <= t) + (lo + 1 < hi && start[lo + 2] <= t);
