@@ -53,7 +53,7 @@ struct CdfTable {
     // The cell holding unit u 2^31, and the position inside it: search the cells of u's
     // guide bucket. Single precision: x is exact (a power-of-two scale of u), and so are
     // its integer part t and the fraction x - t; only the offset's division rounds.
-    ENVMIS_HD CellHit search(float u) const noexcept {
+    ENVMIS_HD ENVMIS_INLINE CellHit search(float u) const noexcept {
         const float x = unit_point(u) * static_cast<float>(kCdfUnits);
         const auto t = static_cast<uint32_t>(x);
         return find(guide_span(bucket_of_unit(t)), x, t);
