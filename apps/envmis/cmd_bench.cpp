@@ -599,6 +599,7 @@ Subcommand add_bench(CLI::App& app) {
         "Time building and sampling, guided-CDF sampler versus the textbook sampler and a pbrt-v4-style one (medians "
         "of repeats)");
     add_bench_flags(*sub, *args);
+    add_threads_flag(*sub);
     return {sub, [args] { run_bench(*args); }};
 }
 

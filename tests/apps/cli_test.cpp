@@ -526,7 +526,7 @@ TEST_F(Cli, ThreadsCapsTheBuildsLoopsAndPrecomputeSaysSo) {
     EXPECT_TRUE(
         contains(every.out, R"(write [0-9.]+ ms \(at most )" + std::to_string(envmis::usable_cores()) + " thread"))
         << every;
-    for (const char* command : {"convert", "visualize", "sample", "info"}) {
+    for (const char* command : {"convert", "visualize", "sample", "info", "bench"}) {
         const Result bad = envmis({command, "map.exr", "--threads", "0"});
         EXPECT_EQ(bad.exit_code, 2) << bad;
         EXPECT_NE(bad.err.find("--threads"), std::string::npos) << bad;
