@@ -53,6 +53,8 @@ struct CdfTable {
     // The cell holding unit u 2^31, and the position inside it: search the cells of u's
     // guide bucket. Single precision: x is exact (a power-of-two scale of u), and so are
     // its integer part t and the fraction x - t; only the offset's division rounds.
+    // Always inlined: every sample's row search, which GCC has left as a call in a
+    // caller's sampling loop (measured: docs/performance-log.md, 'keep_whole').
     ENVMIS_HD ENVMIS_INLINE CellHit search(float u) const noexcept {
         const float x = unit_point(u) * static_cast<float>(kCdfUnits);
         const auto t = static_cast<uint32_t>(x);
