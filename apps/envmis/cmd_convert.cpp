@@ -30,7 +30,8 @@ void add_convert_flags(CLI::App& sub, ConvertArgs& args) {
     sub.add_option("--to", args.to, "Mapping of the output")->capture_default_str()->check(mappings);
     sub.add_option("--size", args.size,
                    "Output size: N (equal-area N x N, equirect 2N x N) or WxH, each side 1 to 65536, at most 2^31 "
-                   "texels and about 24 bytes a texel of free memory (default: about the input's texel count)")
+                   "texels and about 24 bytes a texel of free memory (default: the input's texel count, the short side "
+                   "rounded to a power of two: between half and twice the texels; 1024x512 to equal-area gives 1024)")
         ->type_name("N|WxH")
         ->check(size_validator(true));
     sub.add_option("--supersampling", args.supersampling,

@@ -35,6 +35,10 @@ struct Nodes {
     std::vector<Vec3> direction;
     std::vector<uint32_t> cell;
     double steradians_per_weight = 0;  // solid angle of a texel of weight 1
+    // Per node, the environment's solid-angle density there per unit probability of its
+    // cell: a cell's texels share their cell's probability by luminance (bin_cells.h).
+    // Set by weigh_nodes once the cells' luminance is known.
+    std::vector<double> density_per_probability;
 };
 
 // Moves the brightest texels out of their grid nodes into nodes of their own.
@@ -103,6 +107,17 @@ Nodes nodes_of(const EnvMap& plain, const CellGrid& grid, StopFlag stop) {
     return n;
 }
 
+// Node i holds sum_l[i] / cell_l of its cell's luminance cell_l, over sum_w[i] times the
+// solid angle of a unit weight.
+void weigh_nodes(Nodes& n, std::span<const double> cell_l) {
+    n.density_per_probability.resize(n.sum_l.size());
+    for (size_t i = 0; i < n.sum_l.size(); ++i) {
+        const double share = cell_l[n.cell[i]] > 0 ? n.sum_l[i] / cell_l[n.cell[i]] : 0;
+        const double omega = n.sum_w[i] * n.steradians_per_weight;
+        n.density_per_probability[i] = omega > 0 ? share / omega : 0;
+    }
+}
+
 // Cosine-weighted mean luminance of the hemisphere around each bin's normal: E_b / pi.
 std::vector<double> hemisphere_means(const Nodes& n, const Geometry& geometry) {
     std::vector<double> means(geometry.bin_normal.size());
@@ -132,12 +147,18 @@ float window_floor(float highest) noexcept {
     return id > kMaxBuckets ? std::bit_cast<float>((id - kMaxBuckets) << kHistogramShift) : 0.0f;
 }
 
-// The lobe of a class at one normal, on the nodes: f and p_bsdf per node in the
-// hemisphere (`visible`); mis_variance adds p_env from cell probabilities.
-struct Lobe {
-    std::vector<uint32_t> visible;
-    std::vector<double> f, p_bsdf;
+// The lobe of a class at one normal, on the nodes it sees: per node the integrand f, the
+// node's solid angle, the BSDF's density, and what mis_variance needs for the
+// environment's density given its cells' probabilities.
+struct LobeNode {
+    double f, solid_angle, p_bsdf, density_per_probability;
+    uint32_t cell;
 };
+using Lobe = std::vector<LobeNode>;
+
+LobeNode lobe_node(const Nodes& n, uint32_t i, double f, double p_bsdf) {
+    return {f, n.sum_w[i] * n.steradians_per_weight, p_bsdf, n.density_per_probability[i], n.cell[i]};
+}
 
 constexpr double kNegligibleLog = -9.2;  // log(1e-4)
 
@@ -151,6 +172,7 @@ struct View {
 // cosine lobe about the normal.
 Lobe phong_lobe_seen(const Nodes& n, View v, float exponent) {
     Lobe lobe;
+    lobe.reserve(n.direction.size() / 2);
     const Vec3 mirror = v.normal * (2 * dot(v.normal, v.wo)) - v.wo;
     for (uint32_t i = 0; i < n.direction.size(); ++i) {
         const double ci = dot(n.direction[i], v.normal), c = exponent == 0 ? ci : dot(n.direction[i], mirror);
@@ -158,10 +180,10 @@ Lobe phong_lobe_seen(const Nodes& n, View v, float exponent) {
         // Directions where a glossy lobe is below 1e-4 of its peak add nothing that could
         // rank candidates, and skipping them makes sharp lobes cheap to evaluate.
         if (exponent > 0 && exponent * std::log(c) < kNegligibleLog) continue;
-        const double l = n.sum_l[i] / n.sum_w[i];
-        const double p = exponent == 0 ? c / kPi : (exponent + 1) / (2 * kPi) * std::pow(c, exponent);
-        const double fc = exponent == 0 ? c / kPi : (exponent + 2) / (2 * kPi) * std::pow(c, exponent) * ci;
-        lobe.visible.push_back(i), lobe.f.push_back(l * fc), lobe.p_bsdf.push_back(p);
+        const double l = n.sum_l[i] / n.sum_w[i], ce = exponent == 0 ? 0 : std::pow(c, exponent);
+        const double p = exponent == 0 ? c / kPi : (exponent + 1) / (2 * kPi) * ce;
+        const double fc = exponent == 0 ? c / kPi : (exponent + 2) / (2 * kPi) * ce * ci;
+        lobe.push_back(lobe_node(n, i, l * fc, p));
     }
     return lobe;
 }
@@ -181,9 +203,8 @@ Lobe ggx_lobe_seen(const Nodes& n, View v, double a) {
         if (!(ci > 0) || !(n.sum_l[i] > 0)) continue;
         const Vec3 h = normalize(n.direction[i] + v.wo);
         const double ch = dot(h, v.normal), t = ch * ch * (a2 - 1) + 1, d = a2 / (kPi * t * t);
-        lobe.visible.push_back(i);
-        lobe.f.push_back(n.sum_l[i] / n.sum_w[i] * d / (4 * co * (1 + lambda_o + lambda(ci))));
-        lobe.p_bsdf.push_back(d / (4 * co * (1 + lambda_o)));
+        lobe.push_back(lobe_node(n, i, n.sum_l[i] / n.sum_w[i] * d / (4 * co * (1 + lambda_o + lambda(ci))),
+                                 d / (4 * co * (1 + lambda_o))));
     }
     return lobe;
 }
@@ -205,15 +226,10 @@ std::vector<View> views_about(Vec3 axis, double angle) {
 }
 
 // Exact variance of one 1 + 1 balance MIS estimate at the lobe's normal (mis_variance.h).
-double mis_variance(const Nodes& n, const Lobe& lobe, std::span<const double> cell_probability,
-                    std::span<const double> cell_mass) {
+double mis_variance(const Lobe& lobe, std::span<const double> cell_probability) {
     MisMoments m;
-    for (size_t j = 0; j < lobe.visible.size(); ++j) {
-        const uint32_t i = lobe.visible[j];
-        const double omega = n.sum_w[i] * n.steradians_per_weight;
-        const double share = cell_mass[n.cell[i]] > 0 ? n.sum_l[i] / cell_mass[n.cell[i]] : 0;
-        m.add_balance({lobe.f[j], omega, cell_probability[n.cell[i]] * share / omega, lobe.p_bsdf[j]}, {});
-    }
+    for (const LobeNode& x : lobe)
+        m.add_balance({x.f, x.solid_angle, cell_probability[x.cell] * x.density_per_probability, x.p_bsdf}, {});
     return m.variance({});
 }
 
@@ -279,12 +295,11 @@ struct Lobes {
 // light. The views are those at kViewAngles from the axis on four sides; the limit lies
 // halfway between the last angle at which every view's variance is below the plain
 // density's and the first at which one is not.
-float view_limit(const Nodes& n, std::span<const double> mass, std::span<const double> plain_p,
-                 std::span<const double> p, Vec3 axis, Lobes lobes) {
+float view_limit(const Nodes& n, std::span<const double> plain_p, std::span<const double> p, Vec3 axis, Lobes lobes) {
     constexpr double kViewAngles[] = {0.7854, 1.0472, 1.309, 1.4835};  // 45, 60, 75, 85 degrees
     const auto loses = [&](const Lobe& lobe) {
-        const double base = mis_variance(n, lobe, plain_p, mass);
-        return base > 0 && mis_variance(n, lobe, p, mass) > base;
+        const double base = mis_variance(lobe, plain_p);
+        return base > 0 && mis_variance(lobe, p) > base;
     };
     double passed = 0;
     for (double angle : kViewAngles) {
@@ -299,7 +314,7 @@ float view_limit(const Nodes& n, std::span<const double> mass, std::span<const d
 
 std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, const Geometries& geometries,
                                    const BinLayout& shape, const BinnedOptions& options, StopFlag stop) {
-    const Nodes nodes = nodes_of(plain, grid, stop);
+    Nodes nodes = nodes_of(plain, grid, stop);
     const auto classes = static_cast<uint32_t>(shape.lobe_exponents.size());
     const std::vector<float> alphas = options.auto_alpha ? options.candidates : std::vector<float>{options.alpha};
     const size_t count = alphas.size();
@@ -327,6 +342,7 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
     const CellHistogram hist = histogram(plain, grid, every_threshold, stop);
     const size_t cells = size_t{grid.cw} * grid.ch;
     const std::vector<double> plain_p = probabilities(hist.total_l);
+    weigh_nodes(nodes, hist.total_l);
     for (uint32_t c = 0; c < classes; ++c) {
         const bool glossy = c > 0;
         const Geometry& geometry = geometries.of(c);
@@ -346,9 +362,9 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
                 // Per candidate, the weighted mean of log(variance / the plain density's).
                 std::vector<double> log_ratio(count, 0);
                 const auto add = [&](const Lobe& lobe, double weight, std::vector<double>& to) {
-                    const double base = mis_variance(nodes, lobe, plain_p, hist.total_l);
+                    const double base = mis_variance(lobe, plain_p);
                     for (size_t j = 0; j < count; ++j) {
-                        const double v = p[j].empty() ? 0 : mis_variance(nodes, lobe, p[j], hist.total_l);
+                        const double v = p[j].empty() ? 0 : mis_variance(lobe, p[j]);
                         if (base > 0) to[j] += weight * (v > 0 ? std::log(v / base) : (p[j].empty() ? 1e9 : 0));
                     }
                 };
@@ -374,7 +390,7 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
                              ? BinChoice{alphas[best], thresholds[glossy][b * count + best]}
                              : BinChoice{-1, 0};
                 if (glossy && !choice.plain())
-                    choice.min_view_cos = view_limit(nodes, hist.total_l, plain_p, p[best], centre, {exponent, ggx_a});
+                    choice.min_view_cos = view_limit(nodes, plain_p, p[best], centre, {exponent, ggx_a});
             }
         });
     }

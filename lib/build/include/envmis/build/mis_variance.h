@@ -42,13 +42,15 @@ struct MisMoments {
                   node.solid_angle;
     }
 
-    // A node under the balance heuristic, whose weights are in double.
+    // A node under the balance heuristic, whose weights are in double. One division:
+    // each term is f omega / Q times f, n_env p_env or n_bsdf p_bsdf.
     void add_balance(const MisNode& node, MisCounts n) noexcept {
         const double pe = n.env * node.p_env, pb = n.bsdf * node.p_bsdf, q = pe + pb;
         if (!(q > 0)) return;
-        second += node.f * node.f / q * node.solid_angle;
-        env += node.f * pe / q * node.solid_angle;
-        bsdf += node.f * pb / q * node.solid_angle;
+        const double r = node.f * node.solid_angle / q;
+        second += node.f * r;
+        env += pe * r;
+        bsdf += pb * r;
     }
 
     MisMoments& operator+=(const MisMoments& o) noexcept {
