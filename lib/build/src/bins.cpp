@@ -19,14 +19,18 @@ namespace {
 
 using namespace detail;
 
-// Node grid for the choice: each cell cut into k x k nodes, at most kNodeColumns wide.
+// Node grid for the choice: each cell cut into k x k nodes (k <= 4), at most `columns`
+// wide: 64 for the diffuse class, whose cosine lobe is smooth, 128 for the glossy
+// classes, whose narrow lobes a 64-node grid (5.6 degrees a node at 1k) misjudged: with
+// it GGX 0.1 had 1.09x the variance of plain balance MIS at a point where its bin
+// predicted a gain (docs/performance.md).
 // The brightest texels (at least kHotShare of the brightest, at most kMaxHotTexels of
 // them) are nodes of their own, out of their grid node: a sun smeared over a node of
 // 16 x 16 texels misplaces it by degrees, and where it grazes a normal's horizon the
 // variances the choice compares are then wrong (on rooitou_park, a diffuse bin near +z
 // chosen so had 2.2x the variance of plain balance MIS where the sun stood 5 degrees
 // above the normal's horizon).
-constexpr uint32_t kNodeColumns = 64, kMaxHotTexels = 2048;
+constexpr uint32_t kDiffuseNodeColumns = 64, kGlossyNodeColumns = 128, kMaxHotTexels = 2048;
 constexpr float kHotShare = 1e-2f;
 
 struct Nodes {
@@ -74,9 +78,9 @@ void add_hot_texels(const EnvMap& plain, const CellGrid& grid, Nodes& n) {
     }
 }
 
-Nodes nodes_of(const EnvMap& plain, const CellGrid& grid, StopFlag stop) {
+Nodes nodes_of(const EnvMap& plain, const CellGrid& grid, uint32_t columns, StopFlag stop) {
     Nodes n;
-    n.k = std::max(1u, std::min({kNodeColumns / grid.cw, grid.w / grid.cw, grid.h / grid.ch, 4u}));
+    n.k = std::max(1u, std::min({columns / grid.cw, grid.w / grid.cw, grid.h / grid.ch, 4u}));
     n.w = grid.cw * n.k, n.h = grid.ch * n.k;
     n.sum_l.assign(size_t{n.w} * n.h, 0);
     n.sum_w.assign(n.sum_l.size(), 0);
@@ -174,12 +178,13 @@ Lobe phong_lobe_seen(const Nodes& n, View v, float exponent) {
     Lobe lobe;
     lobe.reserve(n.direction.size() / 2);
     const Vec3 mirror = v.normal * (2 * dot(v.normal, v.wo)) - v.wo;
+    // Directions where a glossy lobe is below 1e-4 of its peak (c^e < e^kNegligibleLog)
+    // add nothing that could rank candidates, and skipping them makes sharp lobes cheap
+    // to evaluate.
+    const double least_c = exponent > 0 ? std::exp(kNegligibleLog / exponent) : 0;
     for (uint32_t i = 0; i < n.direction.size(); ++i) {
         const double ci = dot(n.direction[i], v.normal), c = exponent == 0 ? ci : dot(n.direction[i], mirror);
-        if (!(ci > 0) || !(c > 0) || !(n.sum_l[i] > 0)) continue;
-        // Directions where a glossy lobe is below 1e-4 of its peak add nothing that could
-        // rank candidates, and skipping them makes sharp lobes cheap to evaluate.
-        if (exponent > 0 && exponent * std::log(c) < kNegligibleLog) continue;
+        if (!(ci > 0) || !(c > least_c) || !(n.sum_l[i] > 0)) continue;
         const double l = n.sum_l[i] / n.sum_w[i], ce = exponent == 0 ? 0 : std::pow(c, exponent);
         const double p = exponent == 0 ? c / kPi : (exponent + 1) / (2 * kPi) * ce;
         const double fc = exponent == 0 ? c / kPi : (exponent + 2) / (2 * kPi) * ce * ci;
@@ -314,14 +319,15 @@ float view_limit(const Nodes& n, std::span<const double> plain_p, std::span<cons
 
 std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, const Geometries& geometries,
                                    const BinLayout& shape, const BinnedOptions& options, StopFlag stop) {
-    Nodes nodes = nodes_of(plain, grid, stop);
+    // Per grid (0: the diffuse class's, 1: the glossy classes'), the nodes.
+    Nodes nodes[2] = {nodes_of(plain, grid, kDiffuseNodeColumns, stop),
+                      nodes_of(plain, grid, kGlossyNodeColumns, stop)};
     const auto classes = static_cast<uint32_t>(shape.lobe_exponents.size());
     const std::vector<float> alphas = options.auto_alpha ? options.candidates : std::vector<float>{options.alpha};
     const size_t count = alphas.size();
-    // Per grid (0: the diffuse class's, 1: the glossy classes'), each bin's hemisphere
-    // mean and its candidates' thresholds, bin-major.
-    const std::vector<double> means[2] = {hemisphere_means(nodes, geometries.diffuse),
-                                          hemisphere_means(nodes, geometries.glossy)};
+    // Per grid, each bin's hemisphere mean and its candidates' thresholds, bin-major.
+    const std::vector<double> means[2] = {hemisphere_means(nodes[0], geometries.diffuse),
+                                          hemisphere_means(nodes[1], geometries.glossy)};
     double highest_mean = 0;
     for (const auto& m : means) highest_mean = std::max(highest_mean, *std::max_element(m.begin(), m.end()));
     const float highest_alpha = *std::max_element(alphas.begin(), alphas.end());
@@ -342,21 +348,23 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
     const CellHistogram hist = histogram(plain, grid, every_threshold, stop);
     const size_t cells = size_t{grid.cw} * grid.ch;
     const std::vector<double> plain_p = probabilities(hist.total_l);
-    weigh_nodes(nodes, hist.total_l);
+    for (Nodes& n : nodes) weigh_nodes(n, hist.total_l);
     for (uint32_t c = 0; c < classes; ++c) {
         const bool glossy = c > 0;
+        const Nodes& class_nodes = nodes[glossy];
         const Geometry& geometry = geometries.of(c);
         const uint32_t g = shape.side(c);
         const float exponent = shape.lobe_exponents[c];
         const double ggx_a = glossy ? ggx_roughness_of(shape.lobe_exponents, c) : 0;
         parallel_for(g * g, 1, stop, [&](uint32_t lo, uint32_t hi) {
             std::vector<double> mass(cells);
+            std::vector<float> weight(cells);
             for (uint32_t b = lo; b < hi; ++b) {
+                for (size_t cell = 0; cell < cells; ++cell) weight[cell] = geometry.weight(b, cell, glossy);
                 std::vector<std::vector<double>> p(count);  // the candidates' cell probabilities
                 for (size_t j = 0; j < count; ++j) {
                     for (size_t cell = 0; cell < cells; ++cell)
-                        mass[cell] =
-                            geometry.weight(b, cell, glossy) * hist.above(cell, thresholds[glossy][b * count + j]);
+                        mass[cell] = weight[cell] * hist.above(cell, thresholds[glossy][b * count + j]);
                     p[j] = probabilities(mass);
                 }
                 // Per candidate, the weighted mean of log(variance / the plain density's).
@@ -371,7 +379,7 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
                 double weights = 0;
                 for (const WeightedNormal& at : bin_samples(b, g)) {
                     weights += at.weight;
-                    add(lobe_at(nodes, at.normal, exponent), at.weight, log_ratio);
+                    add(lobe_at(class_nodes, at.normal, exponent), at.weight, log_ratio);
                 }
                 for (double& r : log_ratio) r /= weights;
                 // A glossy class serves GGX lobes too, whose tails reach lights its Phong
@@ -381,7 +389,7 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
                 const Vec3 centre = bin_centre(b, g);
                 if (glossy && ggx_a > 0) {
                     std::vector<double> ggx(count, 0);
-                    add(ggx_lobe_seen(nodes, {centre, centre}, ggx_a), 1, ggx);
+                    add(ggx_lobe_seen(class_nodes, {centre, centre}, ggx_a), 1, ggx);
                     for (size_t j = 0; j < count; ++j) log_ratio[j] = std::max(log_ratio[j], ggx[j]);
                 }
                 const size_t best = std::min_element(log_ratio.begin(), log_ratio.end()) - log_ratio.begin();
@@ -390,7 +398,7 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
                              ? BinChoice{alphas[best], thresholds[glossy][b * count + best]}
                              : BinChoice{-1, 0};
                 if (glossy && !choice.plain())
-                    choice.min_view_cos = view_limit(nodes, plain_p, p[best], centre, {exponent, ggx_a});
+                    choice.min_view_cos = view_limit(class_nodes, plain_p, p[best], centre, {exponent, ggx_a});
             }
         });
     }
