@@ -21,9 +21,9 @@ using namespace detail;
 
 // Node grid for the choice: each cell cut into k x k nodes (k <= 4), at most `columns`
 // wide: 64 for the diffuse class, whose cosine lobe is smooth, 128 for the glossy
-// classes, whose narrow lobes a 64-node grid (5.6 degrees a node at 1k) misjudged: with
-// it GGX 0.1 had 1.09x the variance of plain balance MIS at a point where its bin
-// predicted a gain (docs/performance.md).
+// classes, whose narrow lobes need nodes finer than 64 columns give (5.6 degrees at 1k)
+// for the variances the choice compares to rank its candidates as the exact study does
+// (docs/performance.md, "The glossy classes' nodes").
 // The brightest texels (at least kHotShare of the brightest, at most kMaxHotTexels of
 // them) are nodes of their own, out of their grid node: a sun smeared over a node of
 // 16 x 16 texels misplaces it by degrees, and where it grazes a normal's horizon the
@@ -39,10 +39,11 @@ struct Nodes {
     std::vector<Vec3> direction;
     std::vector<uint32_t> cell;
     double steradians_per_weight = 0;  // solid angle of a texel of weight 1
-    // Per node, the environment's solid-angle density there per unit probability of its
-    // cell: a cell's texels share their cell's probability by luminance (bin_cells.h).
-    // Set by weigh_nodes once the cells' luminance is known.
-    std::vector<double> density_per_probability;
+    // Per node, set by weigh_nodes once the cells' luminance is known: its mean luminance,
+    // its solid angle, and the environment's solid-angle density there per unit
+    // probability of its cell (a cell's texels share their cell's probability by
+    // luminance, bin_cells.h).
+    std::vector<double> luminance, solid_angle, density_per_probability;
 };
 
 // Moves the brightest texels out of their grid nodes into nodes of their own.
@@ -78,9 +79,13 @@ void add_hot_texels(const EnvMap& plain, const CellGrid& grid, Nodes& n) {
     }
 }
 
+uint32_t node_k(const CellGrid& grid, uint32_t columns) {
+    return std::max(1u, std::min({columns / grid.cw, grid.w / grid.cw, grid.h / grid.ch, 4u}));
+}
+
 Nodes nodes_of(const EnvMap& plain, const CellGrid& grid, uint32_t columns, StopFlag stop) {
     Nodes n;
-    n.k = std::max(1u, std::min({columns / grid.cw, grid.w / grid.cw, grid.h / grid.ch, 4u}));
+    n.k = node_k(grid, columns);
     n.w = grid.cw * n.k, n.h = grid.ch * n.k;
     n.sum_l.assign(size_t{n.w} * n.h, 0);
     n.sum_w.assign(n.sum_l.size(), 0);
@@ -111,13 +116,15 @@ Nodes nodes_of(const EnvMap& plain, const CellGrid& grid, uint32_t columns, Stop
     return n;
 }
 
-// Node i holds sum_l[i] / cell_l of its cell's luminance cell_l, over sum_w[i] times the
-// solid angle of a unit weight.
+// Node i holds sum_l[i] / cell_l of its cell's luminance cell_l, over its solid angle.
 void weigh_nodes(Nodes& n, std::span<const double> cell_l) {
-    n.density_per_probability.resize(n.sum_l.size());
-    for (size_t i = 0; i < n.sum_l.size(); ++i) {
+    const size_t nodes = n.sum_l.size();
+    n.luminance.resize(nodes), n.solid_angle.resize(nodes), n.density_per_probability.resize(nodes);
+    for (size_t i = 0; i < nodes; ++i) {
         const double share = cell_l[n.cell[i]] > 0 ? n.sum_l[i] / cell_l[n.cell[i]] : 0;
         const double omega = n.sum_w[i] * n.steradians_per_weight;
+        n.luminance[i] = n.sum_w[i] > 0 ? n.sum_l[i] / n.sum_w[i] : 0;
+        n.solid_angle[i] = omega;
         n.density_per_probability[i] = omega > 0 ? share / omega : 0;
     }
 }
@@ -161,7 +168,7 @@ struct LobeNode {
 using Lobe = std::vector<LobeNode>;
 
 LobeNode lobe_node(const Nodes& n, uint32_t i, double f, double p_bsdf) {
-    return {f, n.sum_w[i] * n.steradians_per_weight, p_bsdf, n.density_per_probability[i], n.cell[i]};
+    return {f, n.solid_angle[i], p_bsdf, n.density_per_probability[i], n.cell[i]};
 }
 
 constexpr double kNegligibleLog = -9.2;  // log(1e-4)
@@ -175,17 +182,17 @@ struct View {
 // (e + 2) / (2 pi) cos^e cos_i, density (e + 1) / (2 pi) cos^e), or for exponent 0 the
 // cosine lobe about the normal.
 Lobe phong_lobe_seen(const Nodes& n, View v, float exponent) {
-    Lobe lobe;
-    lobe.reserve(n.direction.size() / 2);
     const Vec3 mirror = v.normal * (2 * dot(v.normal, v.wo)) - v.wo;
-    // Directions where a glossy lobe is below 1e-4 of its peak (c^e < e^kNegligibleLog)
-    // add nothing that could rank candidates, and skipping them makes sharp lobes cheap
-    // to evaluate.
+    // Directions where a glossy lobe is below 1e-4 of its peak (c^exponent <
+    // exp(kNegligibleLog)) add nothing that could rank candidates, and skipping them makes
+    // sharp lobes cheap to evaluate.
     const double least_c = exponent > 0 ? std::exp(kNegligibleLog / exponent) : 0;
+    Lobe lobe;
+    lobe.reserve(static_cast<size_t>(0.5 * (1 - least_c) * static_cast<double>(n.direction.size())) + 1);
     for (uint32_t i = 0; i < n.direction.size(); ++i) {
         const double ci = dot(n.direction[i], v.normal), c = exponent == 0 ? ci : dot(n.direction[i], mirror);
         if (!(ci > 0) || !(c > least_c) || !(n.sum_l[i] > 0)) continue;
-        const double l = n.sum_l[i] / n.sum_w[i], ce = exponent == 0 ? 0 : std::pow(c, exponent);
+        const double l = n.luminance[i], ce = exponent == 0 ? 0 : std::pow(c, exponent);
         const double p = exponent == 0 ? c / kPi : (exponent + 1) / (2 * kPi) * ce;
         const double fc = exponent == 0 ? c / kPi : (exponent + 2) / (2 * kPi) * ce * ci;
         lobe.push_back(lobe_node(n, i, l * fc, p));
@@ -208,7 +215,7 @@ Lobe ggx_lobe_seen(const Nodes& n, View v, double a) {
         if (!(ci > 0) || !(n.sum_l[i] > 0)) continue;
         const Vec3 h = normalize(n.direction[i] + v.wo);
         const double ch = dot(h, v.normal), t = ch * ch * (a2 - 1) + 1, d = a2 / (kPi * t * t);
-        lobe.push_back(lobe_node(n, i, n.sum_l[i] / n.sum_w[i] * d / (4 * co * (1 + lambda_o + lambda(ci))),
+        lobe.push_back(lobe_node(n, i, n.luminance[i] * d / (4 * co * (1 + lambda_o + lambda(ci))),
                                  d / (4 * co * (1 + lambda_o))));
     }
     return lobe;
@@ -317,14 +324,72 @@ float view_limit(const Nodes& n, std::span<const double> plain_p, std::span<cons
     return 0;
 }
 
+// What every bin of one lobe class is chosen from.
+struct ClassChoice {
+    const Nodes& nodes;  // the class's grid's
+    const Geometry& geometry;
+    const CellHistogram& hist;
+    std::span<const double> plain_p;    // the plain density's cell probabilities
+    std::span<const float> alphas;      // the candidates
+    std::span<const float> thresholds;  // per bin of the class's grid, per candidate
+    uint32_t g;                         // bins per side
+    bool glossy;
+    Lobes lobes;
+    double cost;  // BinnedOptions::cost
+};
+
+// One bin's choice: the candidate of the lowest weighted mean of log(variance / the
+// plain density's) at the bin's 9 normals, if it beats the plain density by the cost.
+// `weight` and `mass` are the caller's scratch, one entry per cell.
+BinChoice choose_bin(const ClassChoice& k, uint32_t b, std::vector<float>& weight, std::vector<double>& mass) {
+    const size_t count = k.alphas.size(), cells = weight.size();
+    for (size_t cell = 0; cell < cells; ++cell) weight[cell] = k.geometry.weight(b, cell, k.glossy);
+    std::vector<std::vector<double>> p(count);  // the candidates' cell probabilities
+    for (size_t j = 0; j < count; ++j) {
+        for (size_t cell = 0; cell < cells; ++cell)
+            mass[cell] = weight[cell] * k.hist.above(cell, k.thresholds[b * count + j]);
+        p[j] = probabilities(mass);
+    }
+    std::vector<double> log_ratio(count, 0);
+    const auto add = [&](const Lobe& lobe, double normal_weight, std::vector<double>& to) {
+        const double base = mis_variance(lobe, k.plain_p);
+        for (size_t j = 0; j < count; ++j) {
+            const double v = p[j].empty() ? 0 : mis_variance(lobe, p[j]);
+            if (base > 0) to[j] += normal_weight * (v > 0 ? std::log(v / base) : (p[j].empty() ? 1e9 : 0));
+        }
+    };
+    double weights = 0;
+    for (const WeightedNormal& at : bin_samples(b, k.g)) {
+        weights += at.weight;
+        add(lobe_at(k.nodes, at.normal, k.lobes.exponent), at.weight, log_ratio);
+    }
+    for (double& r : log_ratio) r /= weights;
+    // A glossy class serves GGX lobes too, whose tails reach lights its Phong lobe does
+    // not: a candidate must do for both. GGX at the bin's centre only: its lobe covers the
+    // whole hemisphere, the choice's dearest, and weighing it at the 9 normals changed no
+    // figure measured (docs/performance-log.md).
+    const Vec3 centre = bin_centre(b, k.g);
+    if (k.glossy && k.lobes.ggx_a > 0) {
+        std::vector<double> ggx(count, 0);
+        add(ggx_lobe_seen(k.nodes, {centre, centre}, k.lobes.ggx_a), 1, ggx);
+        for (size_t j = 0; j < count; ++j) log_ratio[j] = std::max(log_ratio[j], ggx[j]);
+    }
+    const size_t best = std::min_element(log_ratio.begin(), log_ratio.end()) - log_ratio.begin();
+    if (!(log_ratio[best] < -std::log(k.cost) - 1e-6)) return {-1, 0};
+    BinChoice choice{k.alphas[best], k.thresholds[b * count + best]};
+    if (k.glossy) choice.min_view_cos = view_limit(k.nodes, k.plain_p, p[best], centre, k.lobes);
+    return choice;
+}
+
 std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, const Geometries& geometries,
                                    const BinLayout& shape, const BinnedOptions& options, StopFlag stop) {
-    // Per grid (0: the diffuse class's, 1: the glossy classes'), the nodes.
-    Nodes nodes[2] = {nodes_of(plain, grid, kDiffuseNodeColumns, stop),
-                      nodes_of(plain, grid, kGlossyNodeColumns, stop)};
+    // Per grid (0: the diffuse class's, 1: the glossy classes'), the nodes; one grid
+    // serves both where the cells are too wide or too narrow for the two to differ.
+    Nodes nodes[2] = {nodes_of(plain, grid, kDiffuseNodeColumns, stop), {}};
+    nodes[1] =
+        node_k(grid, kGlossyNodeColumns) == nodes[0].k ? nodes[0] : nodes_of(plain, grid, kGlossyNodeColumns, stop);
     const auto classes = static_cast<uint32_t>(shape.lobe_exponents.size());
     const std::vector<float> alphas = options.auto_alpha ? options.candidates : std::vector<float>{options.alpha};
-    const size_t count = alphas.size();
     // Per grid, each bin's hemisphere mean and its candidates' thresholds, bin-major.
     const std::vector<double> means[2] = {hemisphere_means(nodes[0], geometries.diffuse),
                                           hemisphere_means(nodes[1], geometries.glossy)};
@@ -346,60 +411,25 @@ std::vector<BinChoice> choose_bins(const EnvMap& plain, const CellGrid& grid, co
     std::vector<float> every_threshold = thresholds[0];
     every_threshold.insert(every_threshold.end(), thresholds[1].begin(), thresholds[1].end());
     const CellHistogram hist = histogram(plain, grid, every_threshold, stop);
-    const size_t cells = size_t{grid.cw} * grid.ch;
     const std::vector<double> plain_p = probabilities(hist.total_l);
     for (Nodes& n : nodes) weigh_nodes(n, hist.total_l);
     for (uint32_t c = 0; c < classes; ++c) {
         const bool glossy = c > 0;
-        const Nodes& class_nodes = nodes[glossy];
-        const Geometry& geometry = geometries.of(c);
-        const uint32_t g = shape.side(c);
-        const float exponent = shape.lobe_exponents[c];
-        const double ggx_a = glossy ? ggx_roughness_of(shape.lobe_exponents, c) : 0;
-        parallel_for(g * g, 1, stop, [&](uint32_t lo, uint32_t hi) {
-            std::vector<double> mass(cells);
-            std::vector<float> weight(cells);
-            for (uint32_t b = lo; b < hi; ++b) {
-                for (size_t cell = 0; cell < cells; ++cell) weight[cell] = geometry.weight(b, cell, glossy);
-                std::vector<std::vector<double>> p(count);  // the candidates' cell probabilities
-                for (size_t j = 0; j < count; ++j) {
-                    for (size_t cell = 0; cell < cells; ++cell)
-                        mass[cell] = weight[cell] * hist.above(cell, thresholds[glossy][b * count + j]);
-                    p[j] = probabilities(mass);
-                }
-                // Per candidate, the weighted mean of log(variance / the plain density's).
-                std::vector<double> log_ratio(count, 0);
-                const auto add = [&](const Lobe& lobe, double weight, std::vector<double>& to) {
-                    const double base = mis_variance(lobe, plain_p);
-                    for (size_t j = 0; j < count; ++j) {
-                        const double v = p[j].empty() ? 0 : mis_variance(lobe, p[j]);
-                        if (base > 0) to[j] += weight * (v > 0 ? std::log(v / base) : (p[j].empty() ? 1e9 : 0));
-                    }
-                };
-                double weights = 0;
-                for (const WeightedNormal& at : bin_samples(b, g)) {
-                    weights += at.weight;
-                    add(lobe_at(class_nodes, at.normal, exponent), at.weight, log_ratio);
-                }
-                for (double& r : log_ratio) r /= weights;
-                // A glossy class serves GGX lobes too, whose tails reach lights its Phong
-                // lobe does not: a candidate must do for both. GGX at the bin's centre only:
-                // its lobe covers the whole hemisphere, the choice's dearest, and weighing
-                // it at the 9 normals changed no figure measured (docs/performance-log.md).
-                const Vec3 centre = bin_centre(b, g);
-                if (glossy && ggx_a > 0) {
-                    std::vector<double> ggx(count, 0);
-                    add(ggx_lobe_seen(class_nodes, {centre, centre}, ggx_a), 1, ggx);
-                    for (size_t j = 0; j < count; ++j) log_ratio[j] = std::max(log_ratio[j], ggx[j]);
-                }
-                const size_t best = std::min_element(log_ratio.begin(), log_ratio.end()) - log_ratio.begin();
-                BinChoice& choice = choices[shape.first(c) + b];
-                choice = log_ratio[best] < -std::log(options.cost) - 1e-6
-                             ? BinChoice{alphas[best], thresholds[glossy][b * count + best]}
-                             : BinChoice{-1, 0};
-                if (glossy && !choice.plain())
-                    choice.min_view_cos = view_limit(class_nodes, plain_p, p[best], centre, {exponent, ggx_a});
-            }
+        const Lobes lobes{shape.lobe_exponents[c], glossy ? ggx_roughness_of(shape.lobe_exponents, c) : 0};
+        const ClassChoice k{.nodes = nodes[glossy],
+                            .geometry = geometries.of(c),
+                            .hist = hist,
+                            .plain_p = plain_p,
+                            .alphas = alphas,
+                            .thresholds = thresholds[glossy],
+                            .g = shape.side(c),
+                            .glossy = glossy,
+                            .lobes = lobes,
+                            .cost = options.cost};
+        parallel_for(k.g * k.g, 1, stop, [&](uint32_t lo, uint32_t hi) {
+            std::vector<float> weight(size_t{grid.cw} * grid.ch);
+            std::vector<double> mass(weight.size());
+            for (uint32_t b = lo; b < hi; ++b) choices[shape.first(c) + b] = choose_bin(k, b, weight, mass);
         });
     }
     return choices;

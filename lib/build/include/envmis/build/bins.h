@@ -4,8 +4,8 @@
 // from it. What a renderer loads (a table's layout) the runtime rebuilds alone:
 // BinnedEnvMap(plain, layout).
 //
-// The choice, per bin of each lobe class: a grid of nodes (cells cut finer, twice as
-// finely for the glossy classes, the brightest texels apart) stands for the map; for
+// The choice, per bin of each lobe class: a grid of nodes (cells cut finer, up to twice
+// as finely for the glossy classes, the brightest texels apart) stands for the map; for
 // each candidate alpha the bin's cell masses give a density, and the variance of one
 // environment plus one BSDF sample, balance heuristic, a Phong lobe of the class's
 // exponent, is summed exactly over the nodes at 9 normals of the bin (for a glossy class
@@ -14,8 +14,9 @@
 // where it lowers the geometric mean of the ratio to the plain density's by more than
 // options.cost (BinnedOptions), else the bin stays plain.
 //
-// Cost: a pass over the texels per node grid, then O(bins x candidates x normals x
-// nodes); parallel over bins (detail/parallel.h), deterministic for any number of threads.
+// Cost: three passes over the texels per node grid (its sums and the brightest texels),
+// then O(bins x candidates x normals x nodes); parallel over bins (detail/parallel.h),
+// deterministic for any number of threads.
 #pragma once
 
 #include "envmis/build_export.h"

@@ -86,8 +86,9 @@
 // the texel in the plain row's segment), pdf O(1); noexcept, allocation-free, ENVMIS_HD.
 // Memory on top of the plain map: 6 bytes per cell per bin per class, 6 bytes per (cell
 // column, texel row); figures in docs/performance.md. At most 65536 cells (uint16 guide).
-// Build: four passes over the texels (the choice's two node grids, candidate and final
-// cell histograms), then O(K classes cells) work and the choice (docs/performance.md).
+// Build: passes over the texels (three per node grid of the choice, one or two; the
+// candidate and final cell histograms), then O(K classes cells) work and the choice
+// (docs/performance.md).
 #pragma once
 
 #include <cstdint>
