@@ -36,6 +36,30 @@ TEST(FastMath, Atan2Within4e7EverywhereIncludingAxes) {
     EXPECT_FLOAT_EQ(fast_atan2(-1.0f, 0.0f), -kPiF / 2);
 }
 
+TEST(FastMath, Atan2IsNotFooledByEachQuadrantsSignsOrSignedZeros) {
+    // The half-angle form's two cases meet on the y axis and at x = -0.
+    for (const float y : {1.0f, -1.0f, 0.5f, -2.0f})
+        for (const float x : {0.0f, -0.0f, 1e-30f, -1e-30f, 3.0f, -3.0f})
+            EXPECT_NEAR(fast_atan2(y, x), std::atan2(double{y}, double{x}), 4e-7) << y << ", " << x;
+    EXPECT_FLOAT_EQ(fast_atan2(0.0f, -0.0f), kPiF);
+    EXPECT_FLOAT_EQ(fast_atan2(-0.0f, -1.0f), -kPiF);
+}
+
+TEST(FastMath, AcosWithin4p5e7OnMinusOneToOneAndExactAtItsEnds) {
+    double worst = 0;
+    for (int i = -4000000; i <= 4000000; ++i) {
+        const float z = static_cast<float>(i) / 4000000.0f;
+        worst = std::max(worst, std::abs(fast_acos(z) - std::acos(double{z})));
+    }
+    for (float z = 1.0f; z > 0.999f; z = std::nextafter(z, 0.0f))  // the pole, where acos is steep
+        worst = std::max(
+            {worst, std::abs(fast_acos(z) - std::acos(double{z})), std::abs(fast_acos(-z) - std::acos(double{-z}))});
+    EXPECT_LT(worst, 4.5e-7);
+    EXPECT_EQ(fast_acos(1.0f), 0.0f);
+    EXPECT_EQ(fast_acos(-1.0f), kPiF);
+    EXPECT_FLOAT_EQ(fast_acos(0.0f), kPiF / 2);
+}
+
 TEST(FastMath, TurnTableSinCosWithin1e7OverTheTurnAndBeyond) {
     const std::vector<SinCos> table = make_turn_table();
     double worst = 0;

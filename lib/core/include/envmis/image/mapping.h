@@ -101,10 +101,11 @@ ENVMIS_HD inline Vec3 equirect_direction(Vec2 uv, float* sin_theta = nullptr) no
 template <class F = float>
 ENVMIS_HD inline Vec2Of<F> equirect_uv(const Vec3Of<F>& d) noexcept {
     const F z = clamp(d.z, -1.0f, 1.0f);
-    const F theta = fast_atan2(sqrt_of(max(0.0f, (1.0f - z) * (1.0f + z))), z);
-    const F phi = fast_atan2(d.y, d.x);
+    const F theta = fast_acos(z);
+    // phi / 2 pi in [0, 1) as 1/2 + atan2(-y, -x) / 2 pi: no wrap of a negative phi by a
+    // select, which random directions would mispredict.
     constexpr float kInvPi = static_cast<float>(1 / kPi);
-    const F u = 0.5f * kInvPi * select(phi < 0.0f, phi + 2 * kPiF, phi);
+    const F u = 0.5f + (0.5f * kInvPi) * fast_atan2(-d.y, -d.x);
     return {clamp(u, 0.0f, kOneMinusEpsilon), clamp(theta * kInvPi, 0.0f, kOneMinusEpsilon)};
 }
 

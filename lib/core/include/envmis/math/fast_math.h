@@ -1,9 +1,10 @@
-// Single-precision sin, cos and atan2 for the sampling hot path, inline and branch-light
-// (libm's calls cost more than the rest of an MIS estimate together). Polynomials after
-// Cephes (Moshier 1989): Cody-Waite range reduction to [-pi/4, pi/4], then minimax
-// polynomials. Accuracy, against double precision: within 2e-7 absolute for sin and cos
-// on |x| <= 8 pi, within 4e-7 (1.5 float ulps of pi) for atan2 everywhere; checked in
-// tests/core/math/fast_math_test.cpp.
+// Single-precision sin, cos, atan2 and acos for the sampling hot path, inline and
+// branch-light (libm's calls cost more than the rest of an MIS estimate together).
+// sin and cos after Cephes (Moshier 1989): Cody-Waite range reduction to [-pi/4, pi/4],
+// then minimax polynomials; atan and acos after Abramowitz and Stegun 4.4.49 and 4.4.46.
+// Accuracy, against double precision: within 2e-7 absolute for sin and cos on
+// |x| <= 8 pi, within 4e-7 (1.5 float ulps of pi) for atan2 everywhere, within 4.5e-7
+// for acos on [-1, 1]; checked in tests/core/math/fast_math_test.cpp.
 #pragma once
 
 #include <cmath>
@@ -38,23 +39,52 @@ ENVMIS_HD inline SinCosOf<F> fast_sincos(F x) noexcept {
     return {select((q & 2u) == 2u, -sin_x, sin_x) * sign, select(((q + 1u) & 2u) == 2u, -cos_x, cos_x)};
 }
 
-// atan2(y, x) in [-pi, pi]; 0 for (0, 0). Branch-free: the quadrant and range choices
-// are selects, since directions arrive in random octants and mispredicted branches
-// would cost more than the arithmetic. One division: atan(n / d) with n <= d, reduced
-// to |r| <= tan(pi/8) by atan(n / d) = pi/4 + atan((n - d) / (n + d)).
+// atan(q) for |q| <= 1: q times a degree-8 polynomial in q^2 (Abramowitz and Stegun
+// 4.4.49, within 2e-8 in exact arithmetic).
+template <class F>
+ENVMIS_HD inline F atan_unit(F q) noexcept {
+    const F z = q * q;
+    F p = 2.8662257e-3f * z - 1.61657367e-2f;
+    p = p * z + 4.29096138e-2f;
+    p = p * z - 7.52896400e-2f;
+    p = p * z + 1.065626393e-1f;
+    p = p * z - 1.420889944e-1f;
+    p = p * z + 1.999355085e-1f;
+    p = p * z - 3.333314528e-1f;
+    return (p * z) * q + q;
+}
+
+// atan2(y, x) in [-pi, pi]; 0 for (0, 0). atan(n / d) with n = min(|x|, |y|) <= d =
+// max(|x|, |y|) needs no range reduction, and each reflection after it (about pi/4 where
+// |y| > |x|, about pi/2 where x < 0, about 0 where y < 0) is a sign copied onto a
+// distance from the mirror, a bit operation: directions arrive in random octants, and
+// the selects these replace compiled to jumps that mispredicted half the time
+// (measured: docs/performance-log.md, 'fast_atan2').
 template <class F>
 ENVMIS_HD inline F fast_atan2(F y, F x) noexcept {
     const F ax = abs_of(x), ay = abs_of(y);
-    const auto swap = ay > ax;
-    const F n = select(swap, ax, ay), d = select(swap, ay, ax);
-    const auto reduce = n > 0.41421356237309515f * d;
-    const F num = select(reduce, n - d, n), den = select(reduce, n + d, d);
-    const F r = select(den > 0.0f, num / den, 0.0f), z = r * r;
-    F a = (((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z - 3.33329491539e-1f) * z * r + r;
-    a = a + select(reduce, kPiF / 4, 0.0f);
-    a = select(swap, kPiF / 2 - a, a);
-    a = select(x < 0.0f, kPiF - a, a);
-    return copysign_of(a, y);
+    const F a = atan_unit(min(ax, ay) / max(max(ax, ay), F(0x1p-126f)));  // [0, pi/4]
+    const F b = kPiF / 4 - copysign_of(kPiF / 4 - a, ax - ay);            // atan(|y| / |x|)
+    return copysign_of(kPiF / 2 - copysign_of(kPiF / 2 - b, x), y);
+}
+
+// acos(z) in [0, pi] for z in [-1, 1], without a division or a branch: sqrt(1 - |z|)
+// times a degree-7 polynomial in |z| (Abramowitz and Stegun 4.4.46, within 2e-8 in exact
+// arithmetic), mirrored for z < 0 by the sign bit. The equirectangular map's inverse
+// takes its theta from here, where atan2(sqrt(1 - z^2), z) would cost a division and
+// the arc tangent's reflections more (measured: docs/performance-log.md, 'fast_acos').
+template <class F>
+ENVMIS_HD inline F fast_acos(F z) noexcept {
+    const F x = abs_of(z);
+    F p = -1.2624911e-3f * x + 6.6700901e-3f;
+    p = p * x - 1.70881256e-2f;
+    p = p * x + 3.08918810e-2f;
+    p = p * x - 5.01743046e-2f;
+    p = p * x + 8.89789874e-2f;
+    p = p * x - 2.145988016e-1f;
+    p = p * x + 1.5707963050f;
+    const F a = sqrt_of(1.0f - x) * p;  // acos |z|
+    return kPiF / 2 - copysign_of(kPiF / 2 - a, z);
 }
 
 // x^y for x >= 0 and y >= 0 (x^y <= FLT_MAX), as 2^(y log2 x) in float multiplies, adds,
