@@ -86,6 +86,30 @@ TEST(Binned, InsideACellTexelsArePickedByThePlainDensity) {
         }
 }
 
+TEST(Binned, ATexelsCellIsTheExactQuotientForEveryMapAndGridSize) {
+    // cell_column, cell_row and find_cell divide by a product and a shift: exact for every
+    // numerator below 2^28 (texel index times cells) and every divisor to 65536.
+    for (const uint32_t d :
+         {1u, 2u, 3u, 7u, 32u, 112u, 724u, 1000u, 1023u, 1024u, 1025u, 4096u, 5792u, 40961u, 65535u, 65536u}) {
+        const detail::ExactDivision by = detail::ExactDivision::by(d);
+        const auto check = [&](uint64_t n) {
+            if (n < (1u << 28)) {
+                ASSERT_EQ(by.of(static_cast<uint32_t>(n)), n / d) << n << " / " << d;
+            }
+        };
+        for (uint64_t q = 0; q * d < (1u << 28); q += 1 + q / 64)  // at quotients' edges, spread over the range
+            for (const int64_t e : {int64_t{-1}, int64_t{0}, int64_t{1}, int64_t{d} - 1})
+                if (static_cast<int64_t>(q * d) + e >= 0) check(q * d + e);
+        check((1u << 28) - 1);
+    }
+    for (const auto& [w, h] : {std::pair{64u, 32u}, {100u, 50u}, {724u, 362u}}) {
+        const BinnedEnvMap map = build_bins(plain_map(test::random_map(w, h, 3)));
+        const BinnedEnvMapView view = map.view();
+        for (uint32_t x = 0; x < w; ++x) EXPECT_EQ(view.cell_column(x), uint64_t{x} * view.cells_w / w) << x;
+        for (uint32_t y = 0; y < h; ++y) EXPECT_EQ(view.cell_row(y), uint64_t{y} * view.cells_h / h) << y;
+    }
+}
+
 TEST(Binned, PdfCoversWhatEveryNormalOfTheBinSeesAcrossBinBorders) {
     expect_coverage(build_bins(plain_map(test::sun_sky_map(64, 32))), 0);
     expect_coverage(build_bins(plain_map(test::random_map(64, 32, 2))), 2);

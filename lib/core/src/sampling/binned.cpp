@@ -367,7 +367,10 @@ BinnedEnvMapView BinnedEnvMap::view() const noexcept {
             layout_.bins_per_side,
             bins(),
             layout_.diffuse_bins_per_side,
-            diffuse_bins()};
+            diffuse_bins(),
+            detail::ExactDivision::by(plain_.width()),
+            detail::ExactDivision::by(plain_.height()),
+            detail::ExactDivision::by(layout_.cell_columns)};
 }
 
 bool BinnedEnvMap::complete(uint32_t lobe) const noexcept {

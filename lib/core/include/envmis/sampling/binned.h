@@ -367,6 +367,25 @@ struct BinView {
     ENVMIS_HD EnvMapView::Lookup lookup(Vec3 direction) const noexcept;
 };
 
+namespace detail {
+// floor(n / d) for n < 2^28 and d in [1, 2^16], as a product and a shift: with
+// k = 28 + ceil(log2 d) and m = ceil(2^k / d) < 2^29, n m / 2^k exceeds n / d by less than
+// 1 / d, so the floor is the same, and n m < 2^57 fits. A binned pdf finds its texel's
+// cell this way, a binned sample its cell's row: the divisions they replace were on
+// their critical paths.
+struct ExactDivision {
+    uint64_t m = 1;
+    uint32_t k = 0;
+    static ExactDivision by(uint32_t d) noexcept {
+        uint32_t l = 0;
+        while ((uint64_t{1} << l) < d) ++l;
+        const uint32_t k = 28 + l;
+        return {((uint64_t{1} << k) + d - 1) / d, k};
+    }
+    ENVMIS_HD uint32_t of(uint32_t n) const noexcept { return static_cast<uint32_t>((uint64_t{n} * m) >> k); }
+};
+}  // namespace detail
+
 // Non-owning, device-friendly view of a BinnedEnvMap (flat arrays).
 struct BinnedEnvMapView {
     EnvMapView plain;                      // texel level: the plain density and the radiance
@@ -384,6 +403,9 @@ struct BinnedEnvMapView {
     uint32_t cells_w = 0, cells_h = 0, classes = 0;
     uint32_t bins_per_side = 0, bins = 0;                  // of each glossy class (1 and up)
     uint32_t diffuse_bins_per_side = 0, diffuse_bins = 0;  // of the diffuse class (0)
+    // Divisions by the plain map's width and height (cell_column, cell_row) and by cells_w
+    // (find_cell's row of a cell).
+    detail::ExactDivision by_width, by_height, by_cells_w;
 
     // The density a shading point samples in lobe class `lobe`: among the bins around
     // `at.axis` (world frame; lobe_axis), the one a uniform `choice` in [0,1) picks
@@ -434,12 +456,8 @@ struct BinnedEnvMapView {
     ENVMIS_HD Rgb eval(Vec3 direction) const noexcept { return plain.eval(direction); }
 
     // Cell column and row of texel (x, y): the cell whose edges hold it.
-    ENVMIS_HD uint32_t cell_column(uint32_t x) const noexcept {
-        return static_cast<uint32_t>(uint64_t{x} * cells_w / plain.distribution.w);
-    }
-    ENVMIS_HD uint32_t cell_row(uint32_t y) const noexcept {
-        return static_cast<uint32_t>(uint64_t{y} * cells_h / plain.distribution.h);
-    }
+    ENVMIS_HD uint32_t cell_column(uint32_t x) const noexcept { return by_width.of(x * cells_w); }
+    ENVMIS_HD uint32_t cell_row(uint32_t y) const noexcept { return by_height.of(y * cells_h); }
     // The CDF over the texel rows of cell (cx, cy).
     ENVMIS_HD CdfView cell_rows(uint32_t cx, uint32_t cy) const noexcept {
         const size_t at = size_t{cx} * plain.distribution.h + row_edges[cy];
@@ -526,7 +544,7 @@ private:
 ENVMIS_HD inline BinView::Cell BinView::find_cell(float ux) const noexcept {
     const BinnedEnvMapView& m = *map;
     const CellHit hit = cells.invert(ux);
-    const uint32_t cy = hit.index / m.cells_w;
+    const uint32_t cy = m.by_cells_w.of(hit.index);
     return {hit, hit.index - cy * m.cells_w, cy};
 }
 
