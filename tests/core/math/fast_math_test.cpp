@@ -45,6 +45,23 @@ TEST(FastMath, Atan2IsNotFooledByEachQuadrantsSignsOrSignedZeros) {
     EXPECT_FLOAT_EQ(fast_atan2(-0.0f, -1.0f), -kPiF);
 }
 
+TEST(FastMath, QuarterTurnsAtanWithin1p5e7OfAQuarterTurnInTheFirstQuadrant) {
+    double worst = 0;
+    for (int i = 0; i <= 1000000; ++i) {
+        const double a = kPi / 2 * i / 1000000.0;
+        for (double r : {1e-6, 1.0, 1e6}) {
+            const auto y = static_cast<float>(r * std::sin(a)), x = static_cast<float>(std::abs(r * std::cos(a)));
+            worst =
+                std::max(worst, std::abs(fast_atan_quarter_turns(y, x) - std::atan2(double{y}, double{x}) / (kPi / 2)));
+        }
+    }
+    EXPECT_LT(worst, 1.5e-7);  // 2.4e-7 radians
+    EXPECT_EQ(fast_atan_quarter_turns(0.0f, 0.0f), 0.0f);
+    EXPECT_EQ(fast_atan_quarter_turns(0.0f, 1.0f), 0.0f);
+    EXPECT_EQ(fast_atan_quarter_turns(1.0f, 0.0f), 1.0f);
+    EXPECT_FLOAT_EQ(fast_atan_quarter_turns(2.0f, 2.0f), 0.5f);
+}
+
 TEST(FastMath, AcosWithin4p5e7OnMinusOneToOneAndExactAtItsEnds) {
     double worst = 0;
     for (int i = -4000000; i <= 4000000; ++i) {

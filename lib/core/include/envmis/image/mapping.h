@@ -150,7 +150,7 @@ template <class F = float>
 ENVMIS_HD inline Vec2Of<F> equal_area_uv(const Vec3Of<F>& d) noexcept {
     const F r = sqrt_of(1.0f - min(abs_of(d.z), 1.0f));
     // The angle within the quadrant, as a fraction of a quarter turn.
-    const F t = fast_atan2(abs_of(d.y), abs_of(d.x)) * static_cast<float>(2 / kPi);
+    const F t = fast_atan_quarter_turns(abs_of(d.y), abs_of(d.x));
     const F north_v = t * r, north_u = r - north_v;
     const auto south = d.z < 0.0f;  // mirrored across the equator
     const F u = copysign_of(select(south, 1.0f - north_v, north_u), d.x);

@@ -68,6 +68,15 @@ ENVMIS_HD inline F fast_atan2(F y, F x) noexcept {
     return copysign_of(kPiF / 2 - copysign_of(kPiF / 2 - b, x), y);
 }
 
+// atan(y / x) in quarter turns, [0, 1], for x, y >= 0 (0 for (0, 0)): fast_atan2's first
+// quadrant in its own unit, one reflection, about an eighth of a turn. The equal-area
+// map's azimuth within its quadrant.
+template <class F>
+ENVMIS_HD inline F fast_atan_quarter_turns(F y, F x) noexcept {
+    const F a = atan_unit(min(x, y) / max(max(x, y), F(0x1p-126f))) * static_cast<float>(2 / kPi);  // [0, 1/2]
+    return 0.5f - copysign_of(0.5f - a, x - y);
+}
+
 // acos(z) in [0, pi] for z in [-1, 1], without a division or a branch: sqrt(1 - |z|)
 // times a degree-7 polynomial in |z| (Abramowitz and Stegun 4.4.46, within 2e-8 in exact
 // arithmetic), mirrored for z < 0 by the sign bit. The equirectangular map's inverse
