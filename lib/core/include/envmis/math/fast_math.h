@@ -54,17 +54,22 @@ ENVMIS_HD inline F atan_unit(F q) noexcept {
     return (p * z) * q + q;
 }
 
-// atan2(y, x) in [-pi, pi]; 0 for (0, 0). atan(n / d) with n = min(|x|, |y|) <= d =
-// max(|x|, |y|) needs no range reduction, and each reflection after it (about pi/4 where
-// |y| > |x|, about pi/2 where x < 0, about 0 where y < 0) is a sign copied onto a
-// distance from the mirror, a bit operation: directions arrive in random octants, and
-// the selects these replace compiled to jumps that mispredicted half the time
-// (measured: docs/performance-log.md, 'fast_atan2').
+// atan(min(a, b) / max(a, b)) in [0, pi/4] for a, b >= 0 (0 for (0, 0)): no range
+// reduction, the ratio being at most 1.
+template <class F>
+ENVMIS_HD inline F atan_octant(F a, F b) noexcept {
+    return atan_unit(min(a, b) / max(max(a, b), F(0x1p-126f)));
+}
+
+// atan2(y, x) in [-pi, pi]; 0 for (0, 0). The octant's arc tangent, then each reflection
+// (about pi/4 where |y| > |x|, about pi/2 where x < 0, about 0 where y < 0) as a sign
+// copied onto a distance from the mirror, a bit operation: a select would compile to a
+// jump, which directions in random octants mispredict half the time (measured:
+// docs/performance-log.md, 'fast_atan2').
 template <class F>
 ENVMIS_HD inline F fast_atan2(F y, F x) noexcept {
     const F ax = abs_of(x), ay = abs_of(y);
-    const F a = atan_unit(min(ax, ay) / max(max(ax, ay), F(0x1p-126f)));  // [0, pi/4]
-    const F b = kPiF / 4 - copysign_of(kPiF / 4 - a, ax - ay);            // atan(|y| / |x|)
+    const F b = kPiF / 4 - copysign_of(kPiF / 4 - atan_octant(ax, ay), ax - ay);  // atan(|y| / |x|)
     return copysign_of(kPiF / 2 - copysign_of(kPiF / 2 - b, x), y);
 }
 
@@ -73,7 +78,7 @@ ENVMIS_HD inline F fast_atan2(F y, F x) noexcept {
 // map's azimuth within its quadrant.
 template <class F>
 ENVMIS_HD inline F fast_atan_quarter_turns(F y, F x) noexcept {
-    const F a = atan_unit(min(x, y) / max(max(x, y), F(0x1p-126f))) * static_cast<float>(2 / kPi);  // [0, 1/2]
+    const F a = atan_octant(x, y) * static_cast<float>(2 / kPi);  // [0, 1/2]
     return 0.5f - copysign_of(0.5f - a, x - y);
 }
 

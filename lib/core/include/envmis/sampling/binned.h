@@ -371,8 +371,8 @@ namespace detail {
 // floor(n / d) for n < 2^28 and d in [1, 2^16], as a product and a shift: with
 // k = 28 + ceil(log2 d) and m = ceil(2^k / d) < 2^29, n m / 2^k exceeds n / d by less than
 // 1 / d, so the floor is the same, and n m < 2^57 fits. A binned pdf finds its texel's
-// cell this way, a binned sample its cell's row: the divisions they replace were on
-// their critical paths.
+// cell this way, a binned sample its cell's row: a division would sit on their critical
+// paths.
 struct ExactDivision {
     uint64_t m = 1;
     uint32_t k = 0;
