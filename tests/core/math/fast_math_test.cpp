@@ -37,7 +37,7 @@ TEST(FastMath, Atan2Within4e7EverywhereIncludingAxes) {
 }
 
 TEST(FastMath, Atan2IsNotFooledByEachQuadrantsSignsOrSignedZeros) {
-    // The half-angle form's two cases meet on the y axis and at x = -0.
+    // The reflections meet on the axes (x = -0 and y = -0 pick their side by the sign bit).
     for (const float y : {1.0f, -1.0f, 0.5f, -2.0f})
         for (const float x : {0.0f, -0.0f, 1e-30f, -1e-30f, 3.0f, -3.0f})
             EXPECT_NEAR(fast_atan2(y, x), std::atan2(double{y}, double{x}), 4e-7) << y << ", " << x;
