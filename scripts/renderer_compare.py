@@ -5,8 +5,8 @@ For each map and scene: the map is converted to pbrt-v4's equal-area square (so 
 every technique, the pbrt-v4-style reference sampler included, samples the same
 texels), three tables are built from it (plain, compensated, normal-aware with 121 bins),
 a high-spp reference is rendered with the plain table, then every technique renders the
-scene with several seeds at equal samples and at equal time (the time the compensated
-table took for those samples, the budget each technique gets). The relative MSE against
+scene with several seeds at equal samples and at equal time (the time the compensated table
+took for those samples, the budget each technique gets), the techniques interleaved. The relative MSE against
 the reference (envmis_example_pathtrace --reference) is averaged over seeds; the table
 gives it with the ratio of the global compensated table's (and the pbrt-v4-style
 sampler's) to the normal-aware table's: above 1, bins have the lower error.
@@ -75,10 +75,23 @@ def render(args, table, env, scene, out, seed, bounces, spp=None, seconds=None, 
     return json.loads(Path(out).with_suffix(".json").read_text())
 
 
+def interleaved(seeds, names):
+    """(seed, technique) in the order the renders run: every technique once per seed, the
+    order turned by one each seed, so that the machine's speed, which drifts within
+    minutes on a shared host, weighs on every technique alike rather than on whichever
+    ran its seeds in a slow spell."""
+    names = list(names)
+    for k, s in enumerate(seeds):
+        turn = k % len(names)
+        for name in names[turn:] + names[:turn]:
+            yield s, name
+
+
 def compare_case(args, made, scene, stem, work, bounces):
     """One scene under one map: reference, then each technique at equal spp and equal time
-    (the sampler's share profiled in a run of its own, as profiling costs time), and the
-    floor: the plain (complete) table with FLOOR_LIGHT_SAMPLES environment samples a vertex."""
+    (interleaved), the sampler's share profiled in a run of its own (profiling costs time),
+    and the floor: the plain (complete) table with FLOOR_LIGHT_SAMPLES environment samples
+    a vertex."""
     prefix = work / f"{stem}.{scene}.b{bounces}"
     reference = Path(f"{prefix}.reference.exr")
     if not reference.exists():
@@ -87,25 +100,32 @@ def compare_case(args, made, scene, stem, work, bounces):
     seeds = range(1, args.seeds + 1)
     more = {name: [m.format(**{k: str(v) for k, v in made.items()}) for m in extra]
             for name, (_, _, extra) in TECHNIQUES.items()}
-    runs = {name: [render(args, made[table], env, scene, f"{prefix}.{name}.spp.{s}.exr", s, bounces, spp=args.spp,
-                          reference=reference, more=more[name]) for s in seeds]
-            for name, (table, env, _) in TECHNIQUES.items()}
+
+    def renders(mode, **kwargs):
+        done = {name: [] for name in TECHNIQUES}
+        for s, name in interleaved(seeds, TECHNIQUES):
+            table, env, _ = TECHNIQUES[name]
+            done[name].append(render(args, made[table], env, scene, f"{prefix}.{name}.{mode}.{s}.exr", s, bounces,
+                                     reference=reference, more=more[name], **kwargs))
+        return done
+
+    runs = renders("spp", spp=args.spp)
     budget = statistics.median(r["seconds"] for r in runs["compensated"])
+    timed = renders("time", seconds=budget)
     for name, (table, env, _) in TECHNIQUES.items():
-        timed = [render(args, made[table], env, scene, f"{prefix}.{name}.time.{s}.exr", s, bounces, seconds=budget,
-                        reference=reference, more=more[name]) for s in seeds]
         profiled = render(args, made[table], env, scene, f"{prefix}.{name}.profile.exr", 1, bounces, spp=args.spp,
                           profile=True, more=more[name])
         equal_spp = runs[name]
         case["techniques"][name] = {
             "equal_spp_relative_mse": statistics.mean(r["relative_mse"] for r in equal_spp),
             "equal_spp_seconds": statistics.median(r["seconds"] for r in equal_spp),
-            "equal_time_relative_mse": statistics.mean(r["relative_mse"] for r in timed),
-            "equal_time_passes": statistics.median(r["passes"] for r in timed),
+            "equal_time_relative_mse": statistics.mean(r["relative_mse"] for r in timed[name]),
+            "equal_time_passes": statistics.median(r["passes"] for r in timed[name]),
             "rays_per_second_per_thread": statistics.median(r["rays_per_second_per_thread"] for r in equal_spp),
             "sampler_share": profiled["sampler_share"],
+            "sampler_ns_per_vertex": sampler_ns_per_vertex(profiled),
             "per_seed": {"equal_spp": [r["relative_mse"] for r in equal_spp],
-                         "equal_time": [r["relative_mse"] for r in timed]},
+                         "equal_time": [r["relative_mse"] for r in timed[name]]},
         }
     floor = [render(args, made["plain"], "global", scene, f"{prefix}.floor.{s}.exr", s, bounces, spp=args.spp,
                     reference=reference, light_samples=FLOOR_LIGHT_SAMPLES) for s in seeds]
@@ -114,6 +134,14 @@ def compare_case(args, made, scene, stem, work, bounces):
     case["triangles"] = runs["plain"][0]["triangles"]
     case["cpu"] = runs["plain"][0]["cpu"]
     return case
+
+
+def sampler_ns_per_vertex(profiled):
+    """The environment's time at a path vertex (choosing the bin, the light samples and
+    the lookup of an escaping material sample), from a profiled render's share of the
+    threads' time: what a sampler costs where a renderer's traversal has evicted it."""
+    vertices = profiled["environment_samples"] / profiled["light_samples"]
+    return profiled["sampler_share"] * profiled["thread_seconds"] / vertices * 1e9 if vertices else 0.0
 
 
 def ratio(case, over, mode, of="bins"):
@@ -127,11 +155,16 @@ def ratio(case, over, mode, of="bins"):
     return t[over][f"{mode}_relative_mse"] / t[of][f"{mode}_relative_mse"]
 
 
+def share(technique):
+    ns = technique.get("sampler_ns_per_vertex")  # absent from runs before it was recorded
+    return f"{technique['sampler_share']:.0%}" + (f" ({ns:.0f})" if ns else "")
+
+
 def table_lines(cases):
     lines = [
         "| scene | map | comp/bins: equal spp · equal time · by cost | pbrt/bins: equal time · by cost | "
         "plain/bins, equal time | comp/bins-first: equal time · by cost | floor/comp | "
-        "passes bins / comp / pbrt | sampler share bins / comp / pbrt | Mrays/s/thread |",
+        "passes bins / comp / pbrt | sampler share (ns a vertex) bins / comp / pbrt | Mrays/s/thread |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for c in cases:
@@ -146,8 +179,8 @@ def table_lines(cases):
             f"{c['floor_relative_mse'] / t['compensated']['equal_spp_relative_mse']:.2f} | "
             f"{t['bins']['equal_time_passes']:g} / {t['compensated']['equal_time_passes']:g} / "
             f"{t['pbrt']['equal_time_passes']:g} | "
-            f"{t['bins']['sampler_share']:.0%} / {t['compensated']['sampler_share']:.0%} / "
-            f"{t['pbrt']['sampler_share']:.0%} | {t['compensated']['rays_per_second_per_thread'] / 1e6:.2f} |")
+            f"{share(t['bins'])} / {share(t['compensated'])} / {share(t['pbrt'])} | "
+            f"{t['compensated']['rays_per_second_per_thread'] / 1e6:.2f} |")
     lines += ["", "Relative MSE per technique (mean over seeds), equal samples / equal time:", "",
               "| scene | map | " + " | ".join(TECHNIQUES) + " |", "|---|---|" + "---|" * len(TECHNIQUES)]
     for c in cases:
@@ -178,11 +211,12 @@ def markdown(results, args, command):
         "vertex; `bins-first`: at the camera's hit only, the compensated table beyond): above 1, "
         "bins have the lower error. At equal time each technique renders for the budget (whole passes); "
         "`by cost` is the equal-time ratio from the equal-spp renders, relMSE x seconds, free of the "
-        f"passes' rounding. Equal-time figures carry the timing noise of a shared machine. `floor/comp`: the plain table with {FLOOR_LIGHT_SAMPLES} environment "
+        f"passes' rounding. The renders run interleaved (each seed renders every technique, in an order "
+        f"turned by one each seed), so that the machine's drifting speed weighs on every technique alike. `floor/comp`: the plain table with {FLOOR_LIGHT_SAMPLES} environment "
         "samples a vertex over the compensated table with one, at equal samples: the error left when direct light from the map is "
         "nearly noise-free, so 1 / floor is the most any environment sampler can gain at equal samples. "
         "Sampler share: the threads' time in the environment's calls (choosing the bin, sampling, looking up; "
-        "timed with the CPU's cycle counter in a run of its own).",
+        "timed with the CPU's cycle counter in a run of its own), and that time per path vertex in ns.",
     ]
     for run in results["runs"]:
         title = "Direct lighting only (1 bounce)" if run["bounces"] == 1 else f"Path tracing, {run['bounces']} bounces"
