@@ -6,10 +6,10 @@ every technique, the pbrt-v4-style reference sampler included, samples the same
 texels), three tables are built from it (plain, compensated, normal-aware with 121 bins),
 a high-spp reference is rendered with the plain table, then every technique renders the
 scene with several seeds at equal samples and at equal time (the time the compensated table
-took for those samples, the budget each technique gets), the techniques interleaved. The relative MSE against
-the reference (envmis_example_pathtrace --reference) is averaged over seeds; the table
-gives it with the ratio of the global compensated table's (and the pbrt-v4-style
-sampler's) to the normal-aware table's: above 1, bins have the lower error.
+took for those samples, the budget each technique gets), the techniques interleaved. The
+relative MSE against the reference (envmis_example_pathtrace --reference) is averaged over
+seeds; the table gives it with the ratio of the global compensated table's (and the
+pbrt-v4-style sampler's) to the normal-aware table's: above 1, bins have the lower error.
 
 Usage (after building envmis and the examples against an install; docs/results-renderer.md):
   /usr/bin/python3 scripts/renderer_compare.py --envmis build/apps/envmis \
@@ -211,8 +211,9 @@ def markdown(results, args, command):
         "vertex; `bins-first`: at the camera's hit only, the compensated table beyond): above 1, "
         "bins have the lower error. At equal time each technique renders for the budget (whole passes); "
         "`by cost` is the equal-time ratio from the equal-spp renders, relMSE x seconds, free of the "
-        f"passes' rounding. The renders run interleaved (each seed renders every technique, in an order "
-        f"turned by one each seed), so that the machine's drifting speed weighs on every technique alike. `floor/comp`: the plain table with {FLOOR_LIGHT_SAMPLES} environment "
+        "passes' rounding. The renders run interleaved (each seed renders every technique, in an order "
+        "turned by one each seed), so that the machine's drifting speed weighs on every technique alike. "
+        f"`floor/comp`: the plain table with {FLOOR_LIGHT_SAMPLES} environment "
         "samples a vertex over the compensated table with one, at equal samples: the error left when direct light from the map is "
         "nearly noise-free, so 1 / floor is the most any environment sampler can gain at equal samples. "
         "Sampler share: the threads' time in the environment's calls (choosing the bin, sampling, looking up; "
