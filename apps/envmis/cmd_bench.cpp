@@ -2,11 +2,13 @@
 // sampler against the textbook float-CDF sampler and a sampler following pbrt-v4's
 // (pbrt_style.h; on the equal-area square of the same map), measured in the same run;
 // with --bins, also the binned sampler (binned.h) against today's EnvMap, plain and
-// compensated: what a renderer pays for normal-aware sampling.
+// compensated, what a renderer pays for normal-aware sampling, and against the global
+// sampler over a bin's own density, what its representation costs.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <random>
@@ -173,8 +175,9 @@ void add_bench_flags(CLI::App& sub, BenchArgs& args) {
     sub.add_option(
            "--bins", args.bins,
            "Also measure the binned sampler with K bins (square number) against today's EnvMap, plain and "
-           "compensated: build, memory, sample and pdf with a random normal per call (lobe class 0), and the pdf in a "
-           "bin picked beforehand (once per shading point, as a renderer weighs its BSDF samples)")
+           "compensated: build, memory, sample and pdf with a random normal per call (lobe class 0), the pdf in a "
+           "bin picked beforehand (once per shading point, as a renderer weighs its BSDF samples), and a bin's "
+           "sample against the global sampler over the same density (the bins nearest the axes and the diagonal)")
         ->type_name("K")
         ->check(bins_validator());
     sub.add_option("--samples-per-normal", args.samples_per_normal,
@@ -369,6 +372,10 @@ struct BinnedResult {
     // A single pdf call in a bin picked beforehand (a renderer picks once per shading
     // point and weighs its BSDF samples in that bin), and its time over the plain pdf's.
     double pdf_in_bin_ns = 0, pdf_in_bin_ratio = 0;
+    // A bin's sample over the global sampler's on the same density (representation_ratios):
+    // least, median and most over the bins measured, and how many (plain bins are skipped).
+    double same_density[3] = {};
+    uint32_t same_density_bins = 0;
 };
 
 // ns per call of the three samplers, back to back in each repeat; lobe class 0.
@@ -428,9 +435,59 @@ void time_binned_calls(const EnvMapView (&today)[2], const BinnedEnvMapView& bin
     }
 }
 
+// A bin's sample against the global sampler over the same density, which sets aside where
+// the density puts its samples (a bin's spread over a hemisphere touches more memory than
+// a compensated map crowded onto a sun) and leaves the representation: the bins nearest
+// these normals (lobe class 0, head-on), each rebuilt as a plain global map whose texels
+// hold the bin's pdf at their centres. A texel's mass is its value times its row's weight
+// (sin theta at the row's centre, or 1), and the bin's pdf there is its image density over
+// that weight, so each texel gets the bin's probability up to the fixed point's rounding.
+constexpr Vec3 kSameDensityNormals[] = {
+    {0, 0, 1}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, -1}, {0.57735f, 0.57735f, 0.57735f}};
+
+EnvMap density_as_map(const BinView& bin, const EnvMapOptions& plain_options, uint32_t w, uint32_t h) {
+    RgbImage image{w, h, RgbPixels(size_t{w} * h)};
+    for (uint32_t y = 0; y < h; ++y)
+        for (uint32_t x = 0; x < w; ++x) {
+            const float pdf = bin.pdf_uv({(x + 0.5f) / static_cast<float>(w), (y + 0.5f) / static_cast<float>(h)});
+            image.pixels[size_t{y} * w + x] = {pdf, pdf, pdf};
+        }
+    EnvMapOptions options = plain_options;
+    options.compensation.enabled = false;
+    return build_env_map(std::move(image), options, &interrupted());
+}
+
+// Per bin, the median over repeats of its sample's time over the global map's (the two in
+// turns at bench's points); the least, median and most over the bins into `result`.
+void representation_ratios(const BinnedEnvMap& binned, const BenchPoints& points, int repeats, Progress& progress,
+                           int& step, BinnedResult& result) {
+    const BinnedEnvMapView view = binned.view();
+    std::vector<double> per_bin;
+    for (Vec3 normal : kSameDensityNormals) {
+        const BinView bin = view.nearest_bin(normal, 0);
+        if (!bin.plain) {
+            const EnvMap global =
+                density_as_map(bin, binned.plain().options(), binned.plain().width(), binned.plain().height());
+            const EnvMapView global_view = global.view();
+            std::vector<double> ratios;
+            for (int r = 0; r < repeats; ++r) {
+                throw_if_interrupted();
+                const double own = ns_per_call(points.us, [&](Vec2 u) { return bin.sample(u); });
+                ratios.push_back(own / ns_per_call(points.us, [&](Vec2 u) { return global_view.sample(u); }));
+            }
+            per_bin.push_back(median(ratios));
+        }
+        progress.update(++step);
+    }
+    result.same_density_bins = static_cast<uint32_t>(per_bin.size());
+    if (per_bin.empty()) return;
+    const auto [least, most] = std::minmax_element(per_bin.begin(), per_bin.end());
+    result.same_density[0] = *least, result.same_density[1] = median(per_bin), result.same_density[2] = *most;
+}
+
 BinnedResult measure_binned(const RgbImage& image, const EnvMapOptions& mapped, uint32_t bins,
                             const BenchPoints& points, int repeats) {
-    Progress progress("bench --bins", 4 * repeats);
+    Progress progress("bench --bins", 4 * repeats + static_cast<int>(std::size(kSameDensityNormals)));
     int step = 0;
     BinnedResult result;
     std::unique_ptr<EnvMap> today[2];
@@ -455,6 +512,7 @@ BinnedResult measure_binned(const RgbImage& image, const EnvMapOptions& mapped, 
     const BinnedEnvMapView binned_view = binned->view();
     const EnvMapView views[2] = {today[kPlain]->view(), today[kCompensated]->view()};
     time_binned_calls(views, binned_view, points, repeats, progress, step, result);
+    representation_ratios(*binned, points, repeats, progress, step, result);
     return result;
 }
 
@@ -485,6 +543,10 @@ nlohmann::json binned_json(const BinnedResult& b) {
     j["binned_over_compensated"]["build"] = binned_build_ratio(b);
     j["binned_over_compensated"]["memory"] = binned_memory_ratio(b);
     j["pdf_in_picked_bin"] = {{"ns", b.pdf_in_bin_ns}, {"over_plain_pdf", b.pdf_in_bin_ratio}};
+    j["sample_over_global_same_density"] = {{"least", b.same_density[0]},
+                                            {"median", b.same_density[1]},
+                                            {"most", b.same_density[2]},
+                                            {"bins", b.same_density_bins}};
     return j;
 }
 
@@ -508,9 +570,12 @@ void print_binned_text(const BinnedResult& b) {
         std::printf("\n");
     }
     std::printf("binned_pdf_in_picked_bin ns=%.1f over_plain_pdf=%.2fx\n", b.pdf_in_bin_ns, b.pdf_in_bin_ratio);
+    std::printf("binned_sample_over_global_same_density median=%.2fx least=%.2fx most=%.2fx bins=%u\n",
+                b.same_density[1], b.same_density[0], b.same_density[2], b.same_density_bins);
     std::printf(
         "(binned over today's: time or bytes, median of the ratios within each repeat; build: plain map "
-        "plus bins over the compensated map; pdf in picked bin: the bin picked beforehand, once per shading point)\n");
+        "plus bins over the compensated map; pdf in picked bin: the bin picked beforehand, once per shading point; "
+        "same density: the bins nearest +-x, +-y, +-z and the diagonal, each against its density as a global map)\n");
 }
 
 void print_bench_json(const BenchArgs& args, const BenchMap& map, const BenchResult& result,

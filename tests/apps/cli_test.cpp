@@ -365,6 +365,9 @@ TEST_F(Cli, BenchWithBinsAddsTheBinnedSamplerAgainstTodaysMaps) {
         << r;
     EXPECT_TRUE(contains(r.out, "\\nbinned_pdf_in_picked_bin ns=" + number + " over_plain_pdf=" + number + "x\\n"))
         << r;
+    EXPECT_TRUE(contains(r.out, "\\nbinned_sample_over_global_same_density median=" + number + "x least=" + number +
+                                    "x most=" + number + "x bins=[1-7]\\n"))
+        << r;
     const Result j =
         envmis({"bench", "--size", "256x128", "--repeats", "1", "--samples", "1000", "--bins", "4", "--json"});
     ASSERT_EQ(j.exit_code, 0) << j;
@@ -375,6 +378,11 @@ TEST_F(Cli, BenchWithBinsAddsTheBinnedSamplerAgainstTodaysMaps) {
         EXPECT_GT(binned.at("binned_over_compensated").at(field).get<double>(), 0) << field << j;
     for (const char* field : {"ns", "over_plain_pdf"})
         EXPECT_GT(binned.at("pdf_in_picked_bin").at(field).get<double>(), 0) << field << j;
+    const nlohmann::json& same = binned.at("sample_over_global_same_density");
+    EXPECT_GE(same.at("bins").get<int>(), 1) << j;
+    EXPECT_LE(same.at("least").get<double>(), same.at("median").get<double>()) << j;
+    EXPECT_LE(same.at("median").get<double>(), same.at("most").get<double>()) << j;
+    EXPECT_GT(same.at("least").get<double>(), 0) << j;
     for (const auto& s : binned.at("samplers")) {
         EXPECT_GT(s.at("ns_per_lookup").get<double>(), 0) << j;
         for (const char* field : {"sample", "lookup_over_pdf", "lookup_over_lookup"})
