@@ -19,6 +19,7 @@
 #include <string_view>
 #include <system_error>
 #include <type_traits>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -187,6 +188,19 @@ void throw_if_interrupted();
 // What main prints and returns once a signal has arrived, `detail` (Interrupted's
 // message, unless it is the plain "interrupted") after the signal's name.
 int exit_interrupted(const std::string& detail);
+
+// A density's solid-angle pdf at every texel centre of a w x h image, row-major (an
+// EnvMapView, EnvMap or BinView: anything with pdf_uv). Per steradian: proportional to q,
+// the compensated or plain luminance, without the sin(theta) of the image-space density.
+template <class Density>
+std::vector<float> pdf_image(const Density& density, uint32_t w, uint32_t h) {
+    std::vector<float> pdf(size_t{w} * h);
+    for (uint32_t y = 0; y < h; ++y) {
+        throw_if_interrupted();
+        for (uint32_t x = 0; x < w; ++x) pdf[size_t{y} * w + x] = density.pdf_uv({(x + 0.5f) / w, (y + 0.5f) / h});
+    }
+    return pdf;
+}
 
 // Exit statuses: 0 success, 1 a failure of the work (input, output, memory), 2 a usage
 // error (an unknown command, flag or value: nothing was started), 128 + the signal's

@@ -372,8 +372,9 @@ struct BinnedResult {
     // A single pdf call in a bin picked beforehand (a renderer picks once per shading
     // point and weighs its BSDF samples in that bin), and its time over the plain pdf's.
     double pdf_in_bin_ns = 0, pdf_in_bin_ratio = 0;
-    // A bin's sample over the global sampler's on the same density (representation_ratios):
-    // least, median and most over the bins measured, and how many (plain bins are skipped).
+    // A bin's sample over the global sampler's on the same density (same_density_ratios):
+    // least, median and most over the bins measured, and how many (plain bins, and a bin
+    // two of the normals share, counted once).
     double same_density[3] = {};
     uint32_t same_density_bins = 0;
 };
@@ -445,29 +446,28 @@ void time_binned_calls(const EnvMapView (&today)[2], const BinnedEnvMapView& bin
 constexpr Vec3 kSameDensityNormals[] = {
     {0, 0, 1}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, -1}, {0.57735f, 0.57735f, 0.57735f}};
 
-EnvMap density_as_map(const BinView& bin, const EnvMapOptions& plain_options, uint32_t w, uint32_t h) {
-    RgbImage image{w, h, RgbPixels(size_t{w} * h)};
-    for (uint32_t y = 0; y < h; ++y)
-        for (uint32_t x = 0; x < w; ++x) {
-            const float pdf = bin.pdf_uv({(x + 0.5f) / static_cast<float>(w), (y + 0.5f) / static_cast<float>(h)});
-            image.pixels[size_t{y} * w + x] = {pdf, pdf, pdf};
-        }
-    EnvMapOptions options = plain_options;
+EnvMap density_as_map(const BinView& bin, const EnvMap& plain) {
+    const std::vector<float> pdf = pdf_image(bin, plain.width(), plain.height());
+    RgbImage image{plain.width(), plain.height(), RgbPixels(pdf.size())};
+    for (size_t i = 0; i < pdf.size(); ++i) image.pixels[i] = {pdf[i], pdf[i], pdf[i]};
+    // A map whose compensation fell back (a constant one) keeps it enabled in its options.
+    EnvMapOptions options = plain.options();
     options.compensation.enabled = false;
     return build_env_map(std::move(image), options, &interrupted());
 }
 
 // Per bin, the median over repeats of its sample's time over the global map's (the two in
 // turns at bench's points); the least, median and most over the bins into `result`.
-void representation_ratios(const BinnedEnvMap& binned, const BenchPoints& points, int repeats, Progress& progress,
-                           int& step, BinnedResult& result) {
+void same_density_ratios(const BinnedEnvMap& binned, const BenchPoints& points, int repeats, Progress& progress,
+                         int& step, BinnedResult& result) {
     const BinnedEnvMapView view = binned.view();
     std::vector<double> per_bin;
+    std::vector<const uint32_t*> seen;  // a coarse grid puts several of the normals in one bin
     for (Vec3 normal : kSameDensityNormals) {
         const BinView bin = view.nearest_bin(normal, 0);
-        if (!bin.plain) {
-            const EnvMap global =
-                density_as_map(bin, binned.plain().options(), binned.plain().width(), binned.plain().height());
+        if (!bin.plain && std::find(seen.begin(), seen.end(), bin.cells.start) == seen.end()) {
+            seen.push_back(bin.cells.start);
+            const EnvMap global = density_as_map(bin, binned.plain());
             const EnvMapView global_view = global.view();
             std::vector<double> ratios;
             for (int r = 0; r < repeats; ++r) {
@@ -512,7 +512,7 @@ BinnedResult measure_binned(const RgbImage& image, const EnvMapOptions& mapped, 
     const BinnedEnvMapView binned_view = binned->view();
     const EnvMapView views[2] = {today[kPlain]->view(), today[kCompensated]->view()};
     time_binned_calls(views, binned_view, points, repeats, progress, step, result);
-    representation_ratios(*binned, points, repeats, progress, step, result);
+    same_density_ratios(*binned, points, repeats, progress, step, result);
     return result;
 }
 

@@ -21,19 +21,6 @@
 namespace envmis::cli {
 namespace {
 
-// Solid-angle pdf at every texel centre (per steradian): proportional to q, the
-// compensated or plain luminance, without the sin(theta) of the image-space density.
-template <class Density>
-std::vector<float> pdf_image(const Density& density, uint32_t w, uint32_t h) {
-    std::vector<float> pdf(size_t{w} * h);
-    for (uint32_t y = 0; y < h; ++y) {
-        throw_if_interrupted();
-        for (uint32_t x = 0; x < w; ++x) pdf[size_t{y} * w + x] = density.pdf_uv({(x + 0.5f) / w, (y + 0.5f) / h});
-    }
-    return pdf;
-}
-std::vector<float> pdf_image(const EnvMap& map) { return pdf_image(map, map.width(), map.height()); }
-
 // The arguments of `envmis visualize`.
 struct VisualizeArgs {
     std::string input, output;
@@ -151,8 +138,8 @@ Visualization visualize(const std::string& name, const Densities& d, const std::
                         PanelSize panel) {
     const uint32_t w = d.loaded.width(), h = d.loaded.height();
     const uint32_t pw = panel.width, ph = panel.height;
-    std::vector<std::vector<float>> pdfs = {pictures::resize(pdf_image(d.plain()), w, h, pw, ph),
-                                            pictures::resize(pdf_image(d.compensated()), w, h, pw, ph)};
+    std::vector<std::vector<float>> pdfs = {pictures::resize(pdf_image(d.plain(), w, h), w, h, pw, ph),
+                                            pictures::resize(pdf_image(d.compensated(), w, h), w, h, pw, ph)};
     if (bin) {
         const BinnedEnvMapView view = bin->binned->view();  // the bin points into it
         pdfs.push_back(pictures::resize(pdf_image(view.nearest_bin(bin->normal, bin->lobe), w, h), w, h, pw, ph));
