@@ -477,9 +477,7 @@ void print_bins(std::ostream& out, const BinLayout& layout) {
 }  // namespace
 
 void print_bins_cost(std::ostream& out, const BinnedEnvMap& binned, double build_ms) {
-    const EnvMap& plain = binned.plain();
-    const double plain_bytes =
-        static_cast<double>(plain.distribution().bytes()) + static_cast<double>(plain.radiance().pixels.size_bytes());
+    const auto plain_bytes = static_cast<double>(binned.plain_bytes());
     const auto flags = out.flags();
     out << std::fixed << std::setprecision(1) << "  bins build    " << build_ms << " ms";
     if (binned.choice_seconds() > 0)
@@ -535,8 +533,11 @@ void print_summary(std::ostream& out, const LoadedMap& loaded, const EnvMap& m) 
     out << "  fallback      " << to_string(s.fallback) << "\n";
     out << "  complete pdf  " << (m.complete() ? "yes" : "no: combine with BSDF sampling through MIS")
         << (loaded.bins ? " (the plain map's; the bins': 'bins complete' below)" : "") << "\n";
-    out << "  memory        " << std::setprecision(3) << m.distribution().bytes() / texels
-        << " bytes/texel (distribution) + " << sizeof(Rgb) << " (float RGB radiance), in memory\n";
+    if (m.distribution().bytes() == 0)  // a binned map's: its cells' tables hold the density
+        out << "  memory        " << sizeof(Rgb) << " bytes/texel (float RGB radiance) + the bins' tables, in memory\n";
+    else
+        out << "  memory        " << std::setprecision(3) << m.distribution().bytes() / texels
+            << " bytes/texel (distribution) + " << sizeof(Rgb) << " (float RGB radiance), in memory\n";
     out.flags(flags);
     if (loaded.bins) print_bins(out, *loaded.bins);
 }

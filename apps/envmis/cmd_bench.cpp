@@ -467,7 +467,7 @@ void same_density_ratios(const BinnedEnvMap& binned, const BenchPoints& points, 
         const BinView bin = view.nearest_bin(normal, 0);
         if (!bin.plain && std::find(seen.begin(), seen.end(), bin.cells.start) == seen.end()) {
             seen.push_back(bin.cells.start);
-            const EnvMap global = density_as_map(bin, binned.plain());
+            const EnvMap global = density_as_map(bin, binned.radiance_map());
             const EnvMapView global_view = global.view();
             std::vector<double> ratios;
             for (int r = 0; r < repeats; ++r) {

@@ -153,7 +153,7 @@ nlohmann::json precompute_one(const PrecomputeArgs& args, const LibraryItem& ite
     for (const std::string& notice : built.notices) notes << "note: " << printable(notice) << "\n";
     const LoadedMap loaded = loaded_map(built);
     const BinnedEnvMap* binned = built.binned ? &*built.binned : nullptr;
-    const EnvMap& map = binned ? binned->plain() : loaded.map;
+    const EnvMap& map = binned ? binned->radiance_map() : loaded.map;
     const TableEncoding encoding = args.compact ? TableEncoding::compact : TableEncoding::full;
     next_stage("writing");
     const auto start = std::chrono::steady_clock::now();

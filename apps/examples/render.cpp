@@ -131,8 +131,8 @@ Scene make_scene() {
 }
 
 // The environment as the renderer samples it: one global density, or with `binned` the
-// bin of each shading point's normal and lobe class (whose texels and radiance are
-// `global`'s, the binned map's plain map).
+// bin of each shading point's normal and lobe class (whose radiance is `global`'s, the
+// binned map's radiance map, then only evaluated).
 struct Environment {
     envmis::EnvMapView global;
     const envmis::BinnedEnvMapView* binned = nullptr;
@@ -240,7 +240,7 @@ envmis::RgbImage render(const Environment& env, const Scene& scene, const Option
 struct Loaded {
     std::optional<envmis::Table> table;
     std::optional<envmis::BinnedEnvMap> binned;
-    const envmis::EnvMap& map() const { return binned ? binned->plain() : table->map; }
+    const envmis::EnvMap& map() const { return binned ? binned->radiance_map() : table->map; }
 };
 
 Loaded load(const Options& o) {

@@ -51,12 +51,6 @@ struct Deleter {
 
 // The deleter of a binned map's plain map, which is part of the binned map: it deletes
 // nothing, and holds the binned map until the last reference to the plain map goes.
-struct PartOf {
-    Provenance provenance;
-    std::shared_ptr<BinnedEnvMap> whole;
-    void operator()(EnvMap*) const noexcept {}
-};
-
 template <class T>
 std::shared_ptr<T> held(T map, Provenance provenance) {
     return std::shared_ptr<T>(new T(std::move(map)), Deleter<T>{std::move(provenance)});
@@ -67,7 +61,6 @@ template <class T>
 Provenance provenance_of(const std::shared_ptr<T>& map) {
     if (const auto* d = std::get_deleter<Deleter<EnvMap>>(map)) return d->provenance;
     if (const auto* d = std::get_deleter<Deleter<BinnedEnvMap>>(map)) return d->provenance;
-    if (const auto* d = std::get_deleter<PartOf>(map)) return d->provenance;
     return {};
 }
 
@@ -83,7 +76,7 @@ std::shared_ptr<EnvMap> plain_of(const std::shared_ptr<BinnedEnvMap>& map) {
     } else {
         provenance.source.build_options.clear();
     }
-    return {const_cast<EnvMap*>(&map->plain()), PartOf{std::move(provenance), map}};
+    return held(map->plain_map(), std::move(provenance));
 }
 
 py::object to_python(Built built) {
@@ -412,8 +405,8 @@ void bind_envmap(py::module_& m) {
 void bind_binned(py::module_& m) {
     py::class_<BinnedEnvMap, std::shared_ptr<BinnedEnvMap>>(m, "BinnedEnvMap", py::dynamic_attr(), docs::kBinned)
         .def_property_readonly("plain", &plain_of, docs::kPlain)
-        .def_property_readonly("width", [](const BinnedEnvMap& map) { return map.plain().width(); })
-        .def_property_readonly("height", [](const BinnedEnvMap& map) { return map.plain().height(); })
+        .def_property_readonly("width", [](const BinnedEnvMap& map) { return map.radiance_map().width(); })
+        .def_property_readonly("height", [](const BinnedEnvMap& map) { return map.radiance_map().height(); })
         .def_property_readonly("bins", &BinnedEnvMap::bins,
                                "K = g^2, the bins of normals of each glossy class (a g x g octahedral grid).")
         .def_property_readonly("diffuse_bins", &BinnedEnvMap::diffuse_bins,
@@ -452,7 +445,8 @@ void bind_binned(py::module_& m) {
         .def("pdf", &pdf_binned, py::arg("directions"), py::arg("normals"), py::arg("choices"), py::arg("lobe") = 0,
              py::kw_only(), py::arg("view_cos") = py::none(), docs::kBinnedPdf)
         .def(
-            "eval", [](const BinnedEnvMap& map, const py::object& d) { return lookup_plain(map.plain(), d, false); },
+            "eval",
+            [](const BinnedEnvMap& map, const py::object& d) { return lookup_plain(map.radiance_map(), d, false); },
             py::arg("directions"), docs::kEval)
         .def(
             "save",
@@ -464,7 +458,7 @@ void bind_binned(py::module_& m) {
             py::arg("path"), py::kw_only(), py::arg("compact") = false, docs::kSave)
         .def("__repr__", [](const std::shared_ptr<BinnedEnvMap>& map) {
             return "<envmis.BinnedEnvMap " + std::to_string(map->bins()) + " bins over " +
-                   describe(map->plain(), provenance_of(map).source) + ">";
+                   describe(map->radiance_map(), provenance_of(map).source) + ">";
         });
 }
 

@@ -120,7 +120,7 @@ TEST(BuildMap, RecordsTheCanonicalOptionsAndBuildsBinsWhereAsked) {
     const BuiltMap built = build_map(grey(64, 32), request);
     ASSERT_TRUE(built.binned.has_value());
     EXPECT_EQ(built.binned->bins(), 9u);
-    EXPECT_FALSE(built.binned->plain().compensated());
+    EXPECT_FALSE(built.binned->radiance_map().compensated());
     EXPECT_EQ(built.source.build_options, canonical_options(request));
     EXPECT_EQ(built.source.name, "array");
     EXPECT_TRUE(built.notices.empty());

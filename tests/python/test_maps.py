@@ -377,10 +377,15 @@ def test_glossy_bins_seen_obliquely_sample_and_weigh_by_their_view_cosines():
     u = envmis.uniform_points(2000, seed=6)
     head_on = binned.sample(u, normals, choices, 1)
     assert np.array_equal(head_on.pdf, binned.sample(u, normals, choices, 1, view_cos=np.ones(2000, np.float32)).pdf)
-    # Seen edge-on every glossy bin with a view limit samples the plain map.
+    # Seen edge-on every glossy bin with a view limit samples the plain density (through
+    # the cells: equal to the plain map's up to fixed-point rounding).
     edge_on = binned.sample(u, normals, choices, 1, view_cos=np.zeros(2000, np.float32))
-    plain = binned.plain.sample(u)
-    assert np.mean(edge_on.pdf == plain.pdf) > np.mean(head_on.pdf == plain.pdf)
+    plain = binned.plain
+
+    def plain_share(s):
+        return np.mean(np.isclose(s.pdf, plain.pdf(s.direction), rtol=1e-3))
+
+    assert plain_share(edge_on) > plain_share(head_on)
     view_cos = rng.uniform(size=2000).astype(np.float32)
     s = binned.sample(u, normals, choices, 1, view_cos=view_cos)
     agree = np.abs(binned.pdf(s.direction, normals, choices, 1, view_cos=view_cos) / s.pdf - 1) < 1e-4

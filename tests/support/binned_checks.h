@@ -44,7 +44,8 @@ inline std::vector<Vec3> test_normals(uint32_t g) {
 
 // Texel probabilities of a bin, from pdf_uv at texel centres: the image density is
 // constant over a texel, and pdf_uv turns it into solid angle with the sine at uv.
-inline std::vector<double> texel_probabilities(const BinView& bin, const EnvMap& plain) {
+template <class View>
+std::vector<double> texel_probabilities(const View& bin, const EnvMap& plain) {
     const uint32_t w = plain.width(), h = plain.height();
     std::vector<double> p(size_t{w} * h);
     for (uint32_t y = 0; y < h; ++y)
@@ -99,13 +100,13 @@ inline void expect_samples_follow_pdf(const BinnedEnvMap& binned, LobeAxis at, u
     const std::vector<PickedBin> picks = picked_bins(view, at, lobe);
     std::vector<double> mixture;
     for (const PickedBin& pick : picks) {
-        const std::vector<double> p = texel_probabilities(pick.bin, binned.plain());
+        const std::vector<double> p = texel_probabilities(pick.bin, binned.radiance_map());
         EXPECT_NEAR(std::accumulate(p.begin(), p.end(), 0.0), 1.0, 1e-4);
         mixture.resize(p.size());
         for (size_t i = 0; i < p.size(); ++i) mixture[i] += pick.weight * p[i];
         const size_t n = std::max<size_t>(100000, 20 * p.size());
         expect_texels_follow(
-            p, binned.plain(), n,
+            p, binned.radiance_map(), n,
             [&] {
                 const EnvSample s = pick.bin.sample(rng.uniform2());
                 EXPECT_EQ(s.pdf, pick.bin.pdf_uv(s.uv));
@@ -115,7 +116,7 @@ inline void expect_samples_follow_pdf(const BinnedEnvMap& binned, LobeAxis at, u
     }
     if (picks.size() < 2) return;
     expect_texels_follow(
-        mixture, binned.plain(), std::max<size_t>(100000, 20 * mixture.size()),
+        mixture, binned.radiance_map(), std::max<size_t>(100000, 20 * mixture.size()),
         [&] {
             const float choice = rng.uniform();
             const EnvSample s = view.sample(at, lobe, choice, rng.uniform2());
@@ -129,7 +130,7 @@ inline void expect_samples_follow_pdf(const BinnedEnvMap& binned, LobeAxis at, u
 // above its bin's threshold (everywhere with light for an uncompensated bin).
 inline void expect_coverage(const BinnedEnvMap& map, uint32_t lobe) {
     const BinnedEnvMapView view = map.view();
-    const EnvMap& plain = map.plain();
+    const EnvMap& plain = map.radiance_map();
     const uint32_t w = plain.width(), h = plain.height(), g = map.layout().side(lobe);
     const std::vector<float> density = plain.density();
     int checked = 0;

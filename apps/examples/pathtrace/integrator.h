@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "envmis/math/random.h"
@@ -54,7 +55,8 @@ struct GlobalEnvironment {
 // and weighs with one density, so each vertex's estimate is unbiased.
 struct BinnedEnvironment {
     envmis::RotatedBinned bins;
-    envmis::Rotated<envmis::EnvMapView> beyond;
+    // The global table past `depth`; none: the binned table's own plain density.
+    std::optional<envmis::Rotated<envmis::EnvMapView>> beyond;
     uint32_t depth = UINT32_MAX;
 
     struct Density {
@@ -67,8 +69,10 @@ struct BinnedEnvironment {
         }
     };
     Density at(Vec3 normal, Vec3 to_viewer, uint32_t lobe, float choice, uint32_t vertex) const {
-        if (vertex >= depth) return {false, {}, &beyond};
-        return {true, bins.bin(envmis::lobe_axis(lobe, normal, to_viewer), lobe, choice), &beyond};
+        if (vertex >= depth)
+            return beyond ? Density{false, {}, &*beyond}
+                          : Density{true, {bins.map->plain_bin(), bins.rotation}, nullptr};
+        return {true, bins.bin(envmis::lobe_axis(lobe, normal, to_viewer), lobe, choice), nullptr};
     }
     Rgb eval(Vec3 direction) const noexcept { return bins.eval(direction); }
 };

@@ -215,7 +215,7 @@ struct Loaded {
     std::optional<envmis::reference::PbrtStyleEnvMap> pbrt;
     std::string technique;  // plain, compensated, bins, pbrt
 
-    const envmis::EnvMap& map() const { return binned ? binned->plain() : table.map; }
+    const envmis::EnvMap& map() const { return binned ? binned->radiance_map() : table.map; }
 };
 
 // The normal-aware table and, with --beyond, the global table that must hold the same
@@ -355,8 +355,9 @@ int run(const Options& o) {
     RenderResult r;
     if (loaded->binned) {
         const envmis::BinnedEnvMapView view = loaded->binned->view();
-        const envmis::EnvMapView beyond = loaded->beyond ? loaded->beyond->map.view() : map.view();
-        r = render(BinnedEnvironment{{&view, rotation}, {beyond, rotation}, o.bins_depth}, scene, rays, lobes, o);
+        std::optional<envmis::Rotated<envmis::EnvMapView>> beyond;
+        if (loaded->beyond) beyond = envmis::Rotated<envmis::EnvMapView>{loaded->beyond->map.view(), rotation};
+        r = render(BinnedEnvironment{{&view, rotation}, beyond, o.bins_depth}, scene, rays, lobes, o);
     } else if (loaded->pbrt) {
         r = render(PbrtEnvironment{&*loaded->pbrt, map.view(), rotation}, scene, rays, lobes, o);
     } else {

@@ -453,13 +453,18 @@ CellGrid grid_for(const EnvMap& plain, const BinnedOptions& options) {
     check_options(options);
     const uint32_t w = plain.width(), h = plain.height();
     const bool square = plain.options().mapping == Mapping::equal_area;
+    const auto rows_of = [&](uint32_t columns) { return std::min(square ? columns : std::max(1u, columns / 2), h); };
     uint32_t columns = options.cell_columns;
-    if (columns == 0) columns = default_cell_columns(w, square);
+    if (columns == 0) {
+        // Past about 28k texels wide the cap's cells would outgrow a cell texel CDF.
+        columns = default_cell_columns(w, square);
+        while (columns < w && largest_cell(w, h, columns, rows_of(columns)) > kMaxCells1D) ++columns;
+    }
     if (columns > 4096)
         throw std::invalid_argument("cell columns must be at most 4096, got " + std::to_string(columns));
     columns = std::min(columns, w);
-    const uint32_t rows = std::min(square ? columns : std::max(1u, columns / 2), h);
-    check_cells(columns, rows);
+    const uint32_t rows = rows_of(columns);
+    check_cells(w, h, columns, rows);
     return CellGrid(w, h, columns, rows, plain.options().mapping);
 }
 

@@ -212,7 +212,7 @@ void write_table(const std::filesystem::path& path, const BinnedEnvMap& binned, 
     if (g < 1 || g > kMaxBinsPerSide || gd < 1 || gd > kMaxBinsPerSide || classes < 1 || classes > kMaxLobeClasses ||
         layout.choices.size() != layout.choice_count())
         throw TableError(path.string() + ": the binned map has no valid bins to write");
-    write_map(path, binned.plain(), source, encoding, &binned.layout(), stop);
+    write_map(path, binned.radiance_map(), source, encoding, &binned.layout(), stop);
 }
 
 }  // namespace envmis

@@ -644,7 +644,7 @@ TEST_F(BinnedTableTest, BinnedTablesRoundTripBitIdenticallyMappedOrCopied) {
         expect_same_layout(*table.bins, binned_.layout());
         const BinnedEnvMap loaded = binned_map(std::move(table));
         expect_identical_binned_samples(binned_, loaded, 21, 20000);
-        expect_identical_samples(binned_.plain(), loaded.plain(), 22, 1000);
+        expect_identical_samples(binned_.plain_map(), loaded.plain_map(), 22, 1000);
     }
 #if defined(__unix__) || defined(__APPLE__)
     EXPECT_TRUE(read_table(path).mapped);
@@ -662,8 +662,8 @@ TEST_F(BinnedTableTest, CompactBinnedTablesRebuildTheBinsOverTheRoundedMap) {
     const BinnedEnvMap binned = small_binned(plain_sky());
     const fs::path path = dir_ / "compact.envmis";
     write_table(path, binned, source_, TableEncoding::compact);
-    const BinnedEnvMap expected(build_env_map(rgbe_round(binned.plain().radiance()), binned.plain().options()),
-                                binned.layout());
+    const BinnedEnvMap expected(
+        build_env_map(rgbe_round(binned.radiance_map().radiance()), binned.radiance_map().options()), binned.layout());
     expect_identical_binned_samples(expected, binned_map(read_table(path)), 23, 10000);
 }
 

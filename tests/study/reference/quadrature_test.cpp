@@ -97,7 +97,7 @@ TEST(Quadrature, ExactVarianceOfBinnedMisMatchesMeasuredVariance) {
             EXPECT_NEAR(stats.variance(), exact, 0.03 * exact) << bsdf.name() << " normal.z=" << p.normal.z;
         }
     // The plain map's overload refuses a -bins technique rather than use the wrong density.
-    EXPECT_THROW(exact_variance(binned.plain(), t, {}, Bsdf::lambert(), {}, 1), std::invalid_argument);
+    EXPECT_THROW(exact_variance(binned.radiance_map(), t, {}, Bsdf::lambert(), {}, 1), std::invalid_argument);
 }
 
 }  // namespace

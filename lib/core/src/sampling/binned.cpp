@@ -189,11 +189,21 @@ void check_options(const BinnedOptions& o) {
         throw std::invalid_argument("the binned cost must be 1 to 100, got " + std::to_string(o.cost));
 }
 
-// A bin's cells form one CDF, whose uint16 guide entries name at most 65536 cells.
-void check_cells(uint32_t columns, uint32_t rows) {
+uint64_t largest_cell(uint32_t w, uint32_t h, uint32_t columns, uint32_t rows) noexcept {
+    return uint64_t{(w + columns - 1) / columns} * ((h + rows - 1) / rows);
+}
+
+// A bin's cells form one CDF, and a cell's texels another, whose uint16 guide entries
+// name at most 65536 cells or texels.
+void check_cells(uint32_t w, uint32_t h, uint32_t columns, uint32_t rows) {
     if (uint64_t{columns} * rows > kMaxCells1D)
         throw std::invalid_argument("a cell grid has at most 65536 cells, got " + std::to_string(columns) + "x" +
                                     std::to_string(rows));
+    if (largest_cell(w, h, columns, rows) > kMaxCells1D)
+        throw std::invalid_argument("a cell holds at most 65536 texels: " + std::to_string(columns) + "x" +
+                                    std::to_string(rows) + " cells over a " + std::to_string(w) + "x" +
+                                    std::to_string(h) + " map hold up to " +
+                                    std::to_string(largest_cell(w, h, columns, rows)));
 }
 
 CellHistogram histogram(const EnvMap& plain, const CellGrid& grid, std::span<const float> thresholds, StopFlag stop) {
@@ -289,7 +299,7 @@ void BinnedEnvMap::check_layout() const {
                                     " glossy bins per side, " + std::to_string(layout.cell_columns) + "x" +
                                     std::to_string(layout.cell_rows) + " cells does not fit a " + std::to_string(w) +
                                     "x" + std::to_string(h) + " map");
-    detail::check_cells(layout.cell_columns, layout.cell_rows);
+    detail::check_cells(w, h, layout.cell_columns, layout.cell_rows);
     BinnedOptions check;
     check.lobe_exponents = layout.lobe_exponents;
     detail::check_options(check);
@@ -306,17 +316,65 @@ void BinnedEnvMap::check_layout() const {
     }
 }
 
+namespace {
+
+// Fills the cell texel CDFs (BinnedEnvMapView::cell_texels) from the plain map's
+// distribution, each texel weighed by its fixed-point probability (marginal width times
+// row width), and returns each cell's plain mass, their sum.
+std::vector<double> build_cell_texels(const Distribution2DView& plain, const CellGrid& grid, uint32_t* start,
+                                      uint16_t* guide, StopFlag stop) {
+    std::vector<double> masses(size_t{grid.cw} * grid.ch);
+    detail::parallel_for(grid.ch, 1, stop, [&](uint32_t lo, uint32_t hi) {
+        std::vector<double> mass;
+        detail::CdfScratch scratch(0);
+        for (uint32_t cy = lo; cy < hi; ++cy) {
+            const uint32_t y0 = grid.row_edges[cy], rows = grid.row_edges[cy + 1] - y0;
+            for (uint32_t cx = 0; cx < grid.cw; ++cx) {
+                const uint32_t x0 = grid.column_edges[cx], columns = grid.column_edges[cx + 1] - x0;
+                const uint32_t n = columns * rows;
+                mass.resize(n);
+                if (scratch.prefix.size() < n) scratch = detail::CdfScratch(n);
+                for (uint32_t dy = 0; dy < rows; ++dy) {
+                    const CdfView row = plain.row(y0 + dy);
+                    const auto marginal = static_cast<double>(plain.marginal.width(y0 + dy));
+                    for (uint32_t dx = 0; dx < columns; ++dx)
+                        mass[size_t{dy} * columns + dx] = marginal * static_cast<double>(row.width(x0 + dx));
+                }
+                const size_t at = size_t{y0} * grid.w + size_t{rows} * x0;
+                uint32_t invalid = 0;
+                masses[size_t{cy} * grid.cw + cx] =
+                    detail::build_cdf(mass.data(), n, start + at, guide + at, invalid, scratch);
+            }
+        }
+    });
+    return masses;
+}
+
+}  // namespace
+
 void BinnedEnvMap::build(const detail::Geometries* given, StopFlag stop) {
     const CellGrid grid(plain_.width(), plain_.height(), layout_.cell_columns, layout_.cell_rows,
                         plain_.options().mapping);
     std::optional<detail::Geometries> own;
     const detail::Geometries& geometries = given ? *given : own.emplace(plain_, grid, layout_);
-    const std::vector<std::vector<float>> masses = detail::bin_masses(plain_, grid, geometries, layout_, stop);
+    std::vector<std::vector<float>> masses = detail::bin_masses(plain_, grid, geometries, layout_, stop);
     column_edges_ = grid.column_edges;
     row_edges_ = grid.row_edges;
+    by_column_.clear();
+    for (uint32_t cx = 0; cx < grid.cw; ++cx)
+        by_column_.push_back(detail::ExactDivision::by(grid.column_edges[cx + 1] - grid.column_edges[cx]));
     min_view_cos_.clear();
     for (const BinChoice& c : layout_.choices) min_view_cos_.push_back(c.plain() ? 2.0f : c.min_view_cos);
-    const size_t cells = size_t{grid.cw} * grid.ch;
+    const size_t cells = size_t{grid.cw} * grid.ch, texels = size_t{grid.w} * grid.h;
+    texel_start_.resize(texels);
+    texel_guide_.resize(texels);
+    const std::vector<double> plain_masses =
+        build_cell_texels(plain_.distribution().view(), grid, texel_start_.data(), texel_guide_.data(), stop);
+    // The plain cell table last; the plain map's distribution is then the cells' and
+    // their texels'.
+    masses.emplace_back(plain_masses.begin(), plain_masses.end());
+    plain_density_bytes_ = plain_.distribution().bytes();
+    plain_ = std::move(plain_).without_density();
     cell_start_.resize(cells * masses.size());
     cell_guide_.resize(cells * masses.size());
     detail::CdfScratch cell_scratch(static_cast<uint32_t>(cells));
@@ -326,40 +384,17 @@ void BinnedEnvMap::build(const detail::Geometries* given, StopFlag stop) {
                           cell_guide_.data() + cb * cells, invalid, cell_scratch);
         if (invalid) throw std::invalid_argument("bin masses: negative or non-finite value");
     }
-    // Each cell's rows, weighted by the plain mass of their segment in the cell.
-    const Distribution2DView plain = plain_.distribution().view();
-    const uint32_t h = grid.h;
-    rows_start_.resize(size_t{grid.cw} * h);
-    rows_guide_.resize(size_t{grid.cw} * h);
-    detail::parallel_for(grid.cw, 1, stop, [&](uint32_t lo, uint32_t hi) {
-        std::vector<double> mass(h);
-        detail::CdfScratch scratch(h);
-        for (uint32_t cx = lo; cx < hi; ++cx) {
-            const uint32_t x0 = grid.column_edges[cx], x1 = grid.column_edges[cx + 1];
-            for (uint32_t y = 0; y < h; ++y) {
-                const CdfView row = plain.row(y);
-                const uint32_t segment = (x1 < grid.w ? row.start[x1] : kCdfUnits) - row.start[x0];
-                mass[y] = static_cast<double>(plain.marginal.width(y)) * segment;
-            }
-            for (uint32_t cy = 0; cy < grid.ch; ++cy) {
-                const uint32_t y0 = grid.row_edges[cy], n = grid.row_edges[cy + 1] - y0;
-                const size_t at = size_t{cx} * h + y0;
-                uint32_t invalid = 0;
-                detail::build_cdf(mass.data() + y0, n, rows_start_.data() + at, rows_guide_.data() + at, invalid,
-                                  scratch);
-            }
-        }
-    });
 }
 
 BinnedEnvMapView BinnedEnvMap::view() const noexcept {
     return {plain_.view(),
             cell_start_.data(),
             cell_guide_.data(),
-            rows_start_.data(),
-            rows_guide_.data(),
+            texel_start_.data(),
+            texel_guide_.data(),
             column_edges_.data(),
             row_edges_.data(),
+            by_column_.data(),
             min_view_cos_.data(),
             layout_.cell_columns,
             layout_.cell_rows,
@@ -368,6 +403,7 @@ BinnedEnvMapView BinnedEnvMap::view() const noexcept {
             bins(),
             layout_.diffuse_bins_per_side,
             diffuse_bins(),
+            static_cast<uint32_t>(layout_.choices.size()),
             detail::ExactDivision::by(plain_.width()),
             detail::ExactDivision::by(plain_.height()),
             detail::ExactDivision::by(layout_.cell_columns)};
@@ -384,9 +420,11 @@ bool BinnedEnvMap::complete(uint32_t lobe) const noexcept {
 }
 
 size_t BinnedEnvMap::bytes() const noexcept {
-    return (cell_start_.size() + rows_start_.size()) * sizeof(uint32_t) +
-           (cell_guide_.size() + rows_guide_.size()) * sizeof(uint16_t) +
-           (column_edges_.size() + row_edges_.size()) * sizeof(uint32_t) + min_view_cos_.size() * sizeof(float);
+    const size_t tables = (cell_start_.size() + texel_start_.size()) * sizeof(uint32_t) +
+                          (cell_guide_.size() + texel_guide_.size()) * sizeof(uint16_t) +
+                          (column_edges_.size() + row_edges_.size()) * sizeof(uint32_t) +
+                          by_column_.size() * sizeof(detail::ExactDivision) + min_view_cos_.size() * sizeof(float);
+    return tables - std::min(tables, plain_density_bytes_);
 }
 
 namespace {
@@ -403,12 +441,14 @@ Located locate(const BinnedEnvMapView& env, uint32_t lobe, LobeAxis axis, float 
     const Distribution2DView& d = env.plain.distribution;
     const uint32_t x = detail::cell_of(at.uv.x, d.w), y = detail::cell_of(at.uv.y, d.h);
     const uint32_t cx = env.cell_column(x), cy = env.cell_row(y);
-    const size_t texel = static_cast<size_t>(y) * d.w + x, row = static_cast<size_t>(y) * d.w;
-    env.plain.prefetch_texel(texel);
-    ENVMIS_PREFETCH(d.start + row + env.column_edges[cx]);
-    ENVMIS_PREFETCH(d.start + row + env.column_edges[cx + 1]);
+    const uint32_t k =
+        (y - env.row_edges[cy]) * (env.column_edges[cx + 1] - env.column_edges[cx]) + x - env.column_edges[cx];
+    const CdfView texels = env.cell_texels(cx, cy);
+    env.plain.prefetch_radiance(static_cast<size_t>(y) * d.w + x, static_cast<size_t>(y) * d.w + x);
+    ENVMIS_PREFETCH(texels.start + k);
+    ENVMIS_PREFETCH(texels.start + k + 1);
     ENVMIS_PREFETCH(at.bin.cells.start + cy * env.cells_w + cx);
-    ENVMIS_PREFETCH(env.rows_start + size_t{cx} * d.h + y);
+    ENVMIS_PREFETCH(at.bin.cells.start + cy * env.cells_w + cx + 1);
     return at;
 }
 
@@ -433,7 +473,7 @@ void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes
 }
 
 // Software-pipelined: a block of samples goes through each stage of BinView::sample in
-// turn (bin and a prefetch of its CDF at u.x's guide bucket; cell; row; texel; radiance), each
+// turn (bin and a prefetch of its CDF at u.x's guide bucket; cell; texel; radiance), each
 // stage prefetching what the next loads, so that the misses of a block's samples overlap
 // instead of each sample waiting on its chain of dependent loads. The stages are the
 // single call's own functions, so the results are bit-identical to it.
@@ -442,32 +482,25 @@ void sample_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes
     constexpr uint32_t kBlock = 16;
     BinView bins[kBlock];
     BinView::Cell cells[kBlock];
-    BinView::Row rows[kBlock];
     BinView::Texel texels[kBlock];
     for (uint32_t first = 0; first < n; first += kBlock) {
         const uint32_t m = std::min(kBlock, n - first);
         for (uint32_t j = 0; j < m; ++j) {
             const uint32_t i = first + j;
             bins[j] = env.bin({{axes.x[i], axes.y[i], axes.z[i]}, axes.view_cos[i]}, lobe, choices[i]);
-            if (bins[j].plain) continue;
             const CdfView& c = bins[j].cells;
             const uint32_t k = c.bucket(in.x[i]);
             ENVMIS_PREFETCH(c.guide + k);
             ENVMIS_PREFETCH(c.start + k);
         }
         for (uint32_t j = 0; j < m; ++j) {
-            if (bins[j].plain) continue;
             cells[j] = bins[j].find_cell(in.x[first + j]);
-            prefetch_row(env, cells[j], in.y[first + j]);
+            prefetch_texels(env, cells[j], in.y[first + j]);
         }
-        for (uint32_t j = 0; j < m; ++j)
-            if (!bins[j].plain) rows[j] = bins[j].find_row(cells[j], in.y[first + j]);
-        for (uint32_t j = 0; j < m; ++j)
-            if (!bins[j].plain) texels[j] = bins[j].find_texel(cells[j], rows[j]);
+        for (uint32_t j = 0; j < m; ++j) texels[j] = bins[j].find_texel(cells[j], in.y[first + j]);
         for (uint32_t j = 0; j < m; ++j) {
             const uint32_t i = first + j;
-            const EnvSample s =
-                bins[j].plain ? env.plain.sample({in.x[i], in.y[i]}) : bins[j].sample_at(cells[j], rows[j], texels[j]);
+            const EnvSample s = bins[j].sample_at(cells[j], texels[j]);
             out.x[i] = s.direction.x, out.y[i] = s.direction.y, out.z[i] = s.direction.z, out.pdf[i] = s.pdf;
             out.r[i] = s.radiance.r, out.g[i] = s.radiance.g, out.b[i] = s.radiance.b;
             if (out.u) out.u[i] = s.uv.x;

@@ -154,6 +154,19 @@ void EnvMap::rebuild(LargeVector<uint32_t> density_bits) {
                                    });
 }
 
+EnvMap EnvMap::with_density() const {
+    EnvMap m = *this;
+    const uint32_t w = width();
+    LargeVector<uint32_t> bits(size_t{w} * height());
+    std::vector<float> row(w);
+    for (uint32_t y = 0; y < height(); ++y) {
+        density_row(y, row);
+        for (uint32_t x = 0; x < w; ++x) bits[size_t{y} * w + x] = std::bit_cast<uint32_t>(row[x]);
+    }
+    m.rebuild(std::move(bits));
+    return m;
+}
+
 std::vector<float> EnvMap::density() const {
     const uint32_t w = width(), h = height();
     std::vector<float> out(size_t{w} * h);

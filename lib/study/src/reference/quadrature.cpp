@@ -185,7 +185,7 @@ double exact_variance(const BinnedEnvMap& binned, Technique technique, Allocatio
         if (!(blend.weight[k] > 0)) continue;
         const BinView bin = view.bin_at(blend.bin[k], blend.view_cos);
         variance += blend.weight[k] * exact_variance_with(
-                                          binned.plain(), [&](Vec2 uv) { return bin.pdf_uv(uv); }, technique,
+                                          binned.radiance_map(), [&](Vec2 uv) { return bin.pdf_uv(uv); }, technique,
                                           allocation, bsdf, point, subdivisions, stop);
     }
     return variance;

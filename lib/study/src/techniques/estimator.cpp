@@ -131,16 +131,8 @@ struct BinLanes {
     mutable BinView bins[kLanes];
 
     void pick(uint32_t lane, float choice) const noexcept { bins[lane] = map->bin(blend, choice); }
-    // Lanes whose bins are all plain take the plain map's batch functions (bit-identical
-    // to its single calls), so that a plain bin costs what the plain map does.
-    bool plain(uint32_t n) const noexcept {
-        for (uint32_t l = 0; l < n; ++l)
-            if (!bins[l].plain) return false;
-        return true;
-    }
 };
 void sample_lanes(const BinLanes& env, PointArrays u, SampleArrays out, uint32_t n) noexcept {
-    if (env.plain(n)) return sample_many(env.map->plain, u, out, n);
     for (uint32_t l = 0; l < n; ++l) {
         const EnvSample e = env.bins[l].sample({u.x[l], u.y[l]});
         out.x[l] = e.direction.x, out.y[l] = e.direction.y, out.z[l] = e.direction.z, out.pdf[l] = e.pdf;
@@ -148,7 +140,6 @@ void sample_lanes(const BinLanes& env, PointArrays u, SampleArrays out, uint32_t
     }
 }
 void lookup_lanes(const BinLanes& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
-    if (env.plain(n)) return lookup_many(env.map->plain, in, out, n);
     for (uint32_t l = 0; l < n; ++l) {
         const EnvMapView::Lookup e = env.bins[l].lookup({in.x[l], in.y[l], in.z[l]});
         out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b, out.pdf[l] = e.pdf;
@@ -342,9 +333,9 @@ DirectLightingEstimator::DirectLightingEstimator(const EnvMap& env, Technique te
 }
 
 DirectLightingEstimator::DirectLightingEstimator(const BinnedEnvMap& binned, Technique technique, Allocation allocation)
-    : env_(binned.plain().view()),
+    : env_(binned.radiance_map().view()),
       other_(env_),
-      luma_(binned.plain().options().luma),
+      luma_(binned.radiance_map().options().luma),
       technique_(technique),
       allocation_(allocation),
       binned_(&binned),

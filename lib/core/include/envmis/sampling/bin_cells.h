@@ -99,7 +99,11 @@ ENVMIS_CORE_API CellHistogram histogram(const EnvMap& plain, const CellGrid& gri
 // Throw std::invalid_argument for options a build refuses, and for a grid of more cells
 // than a bin's CDF can name (uint16 guide entries: at most 65536).
 ENVMIS_CORE_API void check_options(const BinnedOptions& options);
-ENVMIS_CORE_API void check_cells(uint32_t columns, uint32_t rows);
+// Texels of the largest cell of a grid (CellGrid's edges round up).
+ENVMIS_CORE_API uint64_t largest_cell(uint32_t w, uint32_t h, uint32_t columns, uint32_t rows) noexcept;
+// Throws std::invalid_argument where the grid has more than kMaxCells1D cells or a cell
+// more than kMaxCells1D texels.
+ENVMIS_CORE_API void check_cells(uint32_t w, uint32_t h, uint32_t columns, uint32_t rows);
 
 // The cell masses (cw ch floats) of every (class, bin) of the layout: the weight times the sum
 // over the cell of max(L - threshold, 0) times the texels' relative solid angle, or the

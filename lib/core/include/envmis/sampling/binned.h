@@ -30,12 +30,17 @@
 // the masses of its cells (sum over the cell's texels of q_b times their solid angle), in
 // one 1D CDF over all cells, row-major (two dependent loads to find a cell, where a
 // marginal and a conditional CDF took four). Inside a cell, a texel is picked by the
-// plain map's own density (luminance times solid angle), through the plain EnvMap's row
-// CDFs and one small CDF over each cell's rows: u.x picks the cell and, by its offset in
-// the cell, the texel in the row; u.y the row. pdf_b(x) = P_b(cell) P(row | cell) P(x | row, cell),
-// exact in 31-bit fixed point as in distribution.h, so sample and pdf agree exactly.
-// The plain map is therefore what a binned table stores at the texel level; the
-// compensation lives in the bins.
+// plain map's own density (its fixed-point texel probabilities), through one guided CDF
+// over the cell's texels, row-major in the cell, which every bin shares: u.x picks the
+// cell, u.y the texel in it, and u.x's offset in the cell places the point across the
+// texel, u.y's offset down it. pdf_b(x) = P_b(cell) P(x | cell), exact in 31-bit fixed
+// point as in distribution.h, so sample and pdf agree exactly. These cell texel CDFs take
+// the place of the plain map's row CDFs (6 bytes a texel each): a binned map holds the
+// plain map's radiance, not its distribution, and samples the plain density as one more
+// cell table (its cells' plain masses) over the same texel CDFs. So a binned sample waits
+// on two CDF inversions, as a global map's does; with the plain row CDFs and a CDF over
+// each cell's rows it waited on three (docs/performance-log.md, 'cell texel CDFs').
+// The compensation lives in the bins.
 //
 // Lobes: the best compensation strength depends on the BSDF (a diffuse lobe gains from
 // mild compensation relative to its hemisphere, a sharp glossy one often from strong
@@ -49,8 +54,7 @@
 // lowest weighted geometric mean wins where that mean is below 1 / cost (BinnedOptions:
 // what a binned estimate costs over a plain one), the plain density (alpha < 0 in
 // BinChoice) elsewhere, so that each bin holds what is predicted best at equal time. A
-// plain bin samples and weighs through the plain map's functions, at their cost (and the
-// study's batch paths take the plain map's SIMD kernels when every lane's bin is plain).
+// plain bin samples and weighs through the plain cell table, which all plain bins share.
 // A glossy bin's density is shaped about the mirror direction, but a lobe seen
 // obliquely reaches towards the normal: each compensated glossy bin also records the
 // most oblique view at which the choice predicts it beats the plain density (Phong and
@@ -82,10 +86,11 @@
 // matches what sample(n, choice, u) would have drawn. A compensated bin is incomplete (pdf 0 where L <= its
 // threshold): combine it with BSDF sampling.
 //
-// Cost: sample O(1) (three fixed-point CDF inversions: the bin's cells, the cell's rows,
-// the texel in the plain row's segment), pdf O(1); noexcept, allocation-free, ENVMIS_HD.
-// Memory on top of the plain map: 6 bytes per cell per bin per class, 6 bytes per (cell
-// column, texel row); figures in docs/performance.md. At most 65536 cells (uint16 guide).
+// Cost: sample O(1) (two fixed-point CDF inversions: the bin's cells, the cell's
+// texels), pdf O(1); noexcept, allocation-free, ENVMIS_HD.
+// Memory on top of the plain map: 6 bytes per cell per bin per class and for the plain
+// cell table; the cell texel CDFs take the plain row CDFs' 6 bytes a texel; figures in
+// docs/performance.md. At most 65536 cells, and 65536 texels a cell (uint16 guides).
 // Build: passes over the texels (three per node grid of the choice, one or two; the
 // candidate and final cell histograms), then O(K classes cells) work and the choice
 // (docs/performance.md).
@@ -337,8 +342,8 @@ struct BinView {
     // Over all cells of the grid, row-major (cell cy cells_w + cx): one CDF rather than a
     // marginal and a conditional, so that a sample waits on two dependent loads, not four.
     CdfView cells;
-    // A plain choice (BinChoice::plain): the bin samples and weighs through the plain
-    // map's own functions, at the plain map's cost, its cells unused.
+    // The plain density (a plain choice, BinChoice::plain, or a glossy bin seen beyond its
+    // view limit): the plain cell table, the same for every bin.
     bool plain = false;
 
     // sample(u) in stages, each ending on prefetches of what the next one loads, so that
@@ -347,18 +352,14 @@ struct BinView {
         CellHit hit;  // in the bin's CDF: the cell and u.x's offset in it
         uint32_t cx = 0, cy = 0;
     };
-    struct Row {
-        uint32_t y = 0, width = 0;  // texel row, its width in the cell's row CDF
-        float offset = 0;           // u.y's offset in the row
+    struct Texel {
+        uint32_t x = 0, y = 0;
+        uint32_t width = 0;  // in the cell's texel CDF
+        float offset = 0;    // u.y's offset in it: the point's position down the texel
     };
     ENVMIS_HD Cell find_cell(float ux) const noexcept;
-    ENVMIS_HD Row find_row(const Cell& c, float uy) const noexcept;
-    struct Texel {
-        uint32_t x = 0;
-        float offset = 0;  // u.x's position inside the texel
-    };
-    ENVMIS_HD Texel find_texel(const Cell& c, const Row& r) const noexcept;
-    ENVMIS_HD EnvSample sample_at(const Cell& c, const Row& r, const Texel& t) const noexcept;
+    ENVMIS_HD Texel find_texel(const Cell& c, float uy) const noexcept;
+    ENVMIS_HD EnvSample sample_at(const Cell& c, const Texel& t) const noexcept;
 
     ENVMIS_HD EnvSample sample(Vec2 u) const noexcept;
     ENVMIS_HD float pdf(Vec3 direction) const noexcept;
@@ -388,21 +389,26 @@ struct ExactDivision {
 
 // Non-owning, device-friendly view of a BinnedEnvMap (flat arrays).
 struct BinnedEnvMapView {
-    EnvMapView plain;                      // texel level: the plain density and the radiance
-    const uint32_t* cell_start = nullptr;  // per (class, bin): cells_w cells_h, row-major
+    // The radiance, the mapping and the frame; its distribution holds the sizes only
+    // (the plain density is the plain cell table over the cell texel CDFs).
+    EnvMapView plain;
+    // Per (class, bin), then the plain cell table: cells_w cells_h, row-major.
+    const uint32_t* cell_start = nullptr;
     const uint16_t* cell_guide = nullptr;
-    // Per cell column cx and texel row y: CDF over the texel rows of cell (cx, row of y),
-    // at [cx h + y]: the cell's rows weighted by their plain mass inside the column.
-    const uint32_t* rows_start = nullptr;
-    const uint16_t* rows_guide = nullptr;
-    const uint32_t* column_edges = nullptr;  // cells_w + 1 texel columns
-    const uint32_t* row_edges = nullptr;     // cells_h + 1 texel rows
+    // Per cell, the CDF over its texels (row-major in the cell) by the plain density; the
+    // cells' tables follow each other row-major (cell_texels).
+    const uint32_t* texel_start = nullptr;
+    const uint16_t* texel_guide = nullptr;
+    const uint32_t* column_edges = nullptr;            // cells_w + 1 texel columns
+    const uint32_t* row_edges = nullptr;               // cells_h + 1 texel rows
+    const detail::ExactDivision* by_column = nullptr;  // per cell column: by its width in texels
     // Per (class, bin): the least view cosine at which the bin samples its own density
     // (BinChoice::min_view_cos; above 1 for a plain choice, which never does).
     const float* min_view_cos = nullptr;
     uint32_t cells_w = 0, cells_h = 0, classes = 0;
     uint32_t bins_per_side = 0, bins = 0;                  // of each glossy class (1 and up)
     uint32_t diffuse_bins_per_side = 0, diffuse_bins = 0;  // of the diffuse class (0)
+    uint32_t plain_table = 0;                              // the plain cell table's index
     // Divisions by the plain map's width and height (cell_column, cell_row) and by cells_w
     // (find_cell's row of a cell).
     detail::ExactDivision by_width, by_height, by_cells_w;
@@ -440,9 +446,15 @@ struct BinnedEnvMapView {
     }
     // Bin `class_bin` seen with view cosine `view_cos`: its own density, or the plain one.
     ENVMIS_HD BinView bin_at(uint32_t class_bin, float view_cos) const noexcept {
+        const bool own = view_cos >= min_view_cos[class_bin];
+        return table(own ? class_bin : plain_table);
+    }
+    // The plain density (the map's luminance times solid angle) through the cells.
+    ENVMIS_HD BinView plain_bin() const noexcept { return table(plain_table); }
+    ENVMIS_HD BinView table(uint32_t t) const noexcept {
         const uint32_t cells = cells_w * cells_h;
-        const size_t at = size_t{class_bin} * cells;
-        return {this, {cell_start + at, cell_guide + at, cells}, !(view_cos >= min_view_cos[class_bin])};
+        const size_t at = size_t{t} * cells;
+        return {this, {cell_start + at, cell_guide + at, cells}, t == plain_table};
     }
     ENVMIS_HD EnvSample sample(LobeAxis at, uint32_t lobe, float choice, Vec2 u) const noexcept {
         return bin(at, lobe, choice).sample(u);
@@ -458,24 +470,19 @@ struct BinnedEnvMapView {
     // Cell column and row of texel (x, y): the cell whose edges hold it.
     ENVMIS_HD uint32_t cell_column(uint32_t x) const noexcept { return by_width.of(x * cells_w); }
     ENVMIS_HD uint32_t cell_row(uint32_t y) const noexcept { return by_height.of(y * cells_h); }
-    // The CDF over the texel rows of cell (cx, cy).
-    ENVMIS_HD CdfView cell_rows(uint32_t cx, uint32_t cy) const noexcept {
-        const size_t at = size_t{cx} * plain.distribution.h + row_edges[cy];
-        return {rows_start + at, rows_guide + at, row_edges[cy + 1] - row_edges[cy]};
+    // The CDF over the texels of cell (cx, cy): the cells before it in its row of cells
+    // hold all the texels left of it in its texel rows.
+    ENVMIS_HD CdfView cell_texels(uint32_t cx, uint32_t cy) const noexcept {
+        const uint32_t y0 = row_edges[cy], rows = row_edges[cy + 1] - y0, x0 = column_edges[cx];
+        const size_t at = size_t{y0} * plain.distribution.w + size_t{rows} * x0;
+        return {texel_start + at, texel_guide + at, (column_edges[cx + 1] - x0) * rows};
     }
-    // Image-space density of texel (x, y) of cell column cx under a bin, from the
-    // fixed-point widths of its cell in the bin's CDF, of its row in the cell, and of the
-    // texel and its row segment in the plain row CDF; one expression for sample and pdf.
-    ENVMIS_HD float texel_pdf(uint32_t cell_width, uint32_t cx, uint32_t row_width, uint32_t x,
-                              uint32_t y) const noexcept {
-        const CdfView row = plain.distribution.row(y);
-        const uint32_t x1 = column_edges[cx + 1];
-        const uint32_t segment = (x1 < row.n ? row.start[x1] : kCdfUnits) - row.start[column_edges[cx]];
+    // Image-space density of a texel under a bin, from the fixed-point widths of its cell
+    // in the bin's CDF and of the texel in its cell's CDF; one expression for sample and
+    // pdf. Products of widths, no quotient: a black cell's texels get 0, never 0 / 0.
+    ENVMIS_HD float texel_pdf(uint32_t cell_width, uint32_t texel_width) const noexcept {
         const float texels = static_cast<float>(uint64_t{plain.distribution.w} * plain.distribution.h);
-        // A black segment (0 of the plain row's mass) holds only texels of width 0: its
-        // density is 0, and max(segment, 1) keeps 0 / 0 from making it NaN.
-        return static_cast<float>(cell_width) * static_cast<float>(row_width) * 0x1p-62f *
-               (static_cast<float>(row.width(x)) / static_cast<float>(max(segment, 1u))) * texels;
+        return static_cast<float>(cell_width) * static_cast<float>(texel_width) * 0x1p-62f * texels;
     }
 };
 
@@ -506,7 +513,13 @@ public:
                  double choice_seconds);
 
     BinnedEnvMapView view() const noexcept;
-    const EnvMap& plain() const noexcept { return plain_; }
+    // The plain map's radiance, options, stats and size, without its distribution
+    // (EnvMap::without_density: not to be sampled); the plain density is
+    // view().plain_bin().
+    const EnvMap& radiance_map() const noexcept { return plain_; }
+    // The plain map whole, its distribution rebuilt (EnvMap::with_density; 6 bytes a
+    // texel more), for callers that sample it as a global map.
+    EnvMap plain_map() const { return plain_.with_density(); }
     const BinLayout& layout() const noexcept { return layout_; }
     // Bins of each glossy class (what `precompute --bins` names), and of the diffuse class.
     uint32_t bins() const noexcept { return layout_.bins_per_side * layout_.bins_per_side; }
@@ -518,8 +531,10 @@ public:
     // True if every bin of the class samples where its normals see light (no bin zeroes
     // texels by compensation); a compensated class is incomplete (envmap.h).
     bool complete(uint32_t lobe) const noexcept;
-    // Bytes the bins add to the plain map.
+    // Bytes the bins add to the plain map: their tables less the plain distribution they
+    // replace; and the plain map's own (radiance and distribution).
     size_t bytes() const noexcept;
+    size_t plain_bytes() const noexcept { return plain_density_bytes_ + plain_.radiance().pixels.size_bytes(); }
     // Seconds the build spent choosing alphas (0 when rebuilt from a layout).
     double choice_seconds() const noexcept { return choice_seconds_; }
 
@@ -531,10 +546,12 @@ private:
 
     EnvMap plain_;
     BinLayout layout_;
-    LargeVector<uint32_t> cell_start_, rows_start_;
-    LargeVector<uint16_t> cell_guide_, rows_guide_;
+    LargeVector<uint32_t> cell_start_, texel_start_;
+    LargeVector<uint16_t> cell_guide_, texel_guide_;
     std::vector<uint32_t> column_edges_, row_edges_;
+    std::vector<detail::ExactDivision> by_column_;
     std::vector<float> min_view_cos_;
+    size_t plain_density_bytes_ = 0;
     double choice_seconds_ = 0;
 };
 
@@ -548,80 +565,46 @@ ENVMIS_HD inline BinView::Cell BinView::find_cell(float ux) const noexcept {
     return {hit, hit.index - cy * m.cells_w, cy};
 }
 
-// Prefetches, once the cell is known, of its row CDF where u.y's guide bucket points and
-// of the plain row start of the row that bucket guesses (exact when the rows weigh
-// alike): they overlap the row CDF's misses with the plain row's.
-ENVMIS_HD inline void prefetch_row(const BinnedEnvMapView& m, const BinView::Cell& c, float uy) noexcept {
-    const CdfView rows = m.cell_rows(c.cx, c.cy);
-    const uint32_t k = rows.bucket(uy);
-    ENVMIS_PREFETCH(rows.guide + k);
-    ENVMIS_PREFETCH(rows.start + k);
-    const uint32_t* start = m.plain.distribution.row(m.row_edges[c.cy] + k).start;
-    ENVMIS_PREFETCH(start + m.column_edges[c.cx]);
+// A prefetch, once the cell is known, of its texel CDF where u.y's guide bucket points.
+ENVMIS_HD inline void prefetch_texels(const BinnedEnvMapView& m, const BinView::Cell& c, float uy) noexcept {
+    const CdfView texels = m.cell_texels(c.cx, c.cy);
+    const uint32_t k = texels.bucket(uy);
+    ENVMIS_PREFETCH(texels.guide + k);
+    ENVMIS_PREFETCH(texels.start + k);
 }
 
-// The texel row, by the cell's CDF over its rows; then prefetches of the row's segment.
-ENVMIS_HD inline BinView::Row BinView::find_row(const Cell& c, float uy) const noexcept {
+// The texel, by the cell's texel CDF; then a prefetch of its radiance.
+ENVMIS_HD inline BinView::Texel BinView::find_texel(const Cell& c, float uy) const noexcept {
     const BinnedEnvMapView& m = *map;
-    const CdfView rows = m.cell_rows(c.cx, c.cy);
-    const CellHit ry = rows.invert(uy);
-    const uint32_t y = m.row_edges[c.cy] + ry.index;
-    // Every cache line of the segment (its end too), so that the binary search over it
-    // waits for one miss, not one per halving.
-    const uint32_t* start = m.plain.distribution.row(y).start;
-    const uint32_t x1 = min(m.column_edges[c.cx + 1], m.plain.distribution.w - 1);
-    for (uint32_t x = m.column_edges[c.cx]; x < x1; x += 16) ENVMIS_PREFETCH(start + x);
-    ENVMIS_PREFETCH(start + x1);
-    return {y, ry.width, ry.offset};
+    const CellHit t = m.cell_texels(c.cx, c.cy).invert(uy);
+    const uint32_t dy = m.by_column[c.cx].of(t.index);
+    const uint32_t y = m.row_edges[c.cy] + dy,
+                   x = m.column_edges[c.cx] + t.index - dy * (m.column_edges[c.cx + 1] - m.column_edges[c.cx]);
+    ENVMIS_PREFETCH(m.plain.radiance + static_cast<size_t>(y) * m.plain.distribution.w + x);
+    return {x, y, t.width, t.offset};
 }
 
-// The texel: the plain row CDF inverted inside the cell's segment of the row, at u.x's
-// offset in the cell; then a prefetch of its radiance.
-ENVMIS_HD inline BinView::Texel BinView::find_texel(const Cell& c, const Row& r) const noexcept {
-    const BinnedEnvMapView& m = *map;
-    const CdfView row = m.plain.distribution.row(r.y);
-    const uint32_t x0 = m.column_edges[c.cx], x1 = m.column_edges[c.cx + 1];
-    const uint32_t a = row.start[x0], b = x1 < row.n ? row.start[x1] : kCdfUnits;
-    const double units = a + static_cast<double>(c.hit.offset) * (b - a);
-    const auto t = min(static_cast<uint32_t>(units), b - 1);
-    // The last texel of the segment whose start is <= t (row.start[x0] = a <= t), by
-    // halving with a select: the steps depend on the segment's width alone, so the loop's
-    // jumps are predicted, where a search's on u would miss half the time.
-    uint32_t lo = x0;
-    for (uint32_t len = x1 - x0; len > 1;) {
-        const uint32_t half = len / 2;
-        lo = row.start[lo + half] <= t ? lo + half : lo;
-        len -= half;
-    }
-    const float ox = min(static_cast<float>((units - row.start[lo]) / row.width(lo)), kOneMinusEpsilon);
-    ENVMIS_PREFETCH(m.plain.radiance + static_cast<size_t>(r.y) * row.n + lo);
-    return {lo, max(ox, 0.0f)};
-}
-
-ENVMIS_HD inline EnvSample BinView::sample_at(const Cell& c, const Row& r, const Texel& t) const noexcept {
+ENVMIS_HD inline EnvSample BinView::sample_at(const Cell& c, const Texel& t) const noexcept {
     const BinnedEnvMapView& m = *map;
     const uint32_t w = m.plain.distribution.w;
-    const Vec2 p{detail::point_in_cell(t.x, t.offset, w), detail::point_in_cell(r.y, r.offset, m.plain.distribution.h)};
-    const float image_pdf = m.texel_pdf(cells.width(c.hit.index), c.cx, r.width, t.x, r.y);
-    return m.plain.at(p, image_pdf, static_cast<size_t>(r.y) * w + t.x);
+    const Vec2 p{detail::point_in_cell(t.x, c.hit.offset, w),
+                 detail::point_in_cell(t.y, t.offset, m.plain.distribution.h)};
+    const float image_pdf = m.texel_pdf(cells.width(c.hit.index), t.width);
+    return m.plain.at(p, image_pdf, static_cast<size_t>(t.y) * w + t.x);
 }
 
-// u.x picks the cell and, by its offset there, the texel inside the row; u.y the row.
+// u.x picks the cell, u.y the texel in it.
 ENVMIS_HD inline EnvSample BinView::sample(Vec2 u) const noexcept {
-    if (plain) return map->plain.sample(u);
     const Cell c = find_cell(u.x);
-    prefetch_row(*map, c, u.y);
-    const Row r = find_row(c, u.y);
-    return sample_at(c, r, find_texel(c, r));
+    return sample_at(c, find_texel(c, u.y));
 }
 
 ENVMIS_HD inline float BinView::pdf_uv(Vec2 uv) const noexcept {
     const BinnedEnvMapView& m = *map;
-    if (plain) return m.plain.pdf_uv(uv);
     const uint32_t x = detail::cell_of(uv.x, m.plain.distribution.w), y = detail::cell_of(uv.y, m.plain.distribution.h);
     const uint32_t cx = m.cell_column(x), cy = m.cell_row(y);
-    const uint32_t row_width = m.cell_rows(cx, cy).width(y - m.row_edges[cy]);
-    const float image_pdf = m.texel_pdf(cells.width(cy * m.cells_w + cx), cx, row_width, x, y);
+    const uint32_t k = (y - m.row_edges[cy]) * (m.column_edges[cx + 1] - m.column_edges[cx]) + x - m.column_edges[cx];
+    const float image_pdf = m.texel_pdf(cells.width(cy * m.cells_w + cx), m.cell_texels(cx, cy).width(k));
     return m.plain.image_to_solid_angle(image_pdf, uv.y);
 }
 

@@ -343,6 +343,14 @@ public:
     float pdf(Vec2 p) const noexcept { return view().pdf(p); }
     Vec2 invert(Vec2 p) const noexcept { return view().invert(p); }
 
+    // The sizes, integral and fallback without the tables: for a holder that samples the
+    // function through tables of its own (EnvMap::without_density); not to be sampled.
+    Distribution2D without_tables() const {
+        Distribution2D d;
+        d.w_ = w_, d.h_ = h_, d.integral_ = integral_, d.uniform_ = uniform_;
+        return d;
+    }
+
     uint32_t width() const noexcept { return w_; }
     uint32_t height() const noexcept { return h_; }
     double integral() const noexcept { return integral_; }  // mean of the input func over [0,1)^2

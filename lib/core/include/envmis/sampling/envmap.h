@@ -267,6 +267,17 @@ public:
     // The repaired radiance, as built (owned) or loaded (possibly a file mapping).
     RgbImageView radiance() const noexcept { return radiance_; }
     const Distribution2D& distribution() const noexcept { return distribution_; }
+    // The same map without its distribution's tables (Distribution2D::without_tables):
+    // radiance, options, stats and sizes, for a holder that samples the map's density
+    // through tables of its own (BinnedEnvMap). Its sample and pdf must not be called.
+    EnvMap without_density() && {
+        EnvMap m = std::move(*this);
+        m.distribution_ = m.distribution_.without_tables();
+        return m;
+    }
+    // The same map with its distribution rebuilt from the radiance (density()), sharing
+    // the pixels: bit-identical samples to the map built or loaded.
+    EnvMap with_density() const;
     // The image-space density function, q(x, y) w_y, row-major, recomputed
     // from the radiance exactly as the build computed it.
     std::vector<float> density() const;
