@@ -575,5 +575,21 @@ TEST(Binned, RejectsCompensatedMapsAndInvalidOptionsAndLayouts) {
     EXPECT_THROW(BinnedEnvMap(plain, layout), std::invalid_argument);
 }
 
+TEST(Binned, ACellOfMoreThan65536TexelsIsRefusedWithItsSize) {
+    const EnvMap plain = plain_map(test::constant_map(512, 256, {1, 1, 1}));
+    BinnedOptions o;
+    o.auto_alpha = false;
+    o.cell_columns = 1;  // one cell of 512 x 256 texels: its CDF's uint16 guide cannot name them
+    try {
+        build_bins(plain, o);
+        FAIL() << "a cell of 131072 texels was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("at most 65536 texels"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("131072"), std::string::npos) << e.what();
+    }
+    o.cell_columns = 2;  // 256 x 256 texels
+    EXPECT_EQ(build_bins(plain, o).layout().cell_columns, 2u);
+}
+
 }  // namespace
 }  // namespace envmis
