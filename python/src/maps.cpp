@@ -4,7 +4,7 @@
 // std::shared_ptr (py::class_<EnvMap, std::shared_ptr<EnvMap>>), so that envmis._study,
 // which imports this module, takes them as arguments (const EnvMap&,
 // std::shared_ptr<const BinnedEnvMap>) through pybind11's shared type registry. A binned
-// map's `plain` points into the binned map, which its deleter keeps alive.
+// map's `plain` is a map of its own, its distribution rebuilt (BinnedEnvMap::plain_map).
 //
 // What a C++ map does not hold, where it came from (TableSource), how (the request, or a
 // table file) and whether its radiance maps a table file, rides in its shared_ptr's
@@ -49,8 +49,6 @@ struct Deleter {
     void operator()(T* map) const noexcept { delete map; }
 };
 
-// The deleter of a binned map's plain map, which is part of the binned map: it deletes
-// nothing, and holds the binned map until the last reference to the plain map goes.
 template <class T>
 std::shared_ptr<T> held(T map, Provenance provenance) {
     return std::shared_ptr<T>(new T(std::move(map)), Deleter<T>{std::move(provenance)});

@@ -97,8 +97,8 @@ void sample(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, co
 void lookup(const EnvMapView& env, const float* directions, InterleavedLookups out, size_t n) noexcept {
     lookup_chunks(directions, nullptr, out, n,
                   [&](DirectionArrays in, DirectionArrays, LookupArrays o, uint32_t m, size_t) {
-                      if (out.pdf) return lookup_many(env, in, o, m);
-                      // Radiance alone: a binned map's radiance map has no distribution to read.
+                      if (out.pdf || env.distribution.start) return lookup_many(env, in, o, m);
+                      // Radiance alone from a binned map's radiance map: no distribution to read.
                       for (uint32_t i = 0; i < m; ++i) {
                           const Rgb c = env.eval({in.x[i], in.y[i], in.z[i]});
                           o.r[i] = c.r, o.g[i] = c.g, o.b[i] = c.b;

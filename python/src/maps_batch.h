@@ -33,8 +33,8 @@ void sample(const EnvMapView& env, const float* u, InterleavedSamples out, size_
 // (BinnedEnvMapView::bin).
 void sample(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* view_cos,
             const float* choices, const float* u, InterleavedSamples out, size_t n) noexcept;
-// directions: n x 3 unit vectors (world frame). Without out.pdf, the radiance alone
-// (env's distribution unread).
+// directions: n x 3 unit vectors (world frame). Without out.pdf from a map without a
+// distribution (BinnedEnvMap::radiance_map), the radiance alone.
 void lookup(const EnvMapView& env, const float* directions, InterleavedLookups out, size_t n) noexcept;
 void lookup(const BinnedEnvMapView& env, uint32_t lobe, const float* normals, const float* view_cos,
             const float* choices, const float* directions, InterleavedLookups out, size_t n) noexcept;

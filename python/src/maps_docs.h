@@ -135,10 +135,9 @@ by its BSDF's sharpness (lobe_class). The same choice must serve a point's light
 and its BSDF samples' MIS weights. Made by envmis.load(..., bins=K) or from a binned table. pdf and
 sample speak solid angle (per steradian) over world directions, as EnvMap's.)";
 inline constexpr const char* kPlain =
-    "The plain map the bins are built over (an EnvMap sharing this map's radiance, its distribution rebuilt: a binned "
-    "map "
-    "samples the plain density through its cells). Its source "
-    "records what it is: the uncompensated map (compensate=0 ... bins=0), or no options for a binned table's.";
+    "The plain map the bins are built over: an EnvMap sharing this map's radiance, its distribution rebuilt at each "
+    "access (a binned map samples the plain density through its cells). Its source records what it is: the "
+    "uncompensated map (compensate=0 ... bins=0), or no options for a binned table's.";
 inline constexpr const char* kExponents = "The lobe classes' Phong exponents, ascending; 0 is diffuse (Lambert).";
 inline constexpr const char* kLobeClass =
     "The lobe class of a BSDF with this Phong exponent (0 for Lambert): the nearest class on the scale "

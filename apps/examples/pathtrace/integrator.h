@@ -50,7 +50,7 @@ struct GlobalEnvironment {
 
 // Bins at the first `depth` vertices of a path; beyond, a global density over the same
 // texels (`beyond`: a compensated table of the same image, or the binned table's own
-// plain map): a renderer's choice to spend the bins' cost where a path's throughput is
+// plain density through its cells): a renderer's choice to spend the bins' cost where a path's throughput is
 // whole (what it buys: docs/performance.md, 'In a path tracer'). Each vertex samples
 // and weighs with one density, so each vertex's estimate is unbiased.
 struct BinnedEnvironment {

@@ -18,7 +18,7 @@
 // axis at render time (envmis/sampling/rotated.h), every technique alike; --light-samples N
 // draws N environment samples a vertex (balance heuristic with counts); --bins-depth N
 // samples the bins at the first N vertices of a path only and beyond them the binned
-// table's plain map or, with --beyond, a global table of the same image (compensated).
+// table's plain density or, with --beyond, a global table of the same image (compensated).
 #include <algorithm>
 #include <atomic>
 #include <chrono>

@@ -9,7 +9,7 @@ extern "C" {
 void envmis_prefetch_uv(const envmis::EnvMapView& view, envmis::Vec2 uv) { view.prefetch_uv(uv); }
 void envmis_prefetch_texel(const envmis::EnvMapView& view, size_t texel) { view.prefetch_texel(texel); }
 void envmis_prefetch_unit(const envmis::CdfView& cdf, uint32_t t) { cdf.prefetch_unit(t, envmis::NoHint{}); }
-void envmis_prefetch_row(const envmis::BinnedEnvMapView& map, const envmis::BinView::Cell& cell, float uy) {
-    envmis::prefetch_row(map, cell, uy);
+void envmis_prefetch_texels(const envmis::BinnedEnvMapView& map, const envmis::BinView::Cell& cell, float uy) {
+    envmis::prefetch_texels(map, cell, uy);
 }
 }

@@ -395,8 +395,7 @@ TEST(Binned, TinyBlackAndConstantMapsWork) {
 }
 
 // Bytes the bins of `layout` add to a plain map of h texel rows, as binned.h counts them:
-// 6 per cell per (class, bin), 6 per (cell column, texel row), and the small tables.
-// The cell tables (the bins' and the plain one) and the small ones; the cell texel CDFs
+// the cell tables (the bins' and the plain one) and the small ones; the cell texel CDFs
 // take the plain row CDFs' place, and the plain marginal (6 bytes a row) is saved.
 size_t bins_bytes(const BinLayout& layout, uint32_t h) {
     const size_t cells = size_t{layout.cell_columns} * layout.cell_rows;

@@ -87,8 +87,8 @@ TEST(BinnedEstimator, IsUnbiasedOnALossyExrWithNegativePixels) {
     expect_unbiased("city.exr", load_plain("city.exr"), 2000);
 }
 
-// Bins that a cost makes plain sample through the plain map, in batches through its
-// batch functions where every lane's bin is plain (estimator.cpp, BinLanes).
+// Bins that a cost makes plain sample through the plain cell table, in batches beside
+// compensated ones (estimator.cpp, BinLanes).
 TEST(BinnedEstimator, BatchesAreUnbiasedWithPlainAndCompensatedBinsMixed) {
     const EnvMap plain = plain_map(test::sun_sky_map(256, 128));
     uint64_t seed = 500;

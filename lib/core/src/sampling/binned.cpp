@@ -424,6 +424,8 @@ size_t BinnedEnvMap::bytes() const noexcept {
                           (cell_guide_.size() + texel_guide_.size()) * sizeof(uint16_t) +
                           (column_edges_.size() + row_edges_.size()) * sizeof(uint32_t) +
                           by_column_.size() * sizeof(detail::ExactDivision) + min_view_cos_.size() * sizeof(float);
+    // Never below 0: a coarse grid over a map large enough for a coarse guide may save
+    // more than it adds.
     return tables - std::min(tables, plain_density_bytes_);
 }
 
@@ -473,10 +475,11 @@ void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes
 }
 
 // Software-pipelined: a block of samples goes through each stage of BinView::sample in
-// turn (bin and a prefetch of its CDF at u.x's guide bucket; cell; texel; radiance), each
-// stage prefetching what the next loads, so that the misses of a block's samples overlap
-// instead of each sample waiting on its chain of dependent loads. The stages are the
-// single call's own functions, so the results are bit-identical to it.
+// turn (bin and a prefetch of its CDF at u.x's guide bucket; cell; the texel CDF's guide
+// span; texel; radiance), each stage prefetching what the next loads, so that the misses
+// of a block's samples overlap instead of each sample waiting on its chain of dependent
+// loads. The stages are the single call's own functions, so the results are
+// bit-identical to it.
 void sample_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes, const float* choices, PointArrays in,
                  SampleArrays out, uint32_t n) noexcept {
     constexpr uint32_t kBlock = 16;
@@ -497,6 +500,7 @@ void sample_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes
             cells[j] = bins[j].find_cell(in.x[first + j]);
             prefetch_texels(env, cells[j], in.y[first + j]);
         }
+        for (uint32_t j = 0; j < m; ++j) prefetch_texel_span(env, cells[j], in.y[first + j]);
         for (uint32_t j = 0; j < m; ++j) texels[j] = bins[j].find_texel(cells[j], in.y[first + j]);
         for (uint32_t j = 0; j < m; ++j) {
             const uint32_t i = first + j;

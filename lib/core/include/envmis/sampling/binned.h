@@ -372,8 +372,8 @@ namespace detail {
 // floor(n / d) for n < 2^28 and d in [1, 2^16], as a product and a shift: with
 // k = 28 + ceil(log2 d) and m = ceil(2^k / d) < 2^29, n m / 2^k exceeds n / d by less than
 // 1 / d, so the floor is the same, and n m < 2^57 fits. A binned pdf finds its texel's
-// cell this way, a binned sample its cell's row: a division would sit on their critical
-// paths.
+// cell this way, a binned sample its texel's row in the cell (by_column): a division
+// would sit on their critical paths.
 struct ExactDivision {
     uint64_t m = 1;
     uint32_t k = 0;
@@ -574,6 +574,15 @@ ENVMIS_HD inline void prefetch_texels(const BinnedEnvMapView& m, const BinView::
     const uint32_t k = texels.bucket(uy);
     ENVMIS_PREFETCH(texels.guide + k);
     ENVMIS_PREFETCH(texels.start + k);
+}
+
+// Once that guide entry has arrived: prefetches of the first and last CDF entries it
+// names, where the search will look (a large cell's answer lies far from its bucket).
+ENVMIS_HD inline void prefetch_texel_span(const BinnedEnvMapView& m, const BinView::Cell& c, float uy) noexcept {
+    const CdfView texels = m.cell_texels(c.cx, c.cy);
+    const CdfTable::Span s = texels.guide_span(texels.bucket(uy));
+    ENVMIS_PREFETCH(texels.start + s.lo);
+    ENVMIS_PREFETCH(texels.start + s.hi);
 }
 
 // The texel, by the cell's texel CDF; then a prefetch of its radiance.

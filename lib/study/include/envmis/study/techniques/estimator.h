@@ -157,7 +157,7 @@ private:
     // The bin `choice` (uniform in [0,1)) picks for the point and the BSDF's lobe class.
     BinView bin_of(const ShadingPoint& point, const Bsdf& bsdf, float choice) const noexcept;
 
-    EnvMapView env_;    // the sampled density
+    EnvMapView env_;    // the sampled density (a binned map's: its radiance alone)
     EnvMapView other_;  // the plain density, which the mixture also samples
     LumaCoefficients luma_;
     Technique technique_;
