@@ -133,17 +133,10 @@ struct BinLanes {
     void pick(uint32_t lane, float choice) const noexcept { bins[lane] = map->bin(blend, choice); }
 };
 void sample_lanes(const BinLanes& env, PointArrays u, SampleArrays out, uint32_t n) noexcept {
-    for (uint32_t l = 0; l < n; ++l) {
-        const EnvSample e = env.bins[l].sample({u.x[l], u.y[l]});
-        out.x[l] = e.direction.x, out.y[l] = e.direction.y, out.z[l] = e.direction.z, out.pdf[l] = e.pdf;
-        out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b;
-    }
+    sample_many(env.bins, u, out, n);
 }
 void lookup_lanes(const BinLanes& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
-    for (uint32_t l = 0; l < n; ++l) {
-        const EnvMapView::Lookup e = env.bins[l].lookup({in.x[l], in.y[l], in.z[l]});
-        out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b, out.pdf[l] = e.pdf;
-    }
+    lookup_many(env.bins, in, out, n);
 }
 
 constexpr uint32_t kMaxLaneSamples = 8;  // per estimate; estimates that spend more go one at a time

@@ -496,6 +496,10 @@ ENVMIS_CORE_API void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, Lob
                                  DirectionArrays in, LookupArrays out, uint32_t n) noexcept;
 ENVMIS_CORE_API void sample_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes, const float* choices,
                                  PointArrays in, SampleArrays out, uint32_t n) noexcept;
+// The same for n directions or points each in its own bin, picked beforehand (a renderer's
+// or a study's shading points, each with the bin it keeps for its samples).
+ENVMIS_CORE_API void lookup_many(const BinView* bins, DirectionArrays in, LookupArrays out, uint32_t n) noexcept;
+ENVMIS_CORE_API void sample_many(const BinView* bins, PointArrays in, SampleArrays out, uint32_t n) noexcept;
 
 namespace detail {
 struct Geometries;  // bin_cells.h
