@@ -6,6 +6,7 @@
 #include <cstring>
 #include <numeric>
 #include <string>
+#include <vector>
 
 #include "binned_checks.h"
 #include "envmis/build/bins.h"
@@ -295,6 +296,24 @@ void expect_batch_bit_identical(const BinnedEnvMapView& view) {
         const EnvMapView::Lookup l = view.lookup({{nx[i], ny[i], nz[i]}, vc[i]}, 1, c[i], {dx[i], dy[i], dz[i]});
         ASSERT_EQ(l.pdf, pdf[i]);
         ASSERT_EQ(l.radiance.b, b[i]);
+    }
+    // The same over bins picked beforehand.
+    std::vector<BinView> bins;
+    for (uint32_t i = 0; i < n; ++i) bins.push_back(view.bin({{nx[i], ny[i], nz[i]}, vc[i]}, 1, c[i]));
+    sample_many(bins.data(), {ux, uy}, {x, y, z, pdf, r, g, b, u, v}, n);
+    for (uint32_t i = 0; i < n; ++i) {
+        const EnvSample s = bins[i].sample({ux[i], uy[i]});
+        ASSERT_EQ(s.direction.y, y[i]);
+        ASSERT_EQ(s.pdf, pdf[i]);
+        ASSERT_EQ(s.radiance.r, r[i]);
+        ASSERT_EQ(s.uv.x, u[i]);
+        ASSERT_EQ(s.uv.y, v[i]);
+    }
+    lookup_many(bins.data(), {dx, dy, dz}, {r, g, b, pdf}, n);
+    for (uint32_t i = 0; i < n; ++i) {
+        const EnvMapView::Lookup l = bins[i].lookup({dx[i], dy[i], dz[i]});
+        ASSERT_EQ(l.pdf, pdf[i]);
+        ASSERT_EQ(l.radiance.g, g[i]);
     }
 }
 

@@ -109,8 +109,8 @@ float fixed_weight(const Technique& t, const float* q, int k) noexcept {
     return 0;
 }
 
-// The lanes' batch sampling and lookups: the map's batch functions, or single calls for
-// bins (one per estimate: BinLanes below).
+// The lanes' batch sampling and lookups: the map's batch functions, or for bins the batch
+// forms over the bins each lane picked (BinLanes below).
 void sample_lanes(const EnvMapView& env, PointArrays u, SampleArrays out, uint32_t n) noexcept {
     sample_many(env, u, out, n);
 }
