@@ -444,8 +444,7 @@ Located locate(const BinView& bin, Vec3 direction) noexcept {
     const Distribution2DView& d = env.plain.distribution;
     const uint32_t x = detail::cell_of(at.uv.x, d.w), y = detail::cell_of(at.uv.y, d.h);
     const uint32_t cx = env.cell_column(x), cy = env.cell_row(y);
-    const uint32_t k =
-        (y - env.row_edges[cy]) * (env.column_edges[cx + 1] - env.column_edges[cx]) + x - env.column_edges[cx];
+    const uint32_t k = env.texel_in_cell(x, y, cx, cy);
     const CdfView texels = env.cell_texels(cx, cy);
     env.plain.prefetch_radiance(static_cast<size_t>(y) * d.w + x, static_cast<size_t>(y) * d.w + x);
     ENVMIS_PREFETCH(texels.start + k);
@@ -510,15 +509,22 @@ void sample_pipelined(BinOf&& bin_of, PointArrays in, SampleArrays out, uint32_t
     }
 }
 
+// The bins of the picking batch forms: lane i's, by its lobe axis and choice.
+struct PickedBins {
+    const BinnedEnvMapView& env;
+    uint32_t lobe;
+    LobeAxisArrays axes;
+    const float* choices;
+    BinView operator()(uint32_t i) const noexcept {
+        return env.bin({{axes.x[i], axes.y[i], axes.z[i]}, axes.view_cos[i]}, lobe, choices[i]);
+    }
+};
+
 }  // namespace
 
 void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes, const float* choices,
                  DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
-    lookup_pipelined(
-        [&](uint32_t i) noexcept {
-            return env.bin({{axes.x[i], axes.y[i], axes.z[i]}, axes.view_cos[i]}, lobe, choices[i]);
-        },
-        in, out, n);
+    lookup_pipelined(PickedBins{env, lobe, axes, choices}, in, out, n);
 }
 
 void lookup_many(const BinView* bins, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
@@ -527,11 +533,7 @@ void lookup_many(const BinView* bins, DirectionArrays in, LookupArrays out, uint
 
 void sample_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes, const float* choices, PointArrays in,
                  SampleArrays out, uint32_t n) noexcept {
-    sample_pipelined(
-        [&](uint32_t i) noexcept {
-            return env.bin({{axes.x[i], axes.y[i], axes.z[i]}, axes.view_cos[i]}, lobe, choices[i]);
-        },
-        in, out, n);
+    sample_pipelined(PickedBins{env, lobe, axes, choices}, in, out, n);
 }
 
 void sample_many(const BinView* bins, PointArrays in, SampleArrays out, uint32_t n) noexcept {

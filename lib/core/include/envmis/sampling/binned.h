@@ -480,6 +480,10 @@ struct BinnedEnvMapView {
         const size_t at = size_t{y0} * plain.distribution.w + size_t{rows} * x0;
         return {texel_start + at, texel_guide + at, (column_edges[cx + 1] - x0) * rows};
     }
+    // Index of texel (x, y) in its cell (cx, cy)'s texel CDF (row-major in the cell).
+    ENVMIS_HD uint32_t texel_in_cell(uint32_t x, uint32_t y, uint32_t cx, uint32_t cy) const noexcept {
+        return (y - row_edges[cy]) * (column_edges[cx + 1] - column_edges[cx]) + x - column_edges[cx];
+    }
     // Image-space density of a texel under a bin, from the fixed-point widths of its cell
     // in the bin's CDF and of the texel in its cell's CDF; one expression for sample and
     // pdf. Products of widths, no quotient: a black cell's texels get 0, never 0 / 0.
@@ -619,8 +623,8 @@ ENVMIS_HD inline float BinView::pdf_uv(Vec2 uv) const noexcept {
     const BinnedEnvMapView& m = *map;
     const uint32_t x = detail::cell_of(uv.x, m.plain.distribution.w), y = detail::cell_of(uv.y, m.plain.distribution.h);
     const uint32_t cx = m.cell_column(x), cy = m.cell_row(y);
-    const uint32_t k = (y - m.row_edges[cy]) * (m.column_edges[cx + 1] - m.column_edges[cx]) + x - m.column_edges[cx];
-    const float image_pdf = m.texel_pdf(cells.width(cy * m.cells_w + cx), m.cell_texels(cx, cy).width(k));
+    const float image_pdf =
+        m.texel_pdf(cells.width(cy * m.cells_w + cx), m.cell_texels(cx, cy).width(m.texel_in_cell(x, y, cx, cy)));
     return m.plain.image_to_solid_angle(image_pdf, uv.y);
 }
 
