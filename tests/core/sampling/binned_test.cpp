@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -269,52 +270,81 @@ TEST(Binned, TablesMixingPlainAndCompensatedBinsFollowTheirPdf) {
     }
 }
 
-void expect_batch_bit_identical(const BinnedEnvMapView& view) {
-    constexpr uint32_t n = 257;
+uint32_t bits(float f) { return bit_cast<uint32_t>(f); }
+
+// Random points of [0,1)^2 and, first, points at its ends, outside it (which every path
+// clamps) and finer than a CDF's unit near 0.
+std::vector<Vec2> batch_points(uint32_t n, uint64_t seed) {
+    const float edges[] = {0.0f,
+                           0x1p-24f,
+                           0.5f,
+                           1 - 0x1p-24f,
+                           kOneMinusEpsilon,
+                           1.0f,
+                           -0.5f,
+                           2.0f,
+                           std::numeric_limits<float>::quiet_NaN()};
+    std::vector<Vec2> points;
+    for (const float a : edges)
+        for (const float b : edges) points.push_back({a, b});
+    Rng rng(seed);
+    for (int i = 0; i < 40; ++i) {
+        const Vec2 u = rng.uniform2();
+        points.push_back({u.x * 0x1p-9f, u.y * 0x1p-9f});
+    }
+    while (points.size() < n) points.push_back(rng.uniform2());
+    return points;
+}
+
+// The batch forms over n lanes against single calls, every output's bits: the picking
+// forms (lobe class 1, view cosines in [0,1), so that some glossy bins pass their view
+// limits) and the forms over bins picked beforehand.
+void expect_batch_bit_identical(const BinnedEnvMapView& view, uint32_t n = 1003) {
     Rng rng(4);
-    float nx[n], ny[n], nz[n], vc[n], c[n], ux[n], uy[n], dx[n], dy[n], dz[n];
+    const std::vector<Vec2> points = batch_points(n, 5);
+    std::vector<float> nx(n), ny(n), nz(n), vc(n), c(n), ux(n), uy(n), dx(n), dy(n), dz(n);
+    std::vector<BinView> bins;
     for (uint32_t i = 0; i < n; ++i) {
         const Vec3 normal = octahedral_normal(rng.uniform(), rng.uniform());
-        nx[i] = normal.x, ny[i] = normal.y, nz[i] = normal.z, ux[i] = rng.uniform(), uy[i] = rng.uniform();
+        nx[i] = normal.x, ny[i] = normal.y, nz[i] = normal.z, ux[i] = points[i].x, uy[i] = points[i].y;
         c[i] = rng.uniform(), vc[i] = rng.uniform();
-        const Vec3 d = equirect_direction(rng.uniform2());
+        bins.push_back(view.bin({normal, vc[i]}, 1, c[i]));
+        // Directions the bin itself samples (its lit cells, its seam) and uniform ones.
+        const Vec3 d = i % 2 ? bins.back().sample(rng.uniform2()).direction : equirect_direction(rng.uniform2());
         dx[i] = d.x, dy[i] = d.y, dz[i] = d.z;
     }
-    float x[n], y[n], z[n], pdf[n], r[n], g[n], b[n], u[n], v[n];
-    sample_many(view, 1, {nx, ny, nz, vc}, c, {ux, uy}, {x, y, z, pdf, r, g, b, u, v}, n);
-    for (uint32_t i = 0; i < n; ++i) {
-        const EnvSample s = view.sample({{nx[i], ny[i], nz[i]}, vc[i]}, 1, c[i], {ux[i], uy[i]});
-        ASSERT_EQ(s.direction.x, x[i]);
-        ASSERT_EQ(s.direction.z, z[i]);
-        ASSERT_EQ(s.pdf, pdf[i]);
-        ASSERT_EQ(s.radiance.g, g[i]);
-        ASSERT_EQ(s.uv.x, u[i]);
-        ASSERT_EQ(s.uv.y, v[i]);
-    }
-    lookup_many(view, 1, {nx, ny, nz, vc}, c, {dx, dy, dz}, {r, g, b, pdf}, n);
-    for (uint32_t i = 0; i < n; ++i) {
-        const EnvMapView::Lookup l = view.lookup({{nx[i], ny[i], nz[i]}, vc[i]}, 1, c[i], {dx[i], dy[i], dz[i]});
-        ASSERT_EQ(l.pdf, pdf[i]);
-        ASSERT_EQ(l.radiance.b, b[i]);
-    }
-    // The same over bins picked beforehand.
-    std::vector<BinView> bins;
-    for (uint32_t i = 0; i < n; ++i) bins.push_back(view.bin({{nx[i], ny[i], nz[i]}, vc[i]}, 1, c[i]));
-    sample_many(bins.data(), {ux, uy}, {x, y, z, pdf, r, g, b, u, v}, n);
-    for (uint32_t i = 0; i < n; ++i) {
-        const EnvSample s = bins[i].sample({ux[i], uy[i]});
-        ASSERT_EQ(s.direction.y, y[i]);
-        ASSERT_EQ(s.pdf, pdf[i]);
-        ASSERT_EQ(s.radiance.r, r[i]);
-        ASSERT_EQ(s.uv.x, u[i]);
-        ASSERT_EQ(s.uv.y, v[i]);
-    }
-    lookup_many(bins.data(), {dx, dy, dz}, {r, g, b, pdf}, n);
-    for (uint32_t i = 0; i < n; ++i) {
-        const EnvMapView::Lookup l = bins[i].lookup({dx[i], dy[i], dz[i]});
-        ASSERT_EQ(l.pdf, pdf[i]);
-        ASSERT_EQ(l.radiance.g, g[i]);
-    }
+    std::vector<float> x(n), y(n), z(n), pdf(n), r(n), g(n), b(n), u(n), v(n);
+    const SampleArrays samples{x.data(), y.data(), z.data(), pdf.data(), r.data(),
+                               g.data(), b.data(), u.data(), v.data()};
+    const LookupArrays lookups{r.data(), g.data(), b.data(), pdf.data()};
+    const auto expect_samples = [&](const char* form) {
+        for (uint32_t i = 0; i < n; ++i) {
+            const EnvSample e = bins[i].sample(points[i]);
+            const float expected[] = {e.direction.x, e.direction.y, e.direction.z, e.pdf, e.radiance.r,
+                                      e.radiance.g,  e.radiance.b,  e.uv.x,        e.uv.y};
+            const float got[] = {x[i], y[i], z[i], pdf[i], r[i], g[i], b[i], u[i], v[i]};
+            for (int k = 0; k < 9; ++k)
+                ASSERT_EQ(bits(got[k]), bits(expected[k])) << form << " lane " << i << " output " << k;
+        }
+    };
+    const auto expect_lookups = [&](const char* form) {
+        for (uint32_t i = 0; i < n; ++i) {
+            const EnvMapView::Lookup e = bins[i].lookup({dx[i], dy[i], dz[i]});
+            const float expected[] = {e.radiance.r, e.radiance.g, e.radiance.b, e.pdf};
+            const float got[] = {r[i], g[i], b[i], pdf[i]};
+            for (int k = 0; k < 4; ++k)
+                ASSERT_EQ(bits(got[k]), bits(expected[k])) << form << " lane " << i << " output " << k;
+        }
+    };
+    const LobeAxisArrays axes{nx.data(), ny.data(), nz.data(), vc.data()};
+    sample_many(view, 1, axes, c.data(), {ux.data(), uy.data()}, samples, n);
+    expect_samples("picking");
+    lookup_many(view, 1, axes, c.data(), {dx.data(), dy.data(), dz.data()}, lookups, n);
+    expect_lookups("picking");
+    sample_many(bins.data(), {ux.data(), uy.data()}, samples, n);
+    expect_samples("picked");
+    lookup_many(bins.data(), {dx.data(), dy.data(), dz.data()}, lookups, n);
+    expect_lookups("picked");
 }
 
 TEST(Binned, BatchCallsAreBitIdenticalToSingleCalls) {
@@ -322,6 +352,77 @@ TEST(Binned, BatchCallsAreBitIdenticalToSingleCalls) {
     for (float cost : {1.0f, 1.5f}) {  // compensated bins; plain and compensated ones mixed
         const BinnedEnvMap map = build_bins(plain_map(test::sun_sky_map(64, 32)), costing(cost));
         expect_batch_bit_identical(map.view());
+    }
+}
+
+// The AVX2 paths search each lane's own tables and place points with the map's sizes:
+// sizes that are no powers of two, the equal-area mapping, another frame, black cells
+// beside lit ones, and cells of one or two texels (the smallest the SIMD search takes).
+TEST(Binned, BatchCallsAreBitIdenticalOnMapsOfEveryShape) {
+    ENVMIS_SKIP_IF_FORCED_PATH_UNAVAILABLE();
+    EnvMapOptions y_up;
+    y_up.compensation.enabled = false;
+    y_up.axes = Axes::parse("x,z,-y");
+    BinnedOptions cells_of_one, cells_of_two;
+    cells_of_one.cell_columns = 16;  // 16 x 8 cells over 16 x 8 texels
+    cells_of_two.cell_columns = 16;  // over 32 x 8
+    const BinnedEnvMap maps[] = {
+        build_bins(plain_map(test::random_map(100, 50, 3))),
+        build_bins(plain_map(test::random_map(37, 37, 8), Mapping::equal_area)),
+        build_bins(build_env_map(test::sun_sky_map(96, 48), y_up)),
+        build_bins(plain_map(test::sparse_map(64, 32, 6, 0.02f))),
+        build_bins(plain_map(test::single_texel_map(64, 32, 10, 3))),
+        build_bins(plain_map(test::random_map(16, 8, 4)), cells_of_one),
+        build_bins(plain_map(test::random_map(32, 8, 5)), cells_of_two),
+    };
+    for (const BinnedEnvMap& map : maps) {
+        SCOPED_TRACE(std::to_string(map.radiance_map().width()) + "x" + std::to_string(map.radiance_map().height()));
+        expect_batch_bit_identical(map.view());
+    }
+}
+
+// The pipelines' and the SIMD groups' start and end: every length up to 70 lanes.
+TEST(Binned, BatchCallsOfEveryLengthAreBitIdentical) {
+    ENVMIS_SKIP_IF_FORCED_PATH_UNAVAILABLE();
+    const BinnedEnvMap map = build_bins(plain_map(test::sun_sky_map(64, 32)));
+    for (uint32_t n = 0; n <= 70; ++n) {
+        SCOPED_TRACE(n);
+        expect_batch_bit_identical(map.view(), n);
+    }
+}
+
+// Bins of two maps in one call: each lane in its own map's tables.
+TEST(Binned, BatchCallsOverBinsOfTwoMapsAreBitIdentical) {
+    ENVMIS_SKIP_IF_FORCED_PATH_UNAVAILABLE();
+    const BinnedEnvMap a = build_bins(plain_map(test::sun_sky_map(64, 32))),
+                       b = build_bins(plain_map(test::random_map(48, 24, 7)));
+    const BinnedEnvMapView va = a.view(), vb = b.view();
+    constexpr uint32_t n = 100;
+    const std::vector<Vec2> points = batch_points(n, 8);
+    Rng rng(9);
+    std::vector<BinView> bins;
+    std::vector<float> ux, uy, dx, dy, dz;
+    for (uint32_t i = 0; i < n; ++i) {
+        const Vec3 normal = octahedral_normal(rng.uniform(), rng.uniform());
+        bins.push_back((i / 20) % 2 ? vb.bin({normal}, 0, rng.uniform()) : va.bin({normal}, 0, rng.uniform()));
+        ux.push_back(points[i].x), uy.push_back(points[i].y);
+        const Vec3 d = equirect_direction(rng.uniform2());
+        dx.push_back(d.x), dy.push_back(d.y), dz.push_back(d.z);
+    }
+    std::vector<float> x(n), y(n), z(n), pdf(n), r(n), g(n), bl(n);
+    sample_many(bins.data(), {ux.data(), uy.data()},
+                {x.data(), y.data(), z.data(), pdf.data(), r.data(), g.data(), bl.data()}, n);
+    for (uint32_t i = 0; i < n; ++i) {
+        const EnvSample e = bins[i].sample(points[i]);
+        ASSERT_EQ(bits(x[i]), bits(e.direction.x)) << i;
+        ASSERT_EQ(bits(pdf[i]), bits(e.pdf)) << i;
+        ASSERT_EQ(bits(g[i]), bits(e.radiance.g)) << i;
+    }
+    lookup_many(bins.data(), {dx.data(), dy.data(), dz.data()}, {r.data(), g.data(), bl.data(), pdf.data()}, n);
+    for (uint32_t i = 0; i < n; ++i) {
+        const EnvMapView::Lookup e = bins[i].lookup({dx[i], dy[i], dz[i]});
+        ASSERT_EQ(bits(pdf[i]), bits(e.pdf)) << i;
+        ASSERT_EQ(bits(bl[i]), bits(e.radiance.b)) << i;
     }
 }
 

@@ -15,7 +15,6 @@
 
 #include "detail/luminance.h"
 #include "detail/parallel.h"
-#include "detail/pipeline.h"
 
 namespace envmis {
 
@@ -427,117 +426,6 @@ size_t BinnedEnvMap::bytes() const noexcept {
     // Never below 0: a coarse grid over a map large enough for a coarse guide may save
     // more than it adds.
     return tables - std::min(tables, plain_density_bytes_);
-}
-
-namespace {
-
-// A direction of lookup_many located: its bin, its image point, and prefetches of all
-// that BinView::pdf_uv and eval_uv read there but the small edge tables.
-struct Located {
-    BinView bin;
-    Vec2 uv;
-};
-
-Located locate(const BinView& bin, Vec3 direction) noexcept {
-    const BinnedEnvMapView& env = *bin.map;
-    const Located at{bin, env.plain.uv_of(direction)};
-    const Distribution2DView& d = env.plain.distribution;
-    const uint32_t x = detail::cell_of(at.uv.x, d.w), y = detail::cell_of(at.uv.y, d.h);
-    const uint32_t cx = env.cell_column(x), cy = env.cell_row(y);
-    const uint32_t k = env.texel_in_cell(x, y, cx, cy);
-    const CdfView texels = env.cell_texels(cx, cy);
-    env.plain.prefetch_radiance(static_cast<size_t>(y) * d.w + x, static_cast<size_t>(y) * d.w + x);
-    ENVMIS_PREFETCH(texels.start + k);
-    ENVMIS_PREFETCH(texels.start + k + 1);
-    ENVMIS_PREFETCH(bin.cells.start + cy * env.cells_w + cx);
-    ENVMIS_PREFETCH(bin.cells.start + cy * env.cells_w + cx + 1);
-    return at;
-}
-
-// lookup_many over the bins bin_of(i) gives, software-pipelined (detail/pipeline.h) as
-// EnvMap's lookup_many: each direction located and its data prefetched 32 directions
-// before its pdf is computed from them, so that the misses of 32 directions are in
-// flight at once. Bit-identical to BinView::lookup, whose functions it calls.
-template <class BinOf>
-void lookup_pipelined(BinOf&& bin_of, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
-    detail::pipelined<32>(
-        0, n,
-        [&](uint32_t i) noexcept {
-            return locate(bin_of(i), {in.x[i], in.y[i], in.z[i]});
-        },
-        [&](const Located& l, uint32_t i) noexcept {
-            const Rgb c = l.bin.map->plain.eval_uv(l.uv);
-            out.r[i] = c.r, out.g[i] = c.g, out.b[i] = c.b, out.pdf[i] = l.bin.pdf_uv(l.uv);
-        });
-}
-
-// sample_many over the bins bin_of(i) gives, software-pipelined: a block of samples goes
-// through each stage of BinView::sample in turn (bin and a prefetch of its CDF at u.x's
-// guide bucket; cell; the texel CDF's guide span; texel; radiance), each stage
-// prefetching what the next loads, so that the misses of a block's samples overlap
-// instead of each sample waiting on its chain of dependent loads. The stages are the
-// single call's own functions, so the results are bit-identical to it.
-template <class BinOf>
-void sample_pipelined(BinOf&& bin_of, PointArrays in, SampleArrays out, uint32_t n) noexcept {
-    constexpr uint32_t kBlock = 16;
-    BinView bins[kBlock];
-    BinView::Cell cells[kBlock];
-    BinView::Texel texels[kBlock];
-    for (uint32_t first = 0; first < n; first += kBlock) {
-        const uint32_t m = std::min(kBlock, n - first);
-        for (uint32_t j = 0; j < m; ++j) {
-            bins[j] = bin_of(first + j);
-            const CdfView& c = bins[j].cells;
-            const uint32_t k = c.bucket(in.x[first + j]);
-            ENVMIS_PREFETCH(c.guide + k);
-            ENVMIS_PREFETCH(c.start + k);
-        }
-        for (uint32_t j = 0; j < m; ++j) {
-            cells[j] = bins[j].find_cell(in.x[first + j]);
-            prefetch_texels(*bins[j].map, cells[j], in.y[first + j]);
-        }
-        for (uint32_t j = 0; j < m; ++j) prefetch_texel_span(*bins[j].map, cells[j], in.y[first + j]);
-        for (uint32_t j = 0; j < m; ++j) texels[j] = bins[j].find_texel(cells[j], in.y[first + j]);
-        for (uint32_t j = 0; j < m; ++j) {
-            const uint32_t i = first + j;
-            const EnvSample s = bins[j].sample_at(cells[j], texels[j]);
-            out.x[i] = s.direction.x, out.y[i] = s.direction.y, out.z[i] = s.direction.z, out.pdf[i] = s.pdf;
-            out.r[i] = s.radiance.r, out.g[i] = s.radiance.g, out.b[i] = s.radiance.b;
-            if (out.u) out.u[i] = s.uv.x;
-            if (out.v) out.v[i] = s.uv.y;
-        }
-    }
-}
-
-// The bins of the picking batch forms: lane i's, by its lobe axis and choice.
-struct PickedBins {
-    const BinnedEnvMapView& env;
-    uint32_t lobe;
-    LobeAxisArrays axes;
-    const float* choices;
-    BinView operator()(uint32_t i) const noexcept {
-        return env.bin({{axes.x[i], axes.y[i], axes.z[i]}, axes.view_cos[i]}, lobe, choices[i]);
-    }
-};
-
-}  // namespace
-
-void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes, const float* choices,
-                 DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
-    lookup_pipelined(PickedBins{env, lobe, axes, choices}, in, out, n);
-}
-
-void lookup_many(const BinView* bins, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
-    lookup_pipelined([&](uint32_t i) noexcept { return bins[i]; }, in, out, n);
-}
-
-void sample_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes, const float* choices, PointArrays in,
-                 SampleArrays out, uint32_t n) noexcept {
-    sample_pipelined(PickedBins{env, lobe, axes, choices}, in, out, n);
-}
-
-void sample_many(const BinView* bins, PointArrays in, SampleArrays out, uint32_t n) noexcept {
-    sample_pipelined([&](uint32_t i) noexcept { return bins[i]; }, in, out, n);
 }
 
 }  // namespace envmis

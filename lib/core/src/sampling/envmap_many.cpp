@@ -6,8 +6,8 @@
 //
 // The AVX2 paths (eight lanes at a time, hardware gathers) map, turn angles and convert
 // densities with the single calls' own functions, instantiated on eight lanes
-// (detail/simd.h). What they write apart is the CDF search by gathers (span8, unit8,
-// search8: CdfView::width and invert, Distribution2DView::pdf_of) and the placement
+// (detail/simd.h). What they write apart is the CDF search by gathers (detail/cdf8.h:
+// CdfView::width and invert; Distribution2DView::pdf_of here) and the placement
 // (detail/cell8.h): the same IEEE operations in the same order as the scalar code, so
 // every lane's result is bit-identical to the scalar call (tests/core/sampling/
 // envmap_test.cpp checks it on maps of several sizes, in both mappings and several axes,
@@ -16,6 +16,7 @@
 
 #include <algorithm>
 
+#include "detail/cdf8.h"
 #include "detail/cell8.h"
 #include "detail/pipeline.h"
 #include "detail/simd.h"
@@ -92,48 +93,10 @@ bool avx2_applies(const EnvMapView& env) noexcept {
     return uint64_t{env.distribution.w} * env.distribution.h * 3 < (uint64_t{1} << 31);
 }
 
-// Cell i of the CDF at `start`, n cells: its first unit and CdfView::width, the next
-// start (kCdfUnits after the last cell) minus this one; for n >= 2 one pair gather at
-// j = min(i, n - 2), which stays inside the table (the last cell's start is then the
-// pair's second value).
-struct Span8 {
-    I8 start, width;
-};
-ENVMIS_AVX2 Span8 span8(const uint32_t* start, I8 base, I8 i, uint32_t n) noexcept {
-    I8 first, end = kCdfUnits;
-    if (n == 1) {  // i = 0
-        first = gather(start, base);
-    } else {
-        const I8 j = _mm256_min_epu32(i, I8(n - 2));
-        const Pair8 p = gather_pairs(start, base + j);
-        const M8 inside = i == j;  // not the last cell
-        first = select(inside, p.first, p.second);
-        end = select(inside, p.second, end);
-    }
-    return {first, end - first};
-}
-
-// Widths to float, as static_cast<float>(uint32_t): a width is at most 2^31, which as a
-// signed 32-bit value is -2^31 and converts exactly; adding 2^32 then gives 2^31.
-ENVMIS_AVX2 F8 width_to_float(I8 w) noexcept {
-    const F8 f = to_float(w);
-    return f + select(f < 0.0f, 0x1p32f, 0.0f);
-}
-
 // Distribution2DView::pdf_of: a cell's image-space density from its row's and its own
 // widths.
 ENVMIS_AVX2 F8 image_pdf8(const Distribution2DView& d, I8 row_width, I8 cell_width) noexcept {
     return width_to_float(row_width) * width_to_float(cell_width) * d.pdf_scale;
-}
-
-// The radiance of eight texels (row-major indices), stored from lane l on.
-ENVMIS_AVX2 void store_radiance8(const Rgb* radiance, I8 texel, float* r, float* g, float* b, uint32_t l) noexcept {
-    const I8 three = texel + texel + texel;
-    const float* rgb = &radiance->r;
-    const Pair8 rg = gather_pairs(rgb, three);
-    store(r + l, from_bits(rg.first));
-    store(g + l, from_bits(rg.second));
-    store(b + l, _mm256_i32gather_ps(rgb + 2, three, 4));
 }
 
 // Where eight directions fall: their cells, the first texel of their rows (y w) and
@@ -150,13 +113,10 @@ struct Cells8 {
 // groups of eight had a lane whose line nobody had asked for (measured:
 // docs/performance-log.md, 'locate8').
 ENVMIS_AVX2_FLAT Cells8 locate8(const EnvMapView& env, DirectionArrays in, uint32_t l) noexcept {
-    const Vec3x8 d = to_canonical<F8>(env.axes, {load(in.x + l), load(in.y + l), load(in.z + l)});
-    const Vec2x8 p = env.mapping == Mapping::equal_area ? equal_area_uv<F8>(d) : equirect_uv<F8>(d);
+    const Vec2x8 p = uv8(env, in, l);
     const I8 x = cell8(p.x, env.distribution.w), y = cell8(p.y, env.distribution.h);
-    alignas(32) uint32_t column[8], row[8];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(column), x);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(row), y);
-    for (int lane = 0; lane < 8; ++lane) env.prefetch_cell(column[lane], row[lane]);
+    const Lanes8 column(x), row(y);
+    for (int lane = 0; lane < 8; ++lane) env.prefetch_cell(column.at[lane], row.at[lane]);
     return {x, y, y * I8(env.distribution.w), p.y};
 }
 
@@ -168,76 +128,10 @@ ENVMIS_AVX2_FLAT void fetch8(const EnvMapView& env, const Cells8& c, LookupArray
     store(out.pdf + l, env.image_to_solid_angle(image_pdf8(d, row_width, span8(d.start, c.row, c.x, d.w).width), c.v));
 }
 
-// Lanes [0, n - n % 8) in groups of eight, up to four groups at a time: start(first)
-// for each of them (it finds what its group will read, prefetches it and returns where
-// it is), then finish(started, first) for each, so that the cache misses of all four
-// overlap. Without the staging, three quarters of lookup_avx2's time went waiting on
-// its first radiance gather. Returns n - n % 8.
-template <class Start, class Finish>
-ENVMIS_AVX2 uint32_t in_staged_groups(uint32_t n, Start&& start, Finish&& finish) noexcept {
-    constexpr uint32_t kGroups = 4;
-    const uint32_t whole = n - n % 8;
-    for (uint32_t first = 0; first < whole; first += 8 * kGroups) {
-        const uint32_t groups = std::min(kGroups, (whole - first) / 8);
-        decltype(start(first)) started[kGroups];
-        for (uint32_t k = 0; k < groups; ++k) started[k] = start(first + 8 * k);
-        for (uint32_t k = 0; k < groups; ++k) finish(started[k], first + 8 * k);
-    }
-    return whole;
-}
-
 ENVMIS_AVX2 uint32_t lookup_avx2(const EnvMapView& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
     return in_staged_groups(
         n, [&](uint32_t first) ENVMIS_AVX2 { return locate8(env, in, first); },
         [&](const Cells8& cells, uint32_t first) ENVMIS_AVX2 { fetch8(env, cells, out, first); });
-}
-
-// Eight units u of CdfView::invert over n cells: u in CDF units (x), its integer part t
-// and its guide bucket k = t n / 2^31 (from 64-bit products of the even and odd lanes).
-struct Unit8 {
-    F8 x;
-    I8 t, k;
-};
-ENVMIS_AVX2 Unit8 unit8(F8 u, uint32_t n) noexcept {
-    // unit_point, in CDF units; x < 2^31, so truncate's signed conversion is exact.
-    const F8 x = select(u > 0.0f, min(u, kOneMinusEpsilon), 0.0f) * static_cast<float>(kCdfUnits);
-    const I8 t = truncate(x);
-    const I8 nn(n);
-    const I8 even = _mm256_srli_epi64(_mm256_mul_epu32(t, nn), 31);
-    const I8 odd = _mm256_slli_epi64(_mm256_srli_epi64(_mm256_mul_epu32(_mm256_srli_epi64(t, 32), nn), 31), 32);
-    return {x, t, _mm256_min_epu32(_mm256_blend_epi32(even, odd, 0xAA), I8(n - 1))};
-}
-
-// The rest of CdfView::invert for eight units, lane i searching the CDF of n >= 2 cells
-// at start + base_i (guide likewise): the cell index and the offset in it.
-struct Hit8 {
-    I8 index;
-    F8 offset;
-    I8 width;  // of the cell
-};
-ENVMIS_AVX2 Hit8 search8(const uint32_t* start, const uint16_t* guide, I8 base, uint32_t n,
-                         const Unit8& unit) noexcept {
-    const I8 t = unit.t, k = unit.k;
-    // guide[k] and guide[k + 1] (or n - 1 after the last bucket) from one 32-bit gather of
-    // the pair at j = min(k, n - 2), which stays inside the guide's n entries.
-    const I8 j = _mm256_min_epu32(k, I8(n - 2));
-    const I8 pair = _mm256_i32gather_epi32(reinterpret_cast<const int*>(guide), base + j, 2);
-    const M8 inside = k == j;
-    I8 lo = select(inside, pair & 0xffffu, pair >> 16), hi = select(inside, pair >> 16, I8(n - 1));
-    // The scalar search, all lanes in step: a lane whose lo = hi keeps them (mid = lo,
-    // whose start is <= t), so the loop runs until the longest search ends.
-    for (;;) {
-        const I8 open = _mm256_cmpgt_epi32(hi, lo);
-        if (_mm256_testz_si256(open, open)) break;
-        const I8 mid = (lo + hi + 1u) >> 1;
-        const M8 at_most_t = I8(_mm256_max_epu32(gather(start, base + mid), t)) == t;  // unsigned start <= t
-        lo = select(at_most_t, mid, lo);
-        hi = select(at_most_t, hi, mid - 1u);
-    }
-    const Span8 cell = span8(start, base, lo, n);
-    const F8 offset =
-        (to_float(t - cell.start) + (unit.x - to_float(t))) / width_to_float(cell.width);  // t - start < 2^31
-    return {lo, min(offset, kOneMinusEpsilon), cell.width};
 }
 
 // Eight points of EnvMapView::sample with their rows found (the marginal is small and
@@ -255,29 +149,13 @@ ENVMIS_AVX2 Rows8 rows8(const EnvMapView& env, PointArrays in, uint32_t l, uint3
     const Distribution2DView& d = env.distribution;
     const Hit8 r = search8(d.marginal.start, d.marginal.guide, I8(0u), d.h, unit8(load(in.y + l), d.h));
     const Rows8 rows{r, r.index * I8(d.w), unit8(load(in.x + l), d.w)};
-    alignas(32) uint32_t y[8], t[8];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(y), r.index);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(t), rows.column.t);
+    const Lanes8 y(r.index), t(rows.column.t);
     const M8 cold = I8(_mm256_min_epu32(r.width, I8(hot_units))) == r.width;  // unsigned width <= hot_units
     for (auto m = static_cast<uint32_t>(_mm256_movemask_ps(cold.v)); m != 0; m &= m - 1) {
         const int lane = __builtin_ctz(m);
-        prefetch_column(env, y[lane], t[lane]);
+        prefetch_column(env, y.at[lane], t.at[lane]);
     }
     return rows;
-}
-
-// EnvMapView::at for eight image points with their image-space density: the direction
-// and its solid-angle pdf.
-struct Direction8 {
-    Vec3x8 d;
-    F8 pdf;
-};
-ENVMIS_AVX2_FLAT Direction8 at8(const EnvMapView& env, Vec2x8 p, F8 image_pdf) noexcept {
-    if (env.mapping == Mapping::equal_area)
-        return {to_world<F8>(env.axes, equal_area_direction<F8>(p)), image_pdf * (1 / kFourPi)};
-    const SinCos8 theta = sincos_half_turns(env.turns, p.y), phi = sincos_turns(env.turns, p.x);
-    const Vec3x8 canonical{theta.sin * phi.cos, theta.sin * phi.sin, theta.cos};
-    return {to_world<F8>(env.axes, canonical), EnvMapView::solid_angle_pdf(image_pdf, theta.sin)};
 }
 
 // EnvMapView::sample for the eight points from lane l on, their rows found.
@@ -286,14 +164,7 @@ ENVMIS_AVX2 void sample8(const EnvMapView& env, const Rows8& rows, SampleArrays 
     const Hit8& r = rows.r;
     const Hit8 c = search8(d.start, d.guide, rows.row, d.w, rows.column);
     const Vec2x8 p{point_in_cell8(c.index, c.offset, d.w), point_in_cell8(r.index, r.offset, d.h)};
-    const Direction8 e = at8(env, p, image_pdf8(d, r.width, c.width));
-    if (out.u) store(out.u + l, p.x);
-    if (out.v) store(out.v + l, p.y);
-    store(out.x + l, e.d.x);
-    store(out.y + l, e.d.y);
-    store(out.z + l, e.d.z);
-    store(out.pdf + l, e.pdf);
-    store_radiance8(env.radiance, rows.row + c.index, out.r, out.g, out.b, l);
+    store_sample8(env, p, at8(env, p, image_pdf8(d, r.width, c.width)), rows.row + c.index, out, l);
 }
 
 // Rows found and columns' data prefetched for up to four groups before the first
