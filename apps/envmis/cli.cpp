@@ -134,8 +134,8 @@ CLI::Option* add_bin_cost_flag(CLI::App& app, float& cost) {
         .add_option("--bin-cost", cost,
                     "With --bins: time of an estimate with a compensated bin over one with the plain density; a "
                     "bin keeps compensation only where it is predicted that much lower in variance (equal time). "
-                    "The default is a renderer's whose rays cost little; the variance study's is about 2-3, 1 "
-                    "chooses at equal samples")
+                    "Both cost about the same; the default is a margin for the choice's errors, 1 chooses at "
+                    "equal samples")
         ->type_name("R")
         ->capture_default_str()
         ->check(CLI::Validator(

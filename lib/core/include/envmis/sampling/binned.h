@@ -288,11 +288,11 @@ struct BinnedOptions {
     // Time of an estimate that samples a compensated bin over one that samples the plain
     // density (whole time per estimate; 1 to 100): auto mode keeps a candidate only where
     // its predicted variance is lower than the plain density's by more than this factor,
-    // so that each bin holds what is predicted best at equal time. The default is that of
-    // a renderer whose rays cost little (the example renderer's); the variance study's
-    // estimates, which do nothing but sample and shade, cost much more with bins
-    // (measured: docs/performance-log.md, 'BinnedOptions::cost'); 1 chooses at equal
-    // samples.
+    // so that each bin holds what is predicted best at equal time. A compensated bin and
+    // a plain one sample through the same tables and kernels, at about the same time; the
+    // default is a margin for the choice's errors: below it, bins whose predicted gain is
+    // small lose to the plain density at some points (measured: docs/performance-log.md,
+    // 'BinnedOptions::cost'); 1 chooses at equal samples.
     float cost = 1.2f;
 };
 
@@ -495,13 +495,17 @@ struct BinnedEnvMapView {
 
 // Both for n (axis, choice, direction or point) at once, one array per world coordinate:
 // the batch forms of BinnedEnvMapView::lookup and sample, bit-identical to n single
-// calls. Host only; noexcept and allocation-free.
+// calls. Host only; noexcept and allocation-free. On the path envmis/cpu.h chose for
+// EnvMap's batch forms: AVX2 searches each lane's bin and cell by gathers, eight lanes at
+// a time, where the map fits 32-bit gather indices and its cells hold two texels or more
+// (any map of the default grid); the scalar pipeline elsewhere.
 ENVMIS_CORE_API void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes, const float* choices,
                                  DirectionArrays in, LookupArrays out, uint32_t n) noexcept;
 ENVMIS_CORE_API void sample_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes, const float* choices,
                                  PointArrays in, SampleArrays out, uint32_t n) noexcept;
 // The same for n directions or points each in its own bin, picked beforehand (a renderer's
-// or a study's shading points, each with the bin it keeps for its samples).
+// or a study's shading points, each with the bin it keeps for its samples). Bins of
+// several maps may share a call; a run of lanes on the first lane's map takes AVX2.
 ENVMIS_CORE_API void lookup_many(const BinView* bins, DirectionArrays in, LookupArrays out, uint32_t n) noexcept;
 ENVMIS_CORE_API void sample_many(const BinView* bins, PointArrays in, SampleArrays out, uint32_t n) noexcept;
 
