@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -309,8 +310,14 @@ void expect_batch_bit_identical(const BinnedEnvMapView& view, uint32_t n = 1003)
         nx[i] = normal.x, ny[i] = normal.y, nz[i] = normal.z, ux[i] = points[i].x, uy[i] = points[i].y;
         c[i] = rng.uniform(), vc[i] = rng.uniform();
         bins.push_back(view.bin({normal, vc[i]}, 1, c[i]));
-        // Directions the bin itself samples (its lit cells, its seam) and uniform ones.
-        const Vec3 d = i % 2 ? bins.back().sample(rng.uniform2()).direction : equirect_direction(rng.uniform2());
+        // Directions off the sphere, the axes and poles; then ones the bin itself samples (its
+        // lit cells, its seam) and uniform ones.
+        const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+        const Vec3 special[] = {{nan, 0, 1}, {inf, 0, 0}, {-inf, inf, 0}, {0, 0, 0},  {0, 0, 1},     {0, 0, -1},
+                                {1, 0, 0},   {-1, 0, 0},  {0, 1, 0},      {0, -1, 0}, {1, -0.0f, 0}, {0.6f, -0.8f, 0}};
+        const Vec3 d = i < std::size(special) ? special[i]
+                       : i % 2                ? bins.back().sample(rng.uniform2()).direction
+                                              : equirect_direction(rng.uniform2());
         dx[i] = d.x, dy[i] = d.y, dz[i] = d.z;
     }
     std::vector<float> x(n), y(n), z(n), pdf(n), r(n), g(n), b(n), u(n), v(n);
@@ -356,18 +363,24 @@ TEST(Binned, BatchCallsAreBitIdenticalToSingleCalls) {
 }
 
 // The AVX2 paths search each lane's own tables and place points with the map's sizes:
-// sizes that are no powers of two, the equal-area mapping, another frame, black cells
-// beside lit ones, and cells of one or two texels (the smallest the SIMD search takes).
+// sizes that are no powers of two, cells of uneven widths (ExactDivisions of several
+// shifts) and heights, the equal-area mapping, another frame, black cells beside lit
+// ones, and cells of one or two texels (the smallest the SIMD search takes); maps under
+// 64 texels wide have one cell on the default grid, which the scalar path takes.
 TEST(Binned, BatchCallsAreBitIdenticalOnMapsOfEveryShape) {
     ENVMIS_SKIP_IF_FORCED_PATH_UNAVAILABLE();
     EnvMapOptions y_up;
     y_up.compensation.enabled = false;
     y_up.axes = Axes::parse("x,z,-y");
-    BinnedOptions cells_of_one, cells_of_two;
+    BinnedOptions seven_columns, cells_of_one, cells_of_two;
+    seven_columns.cell_columns = 7;  // 7 x 3 cells over 100 x 50: widths 14 and 15, heights 16 and 17
     cells_of_one.cell_columns = 16;  // 16 x 8 cells over 16 x 8 texels
     cells_of_two.cell_columns = 16;  // over 32 x 8
     const BinnedEnvMap maps[] = {
         build_bins(plain_map(test::random_map(100, 50, 3))),
+        build_bins(plain_map(test::random_map(100, 50, 11)), seven_columns),
+        build_bins(plain_map(test::random_map(65, 33, 12))),  // columns 33 and 32 texels wide
+        build_bins(plain_map(test::random_map(128, 128, 13), Mapping::equal_area)),
         build_bins(plain_map(test::random_map(37, 37, 8), Mapping::equal_area)),
         build_bins(build_env_map(test::sun_sky_map(96, 48), y_up)),
         build_bins(plain_map(test::sparse_map(64, 32, 6, 0.02f))),
@@ -395,7 +408,7 @@ TEST(Binned, BatchCallsOfEveryLengthAreBitIdentical) {
 TEST(Binned, BatchCallsOverBinsOfTwoMapsAreBitIdentical) {
     ENVMIS_SKIP_IF_FORCED_PATH_UNAVAILABLE();
     const BinnedEnvMap a = build_bins(plain_map(test::sun_sky_map(64, 32))),
-                       b = build_bins(plain_map(test::random_map(48, 24, 7)));
+                       b = build_bins(plain_map(test::random_map(96, 48, 7)));
     const BinnedEnvMapView va = a.view(), vb = b.view();
     constexpr uint32_t n = 100;
     const std::vector<Vec2> points = batch_points(n, 8);

@@ -308,6 +308,9 @@ TEST(EnvMap, LookupManyIsBitIdenticalToLookup) {
     std::vector<Vec3> directions = {{0, 0, 1},      {0, 0, -1},       {1, 0, 0},        {-1, 0, 0},
                                     {0, 1, 0},      {0, -1, 0},       {1, -0.0f, 0},    {-1, -0.0f, 0},
                                     {1e-20f, 0, 1}, {0, -1e-20f, -1}, {0.6f, -0.8f, 0}, {0, 0, 0}};
+    const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+    for (const Vec3 off_sphere : {Vec3{nan, 0, 1}, Vec3{inf, 0, 0}, Vec3{-inf, inf, 0}, Vec3{0, nan, nan}})
+        directions.push_back(off_sphere);  // NaN image points: cell 0 on every path
     Rng rng(17);
     while (directions.size() < 1003) {  // not a multiple of the SIMD width
         const Vec2 u = rng.uniform2();

@@ -126,9 +126,9 @@ ENVMIS_AVX2 inline Hit8 search8(const uint32_t* start, const uint16_t* guide, I8
     return search8(start, guide, base, I8(n), unit);
 }
 
-// detail::ExactDivision::of for eight lanes, each with its own divisor's m and k (m <
-// 2^29 and k < 64 in the low halves of 64-bit entries): (n m) >> k from 64-bit products
-// of the even and odd lanes.
+// detail::ExactDivision::of for eight lanes, each with its own divisor's m < 2^29 and
+// k < 64 in its own 32-bit lane: (n m) >> k from 64-bit products of the even lanes and
+// of the odd ones (shifted down).
 ENVMIS_AVX2 inline I8 divide8(I8 n, I8 m, I8 k) noexcept {
     const __m256i low = _mm256_set1_epi64x(0xffffffff);
     const I8 even = _mm256_srlv_epi64(_mm256_mul_epu32(n, m), _mm256_and_si256(k, low));

@@ -11,9 +11,10 @@
 #ifdef ENVMIS_AVX2_BATCHES
 namespace envmis::simd {
 
-// detail::cell_of: the product in double, truncated, at most n - 1.
+// detail::cell_of: the product in double, truncated, at most n - 1; a NaN (from a NaN
+// direction) gets cell 0, as there.
 ENVMIS_AVX2 inline I8 cell8(F8 x, uint32_t n) noexcept {
-    const F8 c = clamp(x, 0.0f, 1.0f);
+    const F8 c = select(x > 0.0f, min(x, 1.0f), 0.0f);
     const __m256d dn = _mm256_set1_pd(static_cast<double>(n));
     const __m128i lo = _mm256_cvttpd_epi32(_mm256_mul_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(c)), dn));
     const __m128i hi = _mm256_cvttpd_epi32(_mm256_mul_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(c, 1)), dn));

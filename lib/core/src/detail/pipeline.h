@@ -1,4 +1,4 @@
-// Internal: the software pipeline of the scalar batch paths (envmap_many.cpp, binned.cpp).
+// Internal: the software pipeline of the scalar batch paths (envmap_many.cpp, binned_many.cpp).
 // A lane's first stage finds what it will read and prefetches it; its last stage runs a
 // fixed number of lanes later, so that that many lanes' cache misses are in flight at
 // once. The stages are the single calls' own functions, so the results stay
@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cstdint>
+
+#include "envmis/sampling/envmap.h"
 
 namespace envmis::detail {
 
@@ -23,6 +25,14 @@ void pipelined(uint32_t first, uint32_t n, Start&& start, Finish&& finish) noexc
         if (l + kDistance < n) started[slot] = start(l + kDistance);
         finish(s, l);
     }
+}
+
+// A sample's outputs in lane l (the image point's where asked for).
+inline void store_sample(SampleArrays out, uint32_t l, const EnvSample& e) noexcept {
+    out.x[l] = e.direction.x, out.y[l] = e.direction.y, out.z[l] = e.direction.z, out.pdf[l] = e.pdf;
+    out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b;
+    if (out.u) out.u[l] = e.uv.x;
+    if (out.v) out.v[l] = e.uv.y;
 }
 
 }  // namespace envmis::detail

@@ -44,9 +44,10 @@ Located locate(const BinView& bin, Vec3 direction) noexcept {
     return at;
 }
 
-// Lanes first..n, software-pipelined (detail/pipeline.h) as EnvMap's lookup_many: each direction located and its data
-// prefetched 32 directions before its pdf is computed from them, so that the misses of 32 directions are in flight at
-// once. Bit-identical to BinView::lookup, whose functions it calls.
+// Lanes first..n, software-pipelined (detail/pipeline.h) as EnvMap's lookup_many: each
+// direction located and its data prefetched 32 directions before its pdf is computed from
+// them, so that the misses of 32 directions are in flight at once. Bit-identical to
+// BinView::lookup, whose functions it calls.
 void lookup_scalar(const BinView* bins, DirectionArrays in, LookupArrays out, uint32_t first, uint32_t n) noexcept {
     detail::pipelined<32>(
         first, n,
@@ -84,14 +85,7 @@ void sample_scalar(const BinView* lanes, PointArrays in, SampleArrays out, uint3
         }
         for (uint32_t j = 0; j < m; ++j) prefetch_texel_span(*bins[j].map, cells[j], in.y[first + j]);
         for (uint32_t j = 0; j < m; ++j) texels[j] = bins[j].find_texel(cells[j], in.y[first + j]);
-        for (uint32_t j = 0; j < m; ++j) {
-            const uint32_t i = first + j;
-            const EnvSample s = bins[j].sample_at(cells[j], texels[j]);
-            out.x[i] = s.direction.x, out.y[i] = s.direction.y, out.z[i] = s.direction.z, out.pdf[i] = s.pdf;
-            out.r[i] = s.radiance.r, out.g[i] = s.radiance.g, out.b[i] = s.radiance.b;
-            if (out.u) out.u[i] = s.uv.x;
-            if (out.v) out.v[i] = s.uv.y;
-        }
+        for (uint32_t j = 0; j < m; ++j) detail::store_sample(out, first + j, bins[j].sample_at(cells[j], texels[j]));
     }
 }
 
@@ -284,22 +278,6 @@ struct PickedBins {
     }
 };
 
-// The arrays from lane k on.
-PointArrays from(PointArrays a, uint32_t k) noexcept { return {a.x + k, a.y + k}; }
-DirectionArrays from(DirectionArrays a, uint32_t k) noexcept { return {a.x + k, a.y + k, a.z + k}; }
-LookupArrays from(LookupArrays a, uint32_t k) noexcept { return {a.r + k, a.g + k, a.b + k, a.pdf + k}; }
-SampleArrays from(SampleArrays a, uint32_t k) noexcept {
-    return {a.x + k,
-            a.y + k,
-            a.z + k,
-            a.pdf + k,
-            a.r + k,
-            a.g + k,
-            a.b + k,
-            a.u ? a.u + k : nullptr,
-            a.v ? a.v + k : nullptr};
-}
-
 // A picking batch form as the form over picked bins, `many`, a chunk of lanes at a time.
 template <class In, class Out, class Many>
 void in_picked_chunks(const PickedBins& pick, In in, Out out, uint32_t n, Many&& many) noexcept {
@@ -308,7 +286,7 @@ void in_picked_chunks(const PickedBins& pick, In in, Out out, uint32_t n, Many&&
     for (uint32_t first = 0; first < n; first += kChunk) {
         const uint32_t m = std::min(kChunk, n - first);
         for (uint32_t i = 0; i < m; ++i) bins[i] = pick(first + i);
-        many(bins, from(in, first), from(out, first), m);
+        many(bins, from_lane(in, first), from_lane(out, first), m);
     }
 }
 

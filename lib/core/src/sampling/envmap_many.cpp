@@ -77,11 +77,7 @@ void sample_scalar(const EnvMapView& env, PointArrays in, SampleArrays out, uint
             return find_row(env, {in.x[l], in.y[l]});
         },
         [&](CellHit r, uint32_t l) noexcept {
-            const EnvSample e = sample_in_row(env, r, {in.x[l], in.y[l]});
-            out.x[l] = e.direction.x, out.y[l] = e.direction.y, out.z[l] = e.direction.z, out.pdf[l] = e.pdf;
-            out.r[l] = e.radiance.r, out.g[l] = e.radiance.g, out.b[l] = e.radiance.b;
-            if (out.u) out.u[l] = e.uv.x;
-            if (out.v) out.v[l] = e.uv.y;
+            detail::store_sample(out, l, sample_in_row(env, r, {in.x[l], in.y[l]}));
         });
 }
 

@@ -75,8 +75,6 @@ void to_world(const Rotation& r, SampleArrays out, uint32_t n) noexcept {
     }
 }
 
-LookupArrays offset(LookupArrays a, uint32_t k) noexcept { return {a.r + k, a.g + k, a.b + k, a.pdf + k}; }
-
 }  // namespace
 
 void lookup_many(const Rotated<EnvMapView>& env, DirectionArrays in, LookupArrays out, uint32_t n) noexcept {
@@ -84,7 +82,7 @@ void lookup_many(const Rotated<EnvMapView>& env, DirectionArrays in, LookupArray
     for (uint32_t first = 0; first < n; first += kBlock) {
         const uint32_t count = std::min(kBlock, n - first);
         to_local(env.rotation, in, first, count, local);
-        lookup_many(env.view, local.arrays(), offset(out, first), count);
+        lookup_many(env.view, local.arrays(), from_lane(out, first), count);
     }
 }
 
@@ -100,8 +98,8 @@ void lookup_many(const RotatedBinned& env, uint32_t lobe, LobeAxisArrays axes, c
         const uint32_t count = std::min(kBlock, n - first);
         to_local(env.rotation, {axes.x, axes.y, axes.z}, first, count, local_axes);
         to_local(env.rotation, in, first, count, local);
-        lookup_many(*env.map, lobe, local_axes.axes(axes, first), choices + first, local.arrays(), offset(out, first),
-                    count);
+        lookup_many(*env.map, lobe, local_axes.axes(axes, first), choices + first, local.arrays(),
+                    from_lane(out, first), count);
     }
 }
 
@@ -111,17 +109,8 @@ void sample_many(const RotatedBinned& env, uint32_t lobe, LobeAxisArrays axes, c
     for (uint32_t first = 0; first < n; first += kBlock) {
         const uint32_t count = std::min(kBlock, n - first);
         to_local(env.rotation, {axes.x, axes.y, axes.z}, first, count, local_axes);
-        SampleArrays part{out.x + first,
-                          out.y + first,
-                          out.z + first,
-                          out.pdf + first,
-                          out.r + first,
-                          out.g + first,
-                          out.b + first,
-                          out.u ? out.u + first : nullptr,
-                          out.v ? out.v + first : nullptr};
-        sample_many(*env.map, lobe, local_axes.axes(axes, first), choices + first, {in.x + first, in.y + first}, part,
-                    count);
+        sample_many(*env.map, lobe, local_axes.axes(axes, first), choices + first, from_lane(in, first),
+                    from_lane(out, first), count);
     }
     to_world(env.rotation, out, n);
 }

@@ -498,7 +498,7 @@ struct BinnedEnvMapView {
 // calls. Host only; noexcept and allocation-free. On the path envmis/cpu.h chose for
 // EnvMap's batch forms: AVX2 searches each lane's bin and cell by gathers, eight lanes at
 // a time, where the map fits 32-bit gather indices and its cells hold two texels or more
-// (any map of the default grid); the scalar pipeline elsewhere.
+// (maps 64 texels wide or more on the default grid); the scalar pipeline elsewhere.
 ENVMIS_CORE_API void lookup_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes, const float* choices,
                                  DirectionArrays in, LookupArrays out, uint32_t n) noexcept;
 ENVMIS_CORE_API void sample_many(const BinnedEnvMapView& env, uint32_t lobe, LobeAxisArrays axes, const float* choices,

@@ -222,6 +222,21 @@ struct SampleArrays {
     float *u = nullptr, *v = nullptr;  // optional: the image point's two coordinates
 };
 ENVMIS_CORE_API void sample_many(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t n) noexcept;
+// The arrays from lane k on: a batch call over the lanes of a batch from k on.
+inline DirectionArrays from_lane(DirectionArrays a, uint32_t k) noexcept { return {a.x + k, a.y + k, a.z + k}; }
+inline LookupArrays from_lane(LookupArrays a, uint32_t k) noexcept { return {a.r + k, a.g + k, a.b + k, a.pdf + k}; }
+inline PointArrays from_lane(PointArrays a, uint32_t k) noexcept { return {a.x + k, a.y + k}; }
+inline SampleArrays from_lane(SampleArrays a, uint32_t k) noexcept {
+    return {a.x + k,
+            a.y + k,
+            a.z + k,
+            a.pdf + k,
+            a.r + k,
+            a.g + k,
+            a.b + k,
+            a.u ? a.u + k : nullptr,
+            a.v ? a.v + k : nullptr};
+}
 
 // Row y (of h) of the image-space density that a map with these options and stats
 // samples, q(x, y) w_y, from that row's radiance (row.size() values): what
