@@ -163,7 +163,7 @@ ENVMIS_AVX2 void sample8(const EnvMapView& env, const Rows8& rows, SampleArrays 
     store_sample8(env, p, at8(env, p, image_pdf8(d, r.width, c.width)), rows.row + c.index, out, l);
 }
 
-// Rows found and columns' data prefetched for up to four groups before the first
+// Rows found and columns' data prefetched for up to eight groups before the first
 // group's column search.
 ENVMIS_AVX2 uint32_t sample_avx2(const EnvMapView& env, PointArrays in, SampleArrays out, uint32_t n) noexcept {
     const uint32_t hot_units = env.distribution.hot_row_units();

@@ -120,7 +120,7 @@ void lookup_lanes(const EnvMapView& env, DirectionArrays in, LookupArrays out, u
 
 // Estimates side by side, for the fixed-weight techniques over one density (or one
 // bin per estimate).
-constexpr uint32_t kLanes = 32;
+constexpr uint32_t kLanes = 64;
 
 // The bins of the lanes' estimates at one point: each estimate picks its own among the
 // bins around the point's axis (BinnedEnvMapView::bin) with its first random number,

@@ -137,7 +137,7 @@ public:
     // out.size() estimates at one point, the same as that many calls of the above in
     // a row (bit-identical, the same random numbers). The techniques with fixed weights
     // (env, bsdf, mis-balance, mis-power; plain, compensated or binned) with at most 8 samples
-    // per estimate run up to 32 estimates side by side: the shading frame is built
+    // per estimate run up to 64 estimates side by side: the shading frame is built
     // once, and each step runs over all of them before the next, so their cache misses
     // overlap instead of following one another; on x86-64 CPUs with AVX2, eight of them
     // at a time in SIMD lanes. This is the fast path, well ahead of single calls in
