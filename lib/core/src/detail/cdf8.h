@@ -61,9 +61,9 @@ ENVMIS_AVX2 inline void store_radiance8(const Rgb* radiance, I8 texel, float* r,
 // overlap. Without the staging, three quarters of lookup_avx2's time went waiting on
 // its first radiance gather; eight groups rather than four took a 1k map's batch lookup
 // a third faster (measured: docs/performance-log.md, 'kGroups'). Returns n - n % 8.
+inline constexpr uint32_t kGroups = 8;
 template <class Start, class Finish>
 ENVMIS_AVX2 uint32_t in_staged_groups(uint32_t n, Start&& start, Finish&& finish) noexcept {
-    constexpr uint32_t kGroups = 8;
     const uint32_t whole = n - n % 8;
     for (uint32_t first = 0; first < whole; first += 8 * kGroups) {
         const uint32_t groups = std::min(kGroups, (whole - first) / 8);

@@ -248,12 +248,11 @@ ENVMIS_AVX2_FLAT void place8(const BinnedEnvMapView& env, const Sample8& s, Samp
     store_sample8(env.plain, p, e, s.y * I8(d.w) + s.x, out, l);
 }
 
-// Up to eight groups of eight through each stage before the next stage, so that the
-// misses of their loads overlap, as the scalar path's blocks do.
+// Up to kGroups groups of eight through each stage before the next stage, as
+// in_staged_groups does with two, so that the misses of their loads overlap.
 ENVMIS_AVX2 uint32_t sample_avx2(const BinView* bins, PointArrays in, SampleArrays out, uint32_t n) noexcept {
     const BinnedEnvMapView* env = nullptr;
     const uint32_t lanes = avx2_lanes(bins, n, env), whole = lanes - lanes % 8;
-    constexpr uint32_t kGroups = 8;
     Sample8 s[kGroups];
     for (uint32_t first = 0; first < whole; first += 8 * kGroups) {
         const uint32_t groups = std::min(kGroups, (whole - first) / 8);
