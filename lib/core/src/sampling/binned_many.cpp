@@ -64,8 +64,8 @@ void lookup_scalar(const BinView* bins, DirectionArrays in, LookupArrays out, ui
 // BinView::sample in turn (a prefetch of the bin's CDF at u.x's guide bucket; cell; the
 // texel CDF's guide span; texel; radiance), each stage prefetching what the next loads,
 // so that the misses of a block's samples overlap instead of each sample waiting on its
-// chain of dependent loads. The stages are the
-// single call's own functions, so the results are bit-identical to it.
+// chain of dependent loads. The stages are the single call's own functions, so the
+// results are bit-identical to it.
 void sample_scalar(const BinView* lanes, PointArrays in, SampleArrays out, uint32_t from, uint32_t n) noexcept {
     constexpr uint32_t kBlock = 16;
     BinView::Cell cells[kBlock];
