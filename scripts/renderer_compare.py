@@ -72,7 +72,10 @@ def render(args, table, env, scene, out, seed, bounces, spp=None, seconds=None, 
     command += ["--reference", reference] if reference else []
     command += ["--profile"] if profile else []
     run(command)
-    return json.loads(Path(out).with_suffix(".json").read_text())
+    result = json.loads(Path(out).with_suffix(".json").read_text())
+    if reference and result["relative_mse"] is None:  # the renderer writes null for a NaN
+        sys.exit(f"renderer_compare: {out}: relative MSE is not finite (NaN pixels?)")
+    return result
 
 
 def interleaved(seeds, names):
@@ -93,7 +96,8 @@ def compare_case(args, made, scene, stem, work, bounces):
     and the floor: the plain (complete) table with FLOOR_LIGHT_SAMPLES environment samples
     a vertex."""
     prefix = work / f"{stem}.{scene}.b{bounces}"
-    reference = Path(f"{prefix}.reference.exr")
+    # Named by what makes it, so that a run with another size or count renders its own.
+    reference = Path(f"{prefix}.reference.{args.size}.{args.reference_spp}spp.exr")
     if not reference.exists():
         render(args, made["plain"], "global", scene, reference, 1000, bounces, spp=args.reference_spp)
     case = {"scene": scene, "map": stem, "techniques": {}}
@@ -238,7 +242,8 @@ def picture(results, args, path):
     if case is None:
         sys.exit(f"renderer_compare: no case {args.picture_case} in the results")
     prefix = Path(args.work) / f"{map_stem}.{scene}.b{run_['bounces']}"
-    panels = [("reference", f"{prefix}.reference.png", f"{args.reference_spp} spp, plain table")]
+    reference = f"{prefix}.reference.{args.size}.{args.reference_spp}spp.png"
+    panels = [("reference", reference, f"{args.reference_spp} spp, plain table")]
     names = {"compensated": "global compensated", "pbrt": "pbrt-v4-style", "bins": "normal-aware (bins)"}
     for name, label in names.items():
         t = case["techniques"][name]
@@ -288,7 +293,7 @@ def main():
     p.add_argument("--reference-spp", type=int, default=1024)
     p.add_argument("--seeds", type=int, default=5)
     p.add_argument("--bounces", type=int, nargs="+", default=[4, 1], help="one table for each")
-    p.add_argument("--threads", type=int, default=os.cpu_count())
+    p.add_argument("--threads", type=int, default=len(os.sched_getaffinity(0)), help="default: the usable cores")
     p.add_argument("--json", help="write the results here")
     p.add_argument("--markdown", help="write the tables here")
     p.add_argument("--picture", help="write a labelled equal-time comparison of --picture-case here (.jpg, .png)")
@@ -298,6 +303,9 @@ def main():
     args = p.parse_args()
     if args.spp < 1 or args.reference_spp < 2 or args.seeds < 1 or min(args.bounces) < 1 or args.threads < 1:
         p.error("--spp, --seeds, --bounces and --threads must be at least 1, --reference-spp at least 2")
+    stems = [Path(m).stem for m in args.maps]
+    if len(set(stems)) != len(stems):
+        p.error("--maps: two maps share a file stem, which names their tables and images in --work")
     work = Path(args.work)
     work.mkdir(parents=True, exist_ok=True)
     command = "/usr/bin/python3 scripts/renderer_compare.py " + " ".join(sys.argv[1:])

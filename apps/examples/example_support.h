@@ -47,7 +47,9 @@ inline uint64_t parse_number(std::string_view flag, const std::string& text, uin
     } catch (const std::exception&) {
         used = 0;
     }
-    if (used != text.size() || text.empty() || text[0] == '-' || value < lo || value > hi)
+    // stoull skips leading spaces and takes a sign ("-1" wraps to 2^64 - 1): digits only.
+    const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+    if (!digits || used != text.size() || value < lo || value > hi)
         throw UsageError(std::string(flag) + " '" + text + "': expected an integer from " + std::to_string(lo) +
                          " to " + std::to_string(hi));
     return value;

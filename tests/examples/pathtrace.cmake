@@ -90,6 +90,22 @@ set_tests_properties(examples.pathtrace.objects.bins-first PROPERTIES
 set_tests_properties(examples.pathtrace.objects.bins-first.converges PROPERTIES
   FIXTURES_REQUIRED envmis_pt_bins_first TIMEOUT 60)
 
+# Several environment samples a vertex (balance heuristic with counts), and bins at the
+# first two vertices with the binned table's own plain density beyond: both converge.
+foreach(variant light-samples:compensated:global:--light-samples:4 bins-depth:bins:bins:--bins-depth:2)
+  string(REPLACE ":" ";" parts ${variant})
+  list(POP_FRONT parts name table env)
+  add_test(NAME examples.pathtrace.objects.${name}
+    COMMAND ${envmis_pt} ${envmis_pt_work}/${table}.envmis -o ${envmis_pt_work}/objects-${name}.exr --scene objects
+      --env ${env} ${parts} --spp 256 --seed 1 ${envmis_pt_args})
+  add_test(NAME examples.pathtrace.objects.${name}.converges
+    COMMAND ${envmis_pt_check} ${envmis_pt_work}/objects-reference.json ${envmis_pt_work}/objects-${name}.json)
+  set_tests_properties(examples.pathtrace.objects.${name} PROPERTIES
+    FIXTURES_REQUIRED envmis_pt_objects FIXTURES_SETUP envmis_pt_objects_${name} TIMEOUT 300)
+  set_tests_properties(examples.pathtrace.objects.${name}.converges PROPERTIES
+    FIXTURES_REQUIRED envmis_pt_objects_${name} TIMEOUT 60)
+endforeach()
+
 # The sky turned at render time (--rotate 90, rotated.h): every technique converges to
 # the turned reference, which differs from the unturned one.
 add_test(NAME examples.pathtrace.rotated.reference
@@ -140,6 +156,16 @@ add_test(NAME examples.pathtrace.refuses-bins-without-bins
 add_test(NAME examples.pathtrace.refuses-beyond-of-another-image
   COMMAND ${envmis_pt} ${envmis_pt_work}/bins.envmis -o ${envmis_pt_work}/refused.exr --env bins --bins-depth 1
     --beyond ${envmis_examples_work}/compensated.envmis)
+add_test(NAME examples.pathtrace.refuses-beyond-without-depth
+  COMMAND ${envmis_pt} ${envmis_pt_work}/bins.envmis -o ${envmis_pt_work}/refused.exr --env bins
+    --beyond ${envmis_pt_work}/compensated.envmis)
+add_test(NAME examples.pathtrace.refuses-a-missing-output-folder
+  COMMAND ${envmis_pt} ${envmis_pt_work}/compensated.envmis -o ${envmis_pt_work}/no-such-folder/x.exr)
+add_test(NAME examples.pathtrace.refuses-a-reference-of-another-size
+  COMMAND ${envmis_pt} ${envmis_pt_work}/compensated.envmis -o ${envmis_pt_work}/refused.exr --size 16x16
+    --reference ${envmis_pt_work}/objects-reference.exr)
+add_test(NAME examples.pathtrace.refuses-a-signed-number
+  COMMAND ${envmis_pt} ${envmis_pt_work}/compensated.envmis -o ${envmis_pt_work}/refused.exr --seed " -1")
 add_test(NAME examples.pathtrace.refuses-unknown-scene
   COMMAND ${envmis_pt} ${envmis_pt_work}/compensated.envmis -o ${envmis_pt_work}/refused.exr --scene kitchen)
 add_test(NAME examples.pathtrace.refuses-a-bad-obj
@@ -151,10 +177,21 @@ set_tests_properties(examples.pathtrace.refuses-bins-without-bins PROPERTIES
   PASS_REGULAR_EXPRESSION "has no bins.*--bins 121")
 set_tests_properties(examples.pathtrace.refuses-beyond-of-another-image PROPERTIES
   PASS_REGULAR_EXPRESSION "--beyond needs a table of the same image")
+set_tests_properties(examples.pathtrace.refuses-beyond-without-depth PROPERTIES
+  PASS_REGULAR_EXPRESSION "--beyond is the table past --bins-depth: add --bins-depth N")
+set_tests_properties(examples.pathtrace.refuses-a-missing-output-folder PROPERTIES
+  PASS_REGULAR_EXPRESSION "x\\.exr: no such folder")
+set_tests_properties(examples.pathtrace.refuses-a-reference-of-another-size PROPERTIES
+  PASS_REGULAR_EXPRESSION "the reference is 48x36, the render 16x16"
+  FIXTURES_REQUIRED "envmis_pt_built;envmis_pt_tables;envmis_pt_objects" TIMEOUT 60)
+set_tests_properties(examples.pathtrace.refuses-a-signed-number PROPERTIES
+  PASS_REGULAR_EXPRESSION "--seed ' -1': expected an integer")
 set_tests_properties(examples.pathtrace.refuses-unknown-scene PROPERTIES
   PASS_REGULAR_EXPRESSION "--scene 'kitchen': expected one of objects, materials, interior, mesh")
 set_tests_properties(examples.pathtrace.refuses-a-bad-obj PROPERTIES
   PASS_REGULAR_EXPRESSION "not a readable OBJ file|no faces")
 set_tests_properties(examples.pathtrace.refuses-pbrt-on-equirect examples.pathtrace.refuses-bins-without-bins
-  examples.pathtrace.refuses-beyond-of-another-image examples.pathtrace.refuses-unknown-scene examples.pathtrace.refuses-a-bad-obj PROPERTIES
+  examples.pathtrace.refuses-beyond-of-another-image examples.pathtrace.refuses-beyond-without-depth
+  examples.pathtrace.refuses-a-missing-output-folder examples.pathtrace.refuses-a-signed-number
+  examples.pathtrace.refuses-unknown-scene examples.pathtrace.refuses-a-bad-obj PROPERTIES
   FIXTURES_REQUIRED "envmis_pt_built;envmis_pt_tables;envmis_examples_tables" TIMEOUT 60)

@@ -154,7 +154,9 @@ Rgb trace_path(const Environment& env, const RayScene& scene, const SceneDescrip
                 radiance = radiance + throughput * light.radiance * Rgb{f.r, f.g, f.b} * (1 / (n * light.pdf + f.pdf));
         }
         const envmis::BsdfSample s = material.sample(wo, rng.uniform2(), rng.uniform());
-        if (!(s.pdf > 0)) break;
+        // A lobe's sample below the shading horizon has a density but no value: the path
+        // would carry nothing further and still trace its rays.
+        if (!(s.pdf > 0) || !(s.value.r > 0 || s.value.g > 0 || s.value.b > 0)) break;
         const Vec3 next = frame.to_world(s.wi);
         if (envmis::dot(next, hit->geometric_normal) <= 0) break;  // below the surface: no light through it
         throughput = throughput * s.value * (1 / s.pdf);

@@ -303,14 +303,23 @@ void write_file(const std::filesystem::path& path, const std::string& text) {
     std::filesystem::rename(tmp, path);
 }
 
-std::string summary_json(const Options& o, const Loaded& l, const SceneDescription& scene, const RenderResult& r) {
+// A number as JSON has it: null where it is not finite (a NaN pixel in the image).
+std::string json_number(double x) {
+    if (!std::isfinite(x)) return "null";
+    std::ostringstream out;
+    out << x;
+    return out.str();
+}
+
+std::string summary_json(const Options& o, const Loaded& l, const SceneDescription& scene, const RenderResult& r,
+                         const std::optional<envmis::RgbImage>& reference) {
     std::ostringstream j;
     const double rays_per_second = r.thread_seconds > 0 ? static_cast<double>(r.counters.rays) / r.thread_seconds : 0;
     j << "{\n  \"scene\": " << json_string(scene.name) << ",\n  \"triangles\": " << scene.triangles()
       << ",\n  \"table\": " << json_string(o.table.string()) << ",\n  \"technique\": " << json_string(l.technique)
       << ",\n  \"width\": " << o.width << ",\n  \"height\": " << o.height << ",\n  \"passes\": " << r.passes
       << ",\n  \"seed\": " << o.seed << ",\n  \"bounces\": " << o.path.max_bounces
-      << ",\n  \"bins_depth\": " << std::min<uint32_t>(o.bins_depth, 64)
+      << ",\n  \"bins_depth\": " << (o.bins_depth == UINT32_MAX ? std::string("null") : std::to_string(o.bins_depth))
       << ",\n  \"light_samples\": " << o.path.light_samples << ",\n  \"rotate_degrees\": " << o.rotate_degrees
       << ",\n  \"threads\": " << o.threads << ",\n  \"seconds\": " << r.seconds
       << ",\n  \"thread_seconds\": " << r.thread_seconds << ",\n  \"rays\": " << r.counters.rays
@@ -325,19 +334,32 @@ std::string summary_json(const Options& o, const Loaded& l, const SceneDescripti
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
         const double rate = static_cast<double>(ticks() - t0) /
                             std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count();
-        j << ",\n  \"sampler_share\": " << static_cast<double>(r.counters.sampler_ticks) / rate / r.thread_seconds;
+        j << ",\n  \"sampler_share\": "
+          << json_number(static_cast<double>(r.counters.sampler_ticks) / rate / r.thread_seconds);
     }
-    if (o.reference)
+    if (reference)
         j << ",\n  \"reference\": " << json_string(o.reference->string()) << ",\n  \"relative_mse\": "
-          << examples::relative_mse(r.image, examples::read_exr(*o.reference), o.output.string());
-    j << ",\n  \"mean_luminance\": " << r.mean_luminance << ",\n  \"standard_error\": " << r.standard_error
+          << json_number(examples::relative_mse(r.image, *reference, o.output.string()));
+    j << ",\n  \"mean_luminance\": " << json_number(r.mean_luminance)
+      << ",\n  \"standard_error\": " << json_number(r.standard_error)
       << ",\n  \"cpu\": " << json_string(cpu_name()) << "\n}\n";
     return j.str();
 }
 
 int run(const Options& o) {
-    if (o.reference && !std::filesystem::is_regular_file(*o.reference))
-        throw std::runtime_error(o.reference->string() + ": no such reference image");
+    const std::filesystem::path folder = o.output.parent_path().empty() ? "." : o.output.parent_path();
+    if (!std::filesystem::is_directory(folder))
+        throw std::runtime_error(o.output.string() + ": no such folder " + folder.string());
+    std::optional<envmis::RgbImage> reference;
+    if (o.reference) {
+        if (!std::filesystem::is_regular_file(*o.reference))
+            throw std::runtime_error(o.reference->string() + ": no such reference image");
+        reference = examples::read_exr(*o.reference);
+        if (reference->width != o.width || reference->height != o.height)
+            throw std::runtime_error(o.reference->string() + ": the reference is " + std::to_string(reference->width) +
+                                     "x" + std::to_string(reference->height) + ", the render " +
+                                     std::to_string(o.width) + "x" + std::to_string(o.height));
+    }
     const std::unique_ptr<Loaded> loaded = load(o);
     const envmis::EnvMap& map = loaded->map();
     if (map.options().axes != envmis::Axes{})
@@ -369,7 +391,7 @@ int run(const Options& o) {
     json.replace_extension(".json");
     envmis::io::write_exr(o.output, r.image);
     envmis::io::write_png(png, envmis::pictures::tonemap(r.image, 0, map.options().luma));
-    write_file(json, summary_json(o, *loaded, scene, r));
+    write_file(json, summary_json(o, *loaded, scene, r, reference));
     std::printf("%s, %s (%zu triangles), %s: %ux%u, %u spp, %.2f s, %.3g rays/s per thread -> %s\n",
                 o.table.string().c_str(), scene.name.c_str(), scene.triangles(), loaded->technique.c_str(), o.width,
                 o.height, r.passes, r.seconds,
@@ -475,6 +497,8 @@ Options parse(int argc, char** argv) {
     if (o.obj && o.scene != "mesh") throw UsageError("--obj replaces the mesh scene's knot: add --scene mesh");
     if ((o.beyond || o.bins_depth != UINT32_MAX) && o.env != EnvKind::bins)
         throw UsageError("--bins-depth and --beyond choose where bins are sampled: add --env bins");
+    if (o.beyond && o.bins_depth == UINT32_MAX)
+        throw UsageError("--beyond is the table past --bins-depth: add --bins-depth N");
     if (o.seconds > 0 && !spp_given) o.spp = 1u << 24;  // the time decides
     o.table = positional[0];
     return o;
