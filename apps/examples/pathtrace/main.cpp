@@ -338,11 +338,11 @@ std::string summary_json(const Options& o, const Loaded& l, const SceneDescripti
           << json_number(static_cast<double>(r.counters.sampler_ticks) / rate / r.thread_seconds);
     }
     if (reference)
-        j << ",\n  \"reference\": " << json_string(o.reference->string()) << ",\n  \"relative_mse\": "
-          << json_number(examples::relative_mse(r.image, *reference, o.output.string()));
+        j << ",\n  \"reference\": " << json_string(o.reference->string())
+          << ",\n  \"relative_mse\": " << json_number(examples::relative_mse(r.image, *reference, o.output.string()));
     j << ",\n  \"mean_luminance\": " << json_number(r.mean_luminance)
-      << ",\n  \"standard_error\": " << json_number(r.standard_error)
-      << ",\n  \"cpu\": " << json_string(cpu_name()) << "\n}\n";
+      << ",\n  \"standard_error\": " << json_number(r.standard_error) << ",\n  \"cpu\": " << json_string(cpu_name())
+      << "\n}\n";
     return j.str();
 }
 
