@@ -189,6 +189,22 @@ TEST_F(Sweep, AllocationSweepMarksTheMostEfficientSplit) {
     EXPECT_NE(r.out.find("best allocation"), std::string::npos) << r;
 }
 
+TEST_F(Sweep, AllocationSweepSamplesTheBinsAskedFor) {
+    // One bin (every normal alike) and 49: the same seeds, so the variances differ only
+    // if each split samples the bins --bins built.
+    std::vector<double> variances[2];
+    for (int k = 0; k < 2; ++k) {
+        const Result r =
+            compare(std::string("--allocation-sweep 3 --techniques mis-balance-bins --bsdf lambert --bins ") +
+                    (k ? "49" : "1") + " --json bins.json");
+        ASSERT_EQ(r.exit_code, 0) << r;
+        const nlohmann::json j = json("bins.json");
+        for (const auto& row : j["allocation"]) variances[k].push_back(row["variance"].get<double>());
+    }
+    ASSERT_EQ(variances[0].size(), 2u);
+    EXPECT_NE(variances[0], variances[1]);
+}
+
 TEST_F(Sweep, PlotsAreWrittenAsPngsOfTheDocumentedSize) {
     const Result normal = compare("--techniques env,mis-balance,mis-balance-comp --plots plots");
     ASSERT_EQ(normal.exit_code, 0) << normal;

@@ -157,7 +157,7 @@ std::vector<Technique> allocation_sweep_techniques(std::span<const Technique> re
 
 AllocationSweep run_allocation_sweep(const StudyInputs& inputs, uint32_t total, const RunControl& control) {
     AllocationSweep sweep;
-    StudyInputs run{inputs.plain, inputs.compensated, inputs.points, sweep_options(inputs.options)};
+    StudyInputs run{inputs.plain, inputs.compensated, inputs.points, sweep_options(inputs.options), inputs.binned};
     for (uint32_t k = 1; k < total; ++k) {
         run.options.allocation = {k, total - k};
         Comparison c = compare(run, run_control(control, k - 1, total - 1, inputs.points.size()));

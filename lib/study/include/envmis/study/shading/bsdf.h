@@ -90,11 +90,14 @@ struct Bsdf {
 
 namespace ggx {
 
-// Trowbridge-Reitz normal distribution D(m), m in the local frame.
+// Trowbridge-Reitz normal distribution D(m), m a unit vector in the local frame. Its
+// denominator a^2 cos^2 + sin^2 as written: the textbook's cos^2 (a^2 - 1) + 1 cancels to
+// a^2 cos^2 near the peak, where a float cos^2 carries an error of 6e-8, a^2's size at
+// a = 0.00025 (at a = 0.001 the pdf then integrated to 1.08 head-on).
 template <class V>
 ENVMIS_HD inline LaneOf<V> distribution(const V& m, float alpha) noexcept {
     const float a2 = alpha * alpha;
-    const LaneOf<V> t = m.z * m.z * (a2 - 1) + 1.0f;
+    const LaneOf<V> t = a2 * (m.z * m.z) + (m.x * m.x + m.y * m.y);
     return select(m.z <= 0.0f, 0.0f, a2 / (kPiF * t * t));
 }
 // Smith's Lambda(v) for GGX.
