@@ -80,6 +80,27 @@ TEST(Quadrature, ExactVarianceMatchesMeasuredVariance) {
         }
 }
 
+// The same where the two techniques take different sample counts: a weight or a
+// normalisation with the counts swapped gives another variance (one-sample MIS's too).
+TEST(Quadrature, ExactVarianceMatchesMeasuredVarianceAtUnequalCounts) {
+    const RgbImage image = test::random_map(64, 32, 3, 1.5f);
+    const EnvMap plain_map = build_env_map(image, plain()), compensated = build_env_map(image);
+    const ShadingPoint p{normalize(Vec3{0.1f, 0.2f, 1}), normalize(Vec3{0.5f, 0, 1})};
+    for (const Allocation a : {Allocation{3, 1}, Allocation{1, 4}})
+        for (const Bsdf& bsdf : {Bsdf::lambert(), Bsdf::phong(20)})
+            for (const char* name : {"mis-balance", "mis-power", "one-sample", "mis-balance-comp"}) {
+                const Technique t = Technique::parse(name);
+                const EnvMap& env = t.compensated ? compensated : plain_map;
+                const DirectLightingEstimator estimator(env, t, a);
+                Pcg32 rng(11);
+                RunningStats stats;
+                for (int i = 0; i < 200000; ++i) stats.add(luminance(estimator.estimate(p, bsdf, rng), {}));
+                const double exact = exact_variance(env, t, a, bsdf, p, 8);
+                EXPECT_NEAR(stats.variance(), exact, 0.04 * exact)
+                    << bsdf.name() << " " << name << " " << a.env << ":" << a.bsdf;
+            }
+}
+
 // The exact variance of a -bins technique is that of the bin the point picks: a normal
 // facing up and one facing down (another bin, another compensation) on the same map.
 TEST(Quadrature, ExactVarianceOfBinnedMisMatchesMeasuredVariance) {
