@@ -99,6 +99,25 @@ TEST_F(Report, SummarisesCasesWithGeometricMeansAndNamesTheBestMisTechnique) {
     EXPECT_NE(md.find("## a (8x4)"), std::string::npos);
 }
 
+TEST_F(Report, SingleTechniquesTakeTheirExactRatioWhereTheRunHasIt) {
+    // Measured, BSDF sampling looks 100x better than balance MIS: the sun it rarely finds
+    // is missing from the run. With --exact's figures the summary shows the exact ratio,
+    // for single techniques only (an MIS column stays measured), and says so.
+    const fs::path measured = write_run("a", {{"mis-balance", 1}, {"bsdf", 0.01}, {"mis-balance-comp", 0.8}});
+    json j = json::parse(read(measured));
+    j["exact"] = {{"lambert", {{"bsdf", {{"ratio", 210.0}}}, {"mis-balance-comp", {{"ratio", 0.7}}}}}};
+    const fs::path with_exact = dir_ / "exact.json";
+    std::ofstream(with_exact) << j.dump();
+    ASSERT_EQ(run(with_exact.string() + " -o " + (dir_ / "r.md").string()), 0);
+    const std::string md = read(dir_ / "r.md");
+    EXPECT_NE(md.find("| a | lambert | 210.000 | 0.800 |"), std::string::npos) << md;
+    EXPECT_NE(md.find("exact here: `--exact`, quadrature"), std::string::npos) << md;
+    ASSERT_EQ(run(measured.string() + " -o " + (dir_ / "m.md").string()), 0);
+    const std::string m = read(dir_ / "m.md");
+    EXPECT_NE(m.find("| a | lambert | 0.010 | 0.800 |"), std::string::npos) << m;
+    EXPECT_NE(m.find("may understate it by orders of magnitude"), std::string::npos) << m;
+}
+
 TEST_F(Report, EachRunsTableListsItsFiguresAndNoTimingLeavesOutOnlyTheTimedOnes) {
     const fs::path a = write_run("a", {{"mis-balance", 1}, {"mis-optimal", 0.5}});
     ASSERT_EQ(run(a.string() + " -o " + (dir_ / "timed.md").string()), 0);

@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <set>
 #include <stdexcept>
 
 #include "envmis/report/results.h"
@@ -135,6 +136,7 @@ std::string number(double v, const char* format = "%.4g") {
 struct Case {
     std::string map, bsdf;
     std::map<std::string, double> ratio;
+    std::set<std::string> exact;  // techniques whose ratio is the exact one (single techniques)
     std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> points;
 };
 
@@ -234,6 +236,7 @@ void write_allocation(std::ostream& out, const std::vector<json>& runs, bool no_
 
 // The techniques in the order of the first run that has them (mis-balance, the
 // baseline, left out) and the (map, BSDF) cases of all runs.
+bool single_technique(const std::string& t) { return !t.starts_with("mis-") && !t.starts_with("one-sample"); }
 std::pair<std::vector<std::string>, std::vector<Case>> collect_cases(const std::vector<json>& runs) {
     std::vector<std::string> techniques;
     std::vector<Case> cases;
@@ -247,6 +250,16 @@ std::pair<std::vector<std::string>, std::vector<Case>> collect_cases(const std::
                 std::find_if(cases.begin(), cases.end(), [&](const Case& c) { return c.map == map && c.bsdf == bsdf; });
             if (it == cases.end()) it = cases.insert(cases.end(), Case{map, bsdf, {}, {}});
             it->ratio[technique] = r["variance_ratio_vs_mis"];
+            // A single technique's measured variance misses its rare, bright samples: the
+            // exact ratio where the run computed one (compare --exact).
+            const json* exact =
+                run.contains("exact") && run["exact"].contains(bsdf) && run["exact"][bsdf].contains(technique)
+                    ? &run["exact"][bsdf][technique]
+                    : nullptr;
+            if (single_technique(technique) && exact && exact->contains("ratio")) {
+                it->ratio[technique] = (*exact)["ratio"];
+                it->exact.insert(technique);
+            }
             if (r.contains("point_variances") && r.contains("point_variance_rel_se"))
                 it->points[technique] = {r["point_variances"].get<std::vector<double>>(),
                                          r["point_variance_rel_se"].get<std::vector<double>>()};
@@ -304,6 +317,16 @@ void write_summary(std::ostream& out, const std::vector<std::string>& techniques
         if (t.starts_with("mis-") && n == static_cast<int>(cases.size()) && g < best_ratio) best_ratio = g, best = t;
     }
     out << "\n\n";
+    const bool singles = std::any_of(techniques.begin(), techniques.end(), single_technique);
+    const bool exact = std::any_of(cases.begin(), cases.end(), [](const Case& c) { return !c.exact.empty(); });
+    if (singles)
+        out << "A single technique's variance (" << (exact ? "exact here: `--exact`, quadrature" : "measured here")
+            << ") comes from rare, bright samples (a sun that BSDF sampling finds once in thousands of estimates), "
+               "which a finite run often lacks: "
+            << (exact ? "its measured ratio understates it, often by orders of magnitude. The MIS columns are measured."
+                      : "these measured ratios may understate it by orders of magnitude (`envmis compare MAP "
+                        "--exact` gives the exact ones).")
+            << "\n\n";
     if (!best.empty())
         out << "**Lowest variance of the MIS techniques across the table: `" << best << "`, "
             << number(1 / best_ratio, "%.2f") << "x lower variance than balance MIS (geometric mean over "
