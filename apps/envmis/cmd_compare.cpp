@@ -343,6 +343,16 @@ void print_comparison(std::ostream& out, const Comparison& c) {
     for (const BsdfComparison& b : c.bsdfs) out << verdict(b) << "\n";
 }
 
+// A warning for each BSDF whose quadrature reference did not converge to the tolerance.
+void print_reference_errors(std::ostream& out, const Comparison& c, double tolerance) {
+    for (const BsdfComparison& b : c.bsdfs)
+        if (b.reference_error > tolerance)
+            out << "warning: " << b.bsdf.name() << ": the quadrature reference did not converge (relative error up to "
+                << b.reference_error << ", tolerance " << tolerance
+                << "): its lobe is sharper than the subdivided texels resolve; rel_mse and the reference column carry "
+                   "that error\n";
+}
+
 // "0.8" for one albedo shared by all BSDFs, else "lambert 0.8, ggx:0.1 0.95/0.64/0.54".
 std::string albedo_text(std::span<const Bsdf> bsdfs) {
     std::string text;
@@ -446,8 +456,10 @@ void write_plot(const CompareArgs& args, Written& written, const char* name, con
 void write_comparison(std::ostream& out, const CompareArgs& args, const Setup& s, const Comparison& c, Written& w) {
     if (c.points_done < s.points.size()) out << "interrupted: results cover the points done\n";
     print_comparison(out, c);
+    print_reference_errors(out, c, s.options.quadrature.tolerance);
     const auto alpha_of = [&s](const Bsdf& b) { return s.alpha_of(b); };
     w.json["results"] = stats_results_json(c, alpha_of);
+    for (const BsdfComparison& b : c.bsdfs) w.json["reference_error"][b.bsdf.name()] = b.reference_error;
     for (const BsdfComparison& b : c.bsdfs) w.json["verdicts"].push_back(verdict(b));
     if (!args.csv.empty())
         write_file_atomically(args.csv, [&](std::ostream& out) {
@@ -475,7 +487,10 @@ void write_exact(std::ostream& out, const CompareArgs& args, const Setup& s, Wri
         for (const ExactRatio& r : ratios) {
             if (r.bsdf != b) continue;
             char text[96];
-            std::snprintf(text, sizeof text, " %s %.3f (%.3f)", r.technique.name().c_str(), r.ratio, r.worst());
+            if (std::isfinite(r.ratio))
+                std::snprintf(text, sizeof text, " %s %.3f (%.3f)", r.technique.name().c_str(), r.ratio, r.worst());
+            else
+                std::snprintf(text, sizeof text, " %s - (no point with a variance)", r.technique.name().c_str());
             out << text;
             w.json["exact"][s.options.bsdfs[b].name()][r.technique.name()] = {
                 {"ratio", r.ratio}, {"worst", r.worst()}, {"points", r.points}};

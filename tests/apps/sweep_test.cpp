@@ -45,6 +45,13 @@ public:
                                file("out.txt"), file("err.txt"));
     }
 
+    // The same at the one shading point `args` give (--normal excludes --points).
+    Result compare_at(const std::string& args) const {
+        return test::run_shell(
+            "cd '" + dir_.string() + "' && '" + ENVMIS_CLI + "' compare map.exr --spp 64 --threads 2 " + args,
+            file("out.txt"), file("err.txt"));
+    }
+
     nlohmann::json json(const std::string& name) const { return nlohmann::json::parse(std::ifstream(file(name))); }
 };
 
@@ -187,6 +194,29 @@ TEST_F(Sweep, AllocationSweepMarksTheMostEfficientSplit) {
     std::string header;
     EXPECT_EQ(csv_data_rows(read_file(file("r.csv")), &header), 18u);
     EXPECT_NE(r.out.find("best allocation"), std::string::npos) << r;
+}
+
+TEST_F(Sweep, ExactRatiosWithNoPointToCompareAreNoneRatherThanOne) {
+    // Seen from below its surface a point reflects nothing: every variance is 0, and no
+    // technique is as good as balance MIS there, nor worse.
+    const Result r = compare_at(
+        "--normal 0,0,1 --view 0,1,-0.2 --exact --techniques env,mis-balance --bsdf lambert "
+        "--json below.json");
+    ASSERT_EQ(r.exit_code, 0) << r;
+    EXPECT_NE(r.out.find("env - (no point with a variance)"), std::string::npos) << r;
+    EXPECT_TRUE(json("below.json")["exact"]["lambert"]["env"]["ratio"].is_null());
+}
+
+TEST_F(Sweep, AReferenceThatDidNotConvergeIsReported) {
+    // A GGX lobe of roughness 0.001 is far sharper than this map's texels, subdivided 32
+    // times; Lambert's cosine is not. compare's tolerance: 1e-3.
+    const Result r = compare_at("--normal 0,0,1 --bsdf ggx:0.001,lambert --techniques mis-balance --json ref.json");
+    ASSERT_EQ(r.exit_code, 0) << r;
+    EXPECT_NE(r.out.find("warning: ggx:0.001: the quadrature reference did not converge"), std::string::npos) << r;
+    EXPECT_EQ(r.out.find("warning: lambert"), std::string::npos) << r;
+    const nlohmann::json j = json("ref.json");
+    EXPECT_GT(j["reference_error"]["ggx:0.001"].get<double>(), 1e-3);
+    EXPECT_LE(j["reference_error"]["lambert"].get<double>(), 1e-3);
 }
 
 TEST_F(Sweep, AllocationSweepSamplesTheBinsAskedFor) {

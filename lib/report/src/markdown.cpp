@@ -248,7 +248,7 @@ std::pair<std::vector<std::string>, std::vector<Case>> collect_cases(const std::
                 techniques.push_back(technique);
             auto it =
                 std::find_if(cases.begin(), cases.end(), [&](const Case& c) { return c.map == map && c.bsdf == bsdf; });
-            if (it == cases.end()) it = cases.insert(cases.end(), Case{map, bsdf, {}, {}});
+            if (it == cases.end()) it = cases.insert(cases.end(), Case{map, bsdf, {}, {}, {}});
             it->ratio[technique] = r["variance_ratio_vs_mis"];
             // A single technique's measured variance misses its rare, bright samples: the
             // exact ratio where the run computed one (compare --exact).
@@ -256,7 +256,7 @@ std::pair<std::vector<std::string>, std::vector<Case>> collect_cases(const std::
                 run.contains("exact") && run["exact"].contains(bsdf) && run["exact"][bsdf].contains(technique)
                     ? &run["exact"][bsdf][technique]
                     : nullptr;
-            if (single_technique(technique) && exact && exact->contains("ratio")) {
+            if (single_technique(technique) && exact && exact->contains("ratio") && (*exact)["ratio"].is_number()) {
                 it->ratio[technique] = (*exact)["ratio"];
                 it->exact.insert(technique);
             }

@@ -231,14 +231,18 @@ TechniqueStats technique_stats(const CellTable& table, size_t b, size_t t, size_
     return s;
 }
 
-// Appends the point's reference for each BSDF; false, with nothing appended, once `stop`
-// is set (an 8k map's quadrature takes seconds: it stops within a row).
+// Appends the point's reference for each BSDF, and raises each BSDF's largest relative
+// error; false, with nothing appended, once `stop` is set (an 8k map's quadrature takes
+// seconds: it stops within a row).
 bool add_references(const EnvMap& plain, const ShadingPoint& point, const ComparisonOptions& options, StopFlag stop,
-                    std::vector<double>& references) {
+                    std::vector<double>& references, std::vector<double>& worst_error) {
     const size_t first = references.size();
     try {
-        for (const Bsdf& bsdf : options.bsdfs)
-            references.push_back(reflected_radiance(plain, bsdf, point, options.quadrature, stop).luminance);
+        for (size_t b = 0; b < options.bsdfs.size(); ++b) {
+            const QuadratureResult r = reflected_radiance(plain, options.bsdfs[b], point, options.quadrature, stop);
+            references.push_back(r.luminance);
+            if (r.luminance > 0) worst_error[b] = std::max(worst_error[b], r.error / r.luminance);
+        }
         return true;
     } catch (const Interrupted&) {
         references.resize(first);
@@ -261,12 +265,12 @@ Comparison compare_one(const EnvMap& plain, const EnvMap& compensated, const Bin
 
     // cells[(p * nb + b) * nt + t]; references[p * nb + b].
     std::vector<Cell> cells;
-    std::vector<double> references;
+    std::vector<double> references, reference_error(nb, 0.0);
     size_t done = 0;
     if (progress) progress(0, points.size());
     for (; done < points.size() && !(stop && stop->load()); ++done) {
         const ShadingPoint& point = points[done];
-        if (!add_references(plain, point, options, stop, references)) break;
+        if (!add_references(plain, point, options, stop, references, reference_error)) break;
         const size_t first = cells.size();
         cells.resize(first + nb * nt);
         std::atomic<size_t> next{0};
@@ -317,7 +321,7 @@ Comparison compare_one(const EnvMap& plain, const EnvMap& compensated, const Bin
     for (size_t t = 0; t < nt; ++t)
         if (options.techniques[t] == Technique::parse("mis-balance")) mis_index = t;
     for (size_t b = 0; b < nb; ++b) {
-        BsdfComparison bc{options.bsdfs[b], {}};
+        BsdfComparison bc{options.bsdfs[b], {}, reference_error[b]};
         for (size_t t = 0; t < nt; ++t)
             bc.techniques.push_back(technique_stats(table, b, t, mis_index, options.techniques[t]));
         result.bsdfs.push_back(std::move(bc));

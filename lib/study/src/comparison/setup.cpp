@@ -106,9 +106,13 @@ std::vector<ExactRatio> exact_ratios(const CompareSetup& setup, const RunControl
         for (const Technique& t : fixed) {
             const std::vector<double> v = exact_point_variances(inputs, t, b, 1, control.stop);
             std::vector<double> points(v.size(), 0.0);
+            bool any = false;
             for (size_t p = 0; p < v.size(); ++p)
-                if (v[p] > 0 && baseline[p] > 0) points[p] = v[p] / baseline[p];
-            ratios.push_back({b, t, geometric_mean_ratios(v, baseline, 1).front(), std::move(points)});
+                if (v[p] > 0 && baseline[p] > 0) points[p] = v[p] / baseline[p], any = true;
+            // No point to compare (every variance 0: a view below the surface): no ratio,
+            // rather than the neutral 1 the alpha choice ranks with.
+            const double ratio = any ? geometric_mean_ratios(v, baseline, 1).front() : NAN;
+            ratios.push_back({b, t, ratio, std::move(points)});
             step();
         }
     }

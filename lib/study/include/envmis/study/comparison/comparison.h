@@ -81,6 +81,11 @@ struct TechniqueStats {
 struct BsdfComparison {
     Bsdf bsdf;
     std::vector<TechniqueStats> techniques;  // in ComparisonOptions::techniques order
+    // The references' largest error estimate over the points, relative to their value
+    // (QuadratureResult::error / luminance): above ComparisonOptions::quadrature's
+    // tolerance where a reference stopped at its most subdivisions unconverged (a lobe
+    // far sharper than a texel), which rel_mse and the reference column then carry.
+    double reference_error = 0;
 
     const TechniqueStats* find(std::string_view technique) const;
 };

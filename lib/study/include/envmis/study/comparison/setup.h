@@ -81,8 +81,8 @@ CompareSetup prepare_compare(std::shared_ptr<const EnvMap> map, CompareRequest r
 struct ExactRatio {
     size_t bsdf = 0;  // in options.bsdfs order
     Technique technique;
-    double ratio = 0;
-    std::vector<double> points;
+    double ratio = 0;            // NaN where no point has both variances > 0
+    std::vector<double> points;  // per point; 0 where either variance is 0
     double worst() const noexcept { return points.empty() ? 0 : *std::max_element(points.begin(), points.end()); }
 };
 
