@@ -52,8 +52,23 @@ foreach(table plain:--no-compensate compensated bins:--bins:121)
     FIXTURES_REQUIRED envmis_pt_square FIXTURES_SETUP envmis_pt_tables TIMEOUT 120)
 endforeach()
 
-# Per scene: a reference (plain table, 4096 passes, seed 1000) and 256 passes of each
-# technique (seed 1); 48x36 pixels, 3 bounces.
+# A render of 256 passes (seed 1) that must converge to a reference: the tests
+# examples.pathtrace.NAME and NAME.converges (check_mean.py against REFERENCE.json, made
+# by the tests of fixture REQUIRED; its relative MSE in NAME.json); the arguments after
+# REQUIRED are the renderer's table and options.
+function(envmis_pt_converges name reference required)
+  add_test(NAME examples.pathtrace.${name}
+    COMMAND ${envmis_pt} ${ARGN} -o ${envmis_pt_work}/${name}.exr --spp 256 --seed 1 ${envmis_pt_args}
+      --reference ${envmis_pt_work}/${reference}.exr)
+  add_test(NAME examples.pathtrace.${name}.converges
+    COMMAND ${envmis_pt_check} ${envmis_pt_work}/${reference}.json ${envmis_pt_work}/${name}.json)
+  set_tests_properties(examples.pathtrace.${name} PROPERTIES
+    FIXTURES_REQUIRED ${required} FIXTURES_SETUP envmis_pt_${name} TIMEOUT 300)
+  set_tests_properties(examples.pathtrace.${name}.converges PROPERTIES
+    FIXTURES_REQUIRED envmis_pt_${name} TIMEOUT 60)
+endfunction()
+
+# Per scene: a reference (plain table, 4096 passes, seed 1000) and each technique.
 set(envmis_pt_args --size 48x36 --bounces 3)
 foreach(scene objects materials interior mesh)
   add_test(NAME examples.pathtrace.${scene}.reference
@@ -63,48 +78,21 @@ foreach(scene objects materials interior mesh)
     FIXTURES_REQUIRED "envmis_pt_built;envmis_pt_tables" FIXTURES_SETUP envmis_pt_${scene} TIMEOUT 300)
   foreach(technique plain:plain:global compensated:compensated:global bins:bins:bins pbrt:compensated:pbrt)
     string(REPLACE ":" ";" parts ${technique})
-    list(GET parts 0 name)
-    list(GET parts 1 table)
-    list(GET parts 2 env)
-    add_test(NAME examples.pathtrace.${scene}.${name}
-      COMMAND ${envmis_pt} ${envmis_pt_work}/${table}.envmis -o ${envmis_pt_work}/${scene}-${name}.exr
-        --scene ${scene} --env ${env} --spp 256 --seed 1 ${envmis_pt_args}
-        --reference ${envmis_pt_work}/${scene}-reference.exr)
-    add_test(NAME examples.pathtrace.${scene}.${name}.converges
-      COMMAND ${envmis_pt_check} ${envmis_pt_work}/${scene}-reference.json ${envmis_pt_work}/${scene}-${name}.json)
-    set_tests_properties(examples.pathtrace.${scene}.${name} PROPERTIES
-      FIXTURES_REQUIRED "envmis_pt_${scene}" FIXTURES_SETUP envmis_pt_${scene}_${name} TIMEOUT 300)
-    set_tests_properties(examples.pathtrace.${scene}.${name}.converges PROPERTIES
-      FIXTURES_REQUIRED envmis_pt_${scene}_${name} TIMEOUT 60)
+    list(POP_FRONT parts name table env)
+    envmis_pt_converges(${scene}.${name} ${scene}-reference envmis_pt_${scene}
+      ${envmis_pt_work}/${table}.envmis --scene ${scene} --env ${env})
   endforeach()
 endforeach()
 
-# Bins at the camera's hit only, the compensated table of the same image beyond.
-add_test(NAME examples.pathtrace.objects.bins-first
-  COMMAND ${envmis_pt} ${envmis_pt_work}/bins.envmis -o ${envmis_pt_work}/objects-bins-first.exr --scene objects
-    --env bins --bins-depth 1 --beyond ${envmis_pt_work}/compensated.envmis --spp 256 --seed 1 ${envmis_pt_args})
-add_test(NAME examples.pathtrace.objects.bins-first.converges
-  COMMAND ${envmis_pt_check} ${envmis_pt_work}/objects-reference.json ${envmis_pt_work}/objects-bins-first.json)
-set_tests_properties(examples.pathtrace.objects.bins-first PROPERTIES
-  FIXTURES_REQUIRED envmis_pt_objects FIXTURES_SETUP envmis_pt_bins_first TIMEOUT 300)
-set_tests_properties(examples.pathtrace.objects.bins-first.converges PROPERTIES
-  FIXTURES_REQUIRED envmis_pt_bins_first TIMEOUT 60)
-
-# Several environment samples a vertex (balance heuristic with counts), and bins at the
-# first two vertices with the binned table's own plain density beyond: both converge.
-foreach(variant light-samples:compensated:global:--light-samples:4 bins-depth:bins:bins:--bins-depth:2)
-  string(REPLACE ":" ";" parts ${variant})
-  list(POP_FRONT parts name table env)
-  add_test(NAME examples.pathtrace.objects.${name}
-    COMMAND ${envmis_pt} ${envmis_pt_work}/${table}.envmis -o ${envmis_pt_work}/objects-${name}.exr --scene objects
-      --env ${env} ${parts} --spp 256 --seed 1 ${envmis_pt_args})
-  add_test(NAME examples.pathtrace.objects.${name}.converges
-    COMMAND ${envmis_pt_check} ${envmis_pt_work}/objects-reference.json ${envmis_pt_work}/objects-${name}.json)
-  set_tests_properties(examples.pathtrace.objects.${name} PROPERTIES
-    FIXTURES_REQUIRED envmis_pt_objects FIXTURES_SETUP envmis_pt_objects_${name} TIMEOUT 300)
-  set_tests_properties(examples.pathtrace.objects.${name}.converges PROPERTIES
-    FIXTURES_REQUIRED envmis_pt_objects_${name} TIMEOUT 60)
-endforeach()
+# Bins at the camera's hit only, the compensated table of the same image beyond; at the
+# first two vertices, the binned table's own plain density beyond; several environment
+# samples a vertex (balance heuristic with counts).
+envmis_pt_converges(objects.bins-first objects-reference envmis_pt_objects ${envmis_pt_work}/bins.envmis
+  --scene objects --env bins --bins-depth 1 --beyond ${envmis_pt_work}/compensated.envmis)
+envmis_pt_converges(objects.bins-depth objects-reference envmis_pt_objects ${envmis_pt_work}/bins.envmis
+  --scene objects --env bins --bins-depth 2)
+envmis_pt_converges(objects.light-samples objects-reference envmis_pt_objects ${envmis_pt_work}/compensated.envmis
+  --scene objects --light-samples 4)
 
 # The sky turned at render time (--rotate 90, rotated.h): every technique converges to
 # the turned reference, which differs from the unturned one.
@@ -119,18 +107,9 @@ set_tests_properties(examples.pathtrace.rotated.differs PROPERTIES
   FIXTURES_REQUIRED "envmis_pt_rotated;envmis_pt_objects" TIMEOUT 60)
 foreach(technique compensated:compensated:global bins:bins:bins pbrt:compensated:pbrt)
   string(REPLACE ":" ";" parts ${technique})
-  list(GET parts 0 name)
-  list(GET parts 1 table)
-  list(GET parts 2 env)
-  add_test(NAME examples.pathtrace.rotated.${name}
-    COMMAND ${envmis_pt} ${envmis_pt_work}/${table}.envmis -o ${envmis_pt_work}/rotated-${name}.exr
-      --scene objects --env ${env} --spp 256 --seed 1 --rotate 90 ${envmis_pt_args})
-  add_test(NAME examples.pathtrace.rotated.${name}.converges
-    COMMAND ${envmis_pt_check} ${envmis_pt_work}/rotated-reference.json ${envmis_pt_work}/rotated-${name}.json)
-  set_tests_properties(examples.pathtrace.rotated.${name} PROPERTIES
-    FIXTURES_REQUIRED envmis_pt_rotated FIXTURES_SETUP envmis_pt_rotated_${name} TIMEOUT 300)
-  set_tests_properties(examples.pathtrace.rotated.${name}.converges PROPERTIES
-    FIXTURES_REQUIRED envmis_pt_rotated_${name} TIMEOUT 60)
+  list(POP_FRONT parts name table env)
+  envmis_pt_converges(rotated.${name} rotated-reference envmis_pt_rotated
+    ${envmis_pt_work}/${table}.envmis --scene objects --env ${env} --rotate 90)
 endforeach()
 
 # A time budget ends the render after the first pass that reaches it.
