@@ -248,8 +248,8 @@ ENVMIS_AVX2_FLAT void place8(const BinnedEnvMapView& env, const Sample8& s, Samp
     store_sample8(env.plain, p, e, s.y * I8(d.w) + s.x, out, l);
 }
 
-// Up to kGroups groups of eight through each stage before the next stage, as
-// in_staged_groups does with two, so that the misses of their loads overlap.
+// Up to kGroups groups of eight through each of the five stages before the next, as
+// in_staged_groups takes them through its two, so that the misses of their loads overlap.
 ENVMIS_AVX2 uint32_t sample_avx2(const BinView* bins, PointArrays in, SampleArrays out, uint32_t n) noexcept {
     const BinnedEnvMapView* env = nullptr;
     const uint32_t lanes = avx2_lanes(bins, n, env), whole = lanes - lanes % 8;
